@@ -1,0 +1,195 @@
+//! Small linear filters used inside the string loop and the body: first-order allpass
+//! (dispersion and Thiran fractional delay), one-pole loss filter, bandpass biquad.
+//!
+//! Every loop filter exposes its phase delay in samples at a normalised angular
+//! frequency `w` (rad/sample), so the string can account for it in the loop length.
+
+use std::f64::consts::PI;
+
+/// First-order allpass `A(z) = (a + z^-1) / (1 + a z^-1)`, |a| < 1.
+///
+/// With `a = (1 - d) / (1 + d)` it is Thiran's first-order fractional delay of `d` samples
+/// (exact at DC); with `a < 0` its delay falls with frequency, which is what a stiff
+/// string's dispersion needs (Van Duyne and Smith 1994).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Allpass1 {
+    pub a: f64,
+    x1: f64,
+    y1: f64,
+}
+
+impl Allpass1 {
+    pub fn new(a: f64) -> Self {
+        Self {
+            a,
+            x1: 0.0,
+            y1: 0.0,
+        }
+    }
+
+    #[inline]
+    pub fn tick(&mut self, x: f64) -> f64 {
+        let y = self.a * x + self.x1 - self.a * self.y1;
+        self.x1 = x;
+        self.y1 = y;
+        y
+    }
+
+    pub fn reset(&mut self) {
+        self.x1 = 0.0;
+        self.y1 = 0.0;
+    }
+
+    /// Phase delay in samples at `w` rad/sample (`w` in (0, pi)).
+    pub fn phase_delay(a: f64, w: f64) -> f64 {
+        1.0 - 2.0 * (a * w.sin()).atan2(1.0 + a * w.cos()) / w
+    }
+
+    /// The coefficient whose phase delay at `w` is exactly `delay` samples, by bisection
+    /// (phase delay falls monotonically as `a` grows). `delay` should lie in [0.5, 2.5].
+    pub fn coefficient_for_delay(delay: f64, w: f64) -> f64 {
+        let (mut lo, mut hi) = (-0.99, 0.99);
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if Self::phase_delay(mid, w) > delay {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        0.5 * (lo + hi)
+    }
+}
+
+/// One-pole lowpass loss filter `H(z) = g (1 - p) / (1 - p z^-1)`, 0 <= p < 1.
+/// Its gain is largest at DC (`g`), which is kept below 1 so the loop is passive.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct OnePoleLoss {
+    pub g: f64,
+    pub p: f64,
+    y1: f64,
+}
+
+impl OnePoleLoss {
+    /// Fits `p` and `g` so the filter's gain is `gain1` at `w1` and `gain2` at `w2`
+    /// (`w1 < w2`, `gain2 <= gain1 < 1`). The DC gain is capped at `MAX_DC_GAIN`.
+    pub fn fit(w1: f64, gain1: f64, w2: f64, gain2: f64) -> Self {
+        const MAX_DC_GAIN: f64 = 0.99995;
+        let target = (gain2 / gain1).min(1.0);
+        let ratio = |p: f64| {
+            ((1.0 - 2.0 * p * w1.cos() + p * p) / (1.0 - 2.0 * p * w2.cos() + p * p)).sqrt()
+        };
+        let (mut lo, mut hi) = (0.0, 0.999);
+        if ratio(hi) > target {
+            lo = hi;
+        } else {
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                if ratio(mid) > target {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+        }
+        let p = 0.5 * (lo + hi);
+        let g = (gain1 / Self::unit_gain(p, w1)).min(MAX_DC_GAIN);
+        Self { g, p, y1: 0.0 }
+    }
+
+    fn unit_gain(p: f64, w: f64) -> f64 {
+        (1.0 - p) / (1.0 - 2.0 * p * w.cos() + p * p).sqrt()
+    }
+
+    pub fn gain(&self, w: f64) -> f64 {
+        self.g * Self::unit_gain(self.p, w)
+    }
+
+    /// Phase delay in samples at `w`.
+    pub fn phase_delay(&self, w: f64) -> f64 {
+        (self.p * w.sin()).atan2(1.0 - self.p * w.cos()) / w
+    }
+
+    #[inline]
+    pub fn tick(&mut self, x: f64) -> f64 {
+        self.y1 = self.g * (1.0 - self.p) * x + self.p * self.y1;
+        self.y1
+    }
+
+    pub fn reset(&mut self) {
+        self.y1 = 0.0;
+    }
+}
+
+/// Constant-peak-gain bandpass biquad (RBJ cookbook), transposed direct form II.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Bandpass {
+    b0: f64,
+    a1: f64,
+    a2: f64,
+    s1: f64,
+    s2: f64,
+}
+
+impl Bandpass {
+    pub fn new(freq_hz: f64, q: f64, sample_rate_hz: f64) -> Self {
+        let w0 = 2.0 * PI * freq_hz / sample_rate_hz;
+        let alpha = w0.sin() / (2.0 * q);
+        let a0 = 1.0 + alpha;
+        Self {
+            b0: alpha / a0,
+            a1: -2.0 * w0.cos() / a0,
+            a2: (1.0 - alpha) / a0,
+            s1: 0.0,
+            s2: 0.0,
+        }
+    }
+
+    #[inline]
+    pub fn tick(&mut self, x: f64) -> f64 {
+        // b1 = 0, b2 = -b0
+        let y = self.b0 * x + self.s1;
+        self.s1 = -self.a1 * y + self.s2;
+        self.s2 = -self.b0 * x - self.a2 * y;
+        y
+    }
+
+    pub fn reset(&mut self) {
+        self.s1 = 0.0;
+        self.s2 = 0.0;
+    }
+}
+
+/// Flushes values too small to matter (and subnormal) to exact zero.
+#[inline]
+pub fn flush_tiny(x: f64) -> f64 {
+    if x.abs() < 1e-30 {
+        0.0
+    } else {
+        x
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn thiran_coefficient_gives_the_requested_phase_delay() {
+        let w = 2.0 * PI * 147.0 / 48_000.0;
+        for &d in &[0.5, 0.9, 1.37, 2.4] {
+            let a = Allpass1::coefficient_for_delay(d, w);
+            // bisection to 60 halvings: far below a micro-sample
+            assert!((Allpass1::phase_delay(a, w) - d).abs() < 1e-9, "d = {d}");
+        }
+    }
+
+    #[test]
+    fn loss_filter_hits_both_gains_and_stays_passive() {
+        let (w1, w2) = (0.02, 0.2);
+        let f = OnePoleLoss::fit(w1, 0.99, w2, 0.9);
+        assert!((f.gain(w1) - 0.99).abs() < 1e-9);
+        assert!((f.gain(w2) - 0.9).abs() < 1e-6);
+        assert!(f.gain(0.0) < 1.0);
+    }
+}

@@ -1,0 +1,249 @@
+//! Bow-string friction contacts.
+//!
+//! A contact sits between a bow (a velocity source pressed with a normal force) and a
+//! resonator that tells it, each sample, its *load line*: the velocity it would have at the
+//! contact with no force (`v_h`, from incoming waves or free modal motion) and its
+//! instantaneous admittance `Y`, so that with a friction force `F` it moves at
+//! `v_s = v_h + Y F`. For a waveguide string bowed at one point `Y = 1 / (2 Z0)`.
+//! Every friction law implements [`FrictionContact`]; the resonator does not know which.
+//!
+//! Sign convention: `F` is the force of the bow on the resonator; it acts along the
+//! relative (sliding) velocity `dv = v_b - v_s`.
+//!
+//! | symbol | meaning | unit | source |
+//! |---|---|---|---|
+//! | `mu_s` | static friction coefficient | 1 | Serafin et al. (paper A): 0.4 |
+//! | `mu_d` | dynamic (fast-sliding) friction coefficient | 1 | paper A: 0.2 |
+//! | `v0` | velocity scale of the hyperbolic curve | m/s | paper A's Stribeck `v_s` = 0.1 |
+//! | `F_N` | bow normal force | N | player |
+//! | `Y` | admittance of the resonator at the contact | s/kg | resonator |
+//!
+//! ```
+//! use colophony::dsp::friction::{BowInput, FrictionContact, HyperbolicFriction, LoadLine};
+//! let mut contact = HyperbolicFriction::default();
+//! let load = LoadLine { free_velocity_m_per_s: 0.0, admittance_s_per_kg: 1.0 };
+//! let bow = BowInput { velocity_m_per_s: 0.1, normal_force_n: 1.0 };
+//! // Small relative velocity, large force: the bow sticks and drags the string along.
+//! let f = contact.solve(load, bow);
+//! assert!((load.free_velocity_m_per_s + f * load.admittance_s_per_kg - 0.1).abs() < 1e-12);
+//! ```
+
+/// What the resonator offers the contact this sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LoadLine {
+    /// Velocity at the contact if no force acted this sample (`v_h`), m/s.
+    pub free_velocity_m_per_s: f64,
+    /// Instantaneous admittance at the contact (`Y`), s/kg: `v_s = v_h + Y F`.
+    pub admittance_s_per_kg: f64,
+}
+
+/// What the player does with the bow this sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BowInput {
+    pub velocity_m_per_s: f64,
+    pub normal_force_n: f64,
+}
+
+/// A friction law with its solver: given the load line and the bow, the force (N) of the bow
+/// on the resonator, found without inserting any delay in the loop.
+pub trait FrictionContact {
+    fn solve(&mut self, load: LoadLine, bow: BowInput) -> f64;
+    /// Whether the contact stuck on the last sample.
+    fn is_sticking(&self) -> bool;
+    fn reset(&mut self);
+}
+
+/// Static hyperbolic friction curve `mu(dv) = mu_d + (mu_s - mu_d) v0 / (v0 + |dv|)` (the
+/// curve of JOS's bowed-string junction, CLM `strad` and SuperCollider `DWGBowed`), solved
+/// exactly each sample by Friedlander's construction: the load line `F = (dv_stick - dv) / Y`
+/// meets the sliding branch where a quadratic in `|dv|` vanishes.
+///
+/// **Three crossings.** Where the curve is steeper than the load line, the line can cross
+/// the sticking segment (`dv = 0`, `|F| <= mu_s F_N`) and the sliding branch twice. The
+/// rule (McIntyre, Schumacher and Woodhouse's hysteresis): the contact keeps its state while
+/// that state's crossing exists: a sticking contact sticks while `|F_stick| <= mu_s F_N`; a
+/// slipping contact keeps slipping on the outer (stable, largest `|dv|`) crossing; the
+/// middle crossing is unstable and never taken. It changes state only when its crossing
+/// disappears.
+#[derive(Debug, Clone, Copy)]
+pub struct HyperbolicFriction {
+    pub mu_s: f64,
+    pub mu_d: f64,
+    pub v0_m_per_s: f64,
+    sticking: bool,
+}
+
+impl Default for HyperbolicFriction {
+    fn default() -> Self {
+        Self {
+            mu_s: 0.4,
+            mu_d: 0.2,
+            v0_m_per_s: 0.1,
+            sticking: false,
+        }
+    }
+}
+
+impl HyperbolicFriction {
+    /// Friction coefficient at sliding speed `|dv|`.
+    pub fn mu(&self, abs_dv: f64) -> f64 {
+        self.mu_d + (self.mu_s - self.mu_d) * self.v0_m_per_s / (self.v0_m_per_s + abs_dv)
+    }
+
+    /// The outer sliding root `|dv| > 0` for a stick velocity `|dv_stick|`, if one exists.
+    fn outer_slip_root(&self, abs_dv_stick: f64, two_z: f64, f_n: f64) -> Option<f64> {
+        // two_z (|dv_stick| - u) (v0 + u) = f_n (mu_d (v0 + u) + (mu_s - mu_d) v0), i.e.
+        // two_z u^2 + b u + c = 0:
+        let v0 = self.v0_m_per_s;
+        let b = two_z * v0 + f_n * self.mu_d - two_z * abs_dv_stick;
+        let c = v0 * (f_n * self.mu_s - two_z * abs_dv_stick);
+        let disc = b * b - 4.0 * two_z * c;
+        if disc < 0.0 {
+            return None;
+        }
+        // Larger root, in the form that avoids cancellation.
+        let sq = disc.sqrt();
+        let u = if b <= 0.0 {
+            (-b + sq) / (2.0 * two_z)
+        } else {
+            -2.0 * c / (b + sq)
+        };
+        (u > 0.0).then_some(u)
+    }
+}
+
+impl FrictionContact for HyperbolicFriction {
+    #[inline]
+    fn solve(&mut self, load: LoadLine, bow: BowInput) -> f64 {
+        let f_n = bow.normal_force_n;
+        if f_n <= 0.0 {
+            self.sticking = false;
+            return 0.0;
+        }
+        let two_z = 1.0 / load.admittance_s_per_kg;
+        let dv_stick = bow.velocity_m_per_s - load.free_velocity_m_per_s;
+        let f_stick = two_z * dv_stick;
+        let can_stick = f_stick.abs() <= self.mu_s * f_n;
+        let slip = if can_stick && self.sticking {
+            None
+        } else {
+            self.outer_slip_root(dv_stick.abs(), two_z, f_n)
+        };
+        match slip {
+            Some(u) => {
+                self.sticking = false;
+                dv_stick.signum() * f_n * self.mu(u)
+            }
+            None => {
+                // Without a sliding crossing the sticking one exists (the quadratic's
+                // constant term is then non-negative).
+                self.sticking = true;
+                f_stick
+            }
+        }
+    }
+
+    fn is_sticking(&self) -> bool {
+        self.sticking
+    }
+
+    fn reset(&mut self) {
+        self.sticking = false;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const LOAD_Y: f64 = 1.0 / (2.0 * 0.506); // cello D, two half-strings
+
+    fn residual(c: &HyperbolicFriction, load: LoadLine, bow: BowInput, f: f64) -> f64 {
+        let v_s = load.free_velocity_m_per_s + load.admittance_s_per_kg * f;
+        let dv = bow.velocity_m_per_s - v_s;
+        f - dv.signum() * bow.normal_force_n * c.mu(dv.abs())
+    }
+
+    #[test]
+    fn slipping_force_lies_on_the_friction_curve() {
+        let mut c = HyperbolicFriction::default();
+        for &v_h in &[-1.0, -0.5, 0.4, 1.2] {
+            let load = LoadLine {
+                free_velocity_m_per_s: v_h,
+                admittance_s_per_kg: LOAD_Y,
+            };
+            let bow = BowInput {
+                velocity_m_per_s: 0.1,
+                normal_force_n: 1.1,
+            };
+            let f = c.solve(load, bow);
+            assert!(!c.is_sticking());
+            // exact quadratic root: residual at rounding level
+            assert!(residual(&c, load, bow, f).abs() < 1e-12, "v_h = {v_h}");
+        }
+    }
+
+    #[test]
+    fn sticking_force_stays_within_static_limit_and_moves_string_with_bow() {
+        let mut c = HyperbolicFriction::default();
+        c.sticking = true;
+        let load = LoadLine {
+            free_velocity_m_per_s: 0.05,
+            admittance_s_per_kg: LOAD_Y,
+        };
+        let bow = BowInput {
+            velocity_m_per_s: 0.1,
+            normal_force_n: 1.1,
+        };
+        let f = c.solve(load, bow);
+        assert!(c.is_sticking());
+        assert!(f.abs() <= 0.4 * 1.1);
+        assert!((0.05 + LOAD_Y * f - 0.1).abs() < 1e-15);
+    }
+
+    #[test]
+    fn hysteresis_keeps_state_where_the_load_line_crosses_three_times() {
+        // Steep curve (F_N mu_s-mu_d / v0 = 10 N s/m > 2 Z0): at this stick velocity both a
+        // stick crossing and two slip crossings exist.
+        let load = |v_h| LoadLine {
+            free_velocity_m_per_s: v_h,
+            admittance_s_per_kg: LOAD_Y,
+        };
+        let bow = BowInput {
+            velocity_m_per_s: 0.1,
+            normal_force_n: 5.0,
+        };
+        let mut c = HyperbolicFriction::default();
+        let probe = load(-1.0);
+        assert!(c.outer_slip_root(1.1, 2.0 * 0.506, 5.0).is_some());
+        assert!(
+            (2.0 * 0.506 * 1.1) <= 0.4 * 5.0,
+            "stick crossing exists too"
+        );
+        c.sticking = true;
+        c.solve(probe, bow);
+        assert!(c.is_sticking(), "a sticking contact stays stuck");
+        c.sticking = false;
+        c.solve(probe, bow);
+        assert!(!c.is_sticking(), "a slipping contact keeps slipping");
+    }
+
+    #[test]
+    fn lifted_bow_exerts_no_force() {
+        let mut c = HyperbolicFriction::default();
+        let load = LoadLine {
+            free_velocity_m_per_s: 0.3,
+            admittance_s_per_kg: LOAD_Y,
+        };
+        assert_eq!(
+            c.solve(
+                load,
+                BowInput {
+                    velocity_m_per_s: 0.1,
+                    normal_force_n: 0.0
+                }
+            ),
+            0.0
+        );
+    }
+}

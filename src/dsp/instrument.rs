@@ -1,0 +1,390 @@
+//! The instrument: four bowed waveguide strings of a violin, viola or cello, a shared bow,
+//! note handling and a generic body.
+//!
+//! **Which string plays a note.** A note goes to the highest string whose open pitch is at
+//! or below it (the lowest hand position), stopped so it sounds the note. Notes below the
+//! lowest open string are refused; so are notes more than [`MAX_STOP_SEMITONES`] above
+//! the highest open string (the end of the fingerboard). Each string plays one note at a
+//! time: two notes on different strings are a double stop.
+//!
+//! Note on stops the string and lands the bow (the force ramps up over [`BOW_RAMP_S`]);
+//! note off lifts it (the force ramps down) and the string rings on, still stopped, and
+//! decays. A string whose energy falls below [`SLEEP_ENERGY_J`] with the bow lifted is
+//! cleared and skipped until the next note on it.
+
+use super::body::{BodyMode, BodyModes};
+use super::friction::{BowInput, FrictionContact, HyperbolicFriction};
+use super::waveguide::{StringSpec, WaveguideString};
+
+pub const STRINGS: usize = 4;
+/// Highest note above the highest open string (about the end of the fingerboard).
+pub const MAX_STOP_SEMITONES: u8 = 31;
+/// Bow landing and lifting time, s.
+pub const BOW_RAMP_S: f64 = 0.02;
+/// Pitch-bend range, semitones either way.
+pub const PITCH_BEND_SEMITONES: f64 = 2.0;
+/// A lifted string whose wave energy is below this sleeps (about -130 dB below a
+/// default bowed note's few millijoules).
+pub const SLEEP_ENERGY_J: f64 = 1e-16;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InstrumentKind {
+    Violin,
+    Viola,
+    Cello,
+}
+
+impl InstrumentKind {
+    pub const ALL: [InstrumentKind; 3] = [Self::Violin, Self::Viola, Self::Cello];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Violin => "violin",
+            Self::Viola => "viola",
+            Self::Cello => "cello",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL
+            .into_iter()
+            .find(|k| k.name().eq_ignore_ascii_case(name))
+    }
+
+    /// MIDI notes of the open strings, low to high.
+    pub fn open_notes(self) -> [u8; STRINGS] {
+        match self {
+            Self::Violin => [55, 62, 69, 76],
+            Self::Viola => [48, 55, 62, 69],
+            Self::Cello => [36, 43, 50, 57],
+        }
+    }
+
+    /// String data, low to high (PARAMETERS.md §1.4: Desvages/NESS sets; viola G, D, A
+    /// inharmonicities are not in the table and are chosen between the neighbouring
+    /// violin and viola values). Open pitches are equal-tempered from A4 = 440 Hz.
+    pub fn strings(self) -> [StringSpec; STRINGS] {
+        let (z0, b): ([f64; 4], [f64; 4]) = match self {
+            Self::Violin => (
+                [0.350, 0.303, 0.203, 0.173],
+                [2.7e-4, 2.3e-4, 2.1e-4, 4.8e-5],
+            ),
+            Self::Viola => (
+                [0.484, 0.323, 0.281, 0.274],
+                [3.4e-4, 2.7e-4, 2.3e-4, 2.1e-4],
+            ),
+            Self::Cello => (
+                [1.91, 0.833, 0.506, 0.504],
+                [5.7e-4, 1.7e-4, 1.5e-4, 5.3e-5],
+            ),
+        };
+        let notes = self.open_notes();
+        std::array::from_fn(|i| StringSpec {
+            open_hz: midi_to_hz(notes[i] as f64),
+            z0_kg_per_s: z0[i],
+            inharmonicity_open: b[i],
+            q1: 500.0,
+            q_hi: 250.0,
+        })
+    }
+
+    /// Generic body modes (see [`super::body`]).
+    fn body_modes(self) -> [BodyMode; 5] {
+        let scale = match self {
+            Self::Violin => 1.0,
+            Self::Viola => 0.8,
+            Self::Cello => 0.42,
+        };
+        [
+            (275.0, 12.0, 0.8),
+            (405.0, 15.0, 0.5),
+            (470.0, 18.0, 1.0),
+            (540.0, 18.0, 1.0),
+            (2500.0, 2.5, 0.6),
+        ]
+        .map(|(f, q, gain)| BodyMode {
+            freq_hz: f * scale,
+            q,
+            gain,
+        })
+    }
+
+    /// Output scale: bridge force to a sample value, so that a default note of any
+    /// instrument peaks near -12 dBFS.
+    fn output_scale_per_n(self) -> f64 {
+        let mean_z0: f64 =
+            self.strings().iter().map(|s| s.z0_kg_per_s).sum::<f64>() / STRINGS as f64;
+        0.1 / mean_z0
+    }
+
+    /// The string a note goes to, if the instrument can play it.
+    pub fn string_for_note(self, note: u8) -> Option<usize> {
+        let open = self.open_notes();
+        if note < open[0] || note > open[STRINGS - 1] + MAX_STOP_SEMITONES {
+            return None;
+        }
+        open.iter().rposition(|&o| o <= note)
+    }
+
+    /// Playable notes, inclusive.
+    pub fn note_range(self) -> (u8, u8) {
+        let open = self.open_notes();
+        (open[0], open[STRINGS - 1] + MAX_STOP_SEMITONES)
+    }
+}
+
+pub fn midi_to_hz(note: f64) -> f64 {
+    440.0 * 2f64.powf((note - 69.0) / 12.0)
+}
+
+/// The player's bow, shared by every bowed string.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BowControl {
+    /// Signed: the sign is the bow direction.
+    pub velocity_m_per_s: f64,
+    pub force_n: f64,
+    /// Distance from the bridge over the vibrating length.
+    pub position_beta: f64,
+}
+
+impl Default for BowControl {
+    fn default() -> Self {
+        Self {
+            velocity_m_per_s: 0.1,
+            force_n: 1.0,
+            position_beta: 0.1,
+        }
+    }
+}
+
+/// One sample of output with the probed string's contact signals.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Frame {
+    pub audio: f64,
+    /// String velocity at the bow point of the last string that got a note, m/s.
+    pub bow_point_velocity_m_per_s: f64,
+    /// Friction force on that string, N.
+    pub friction_force_n: f64,
+}
+
+#[derive(Debug, Clone)]
+struct StringVoice {
+    string: WaveguideString,
+    contact: HyperbolicFriction,
+    note: Option<u8>,
+    /// Bow envelope, 0 (lifted) to 1 (full force).
+    bow_gain: f64,
+    bowed: bool,
+    awake: bool,
+}
+
+#[derive(Debug, Clone)]
+pub struct Instrument {
+    kind: InstrumentKind,
+    sample_rate_hz: f64,
+    voices: [StringVoice; STRINGS],
+    body: BodyModes,
+    bend_semitones: f64,
+    probed: usize,
+    ramp_step: f64,
+    output_scale: f64,
+}
+
+impl Instrument {
+    /// Allocates everything for this sample rate; instrument changes later do not allocate.
+    pub fn new(kind: InstrumentKind, sample_rate_hz: f64) -> Self {
+        // Lowest fundamental any instrument can reach: cello C bent down.
+        let lowest_hz = midi_to_hz(36.0 - PITCH_BEND_SEMITONES) * 0.99;
+        let specs = kind.strings();
+        let voices = std::array::from_fn(|i| StringVoice {
+            string: WaveguideString::new(specs[i], sample_rate_hz, lowest_hz),
+            contact: HyperbolicFriction::default(),
+            note: None,
+            bow_gain: 0.0,
+            bowed: false,
+            awake: false,
+        });
+        Self {
+            kind,
+            sample_rate_hz,
+            voices,
+            body: BodyModes::new(&kind.body_modes(), 1.0, sample_rate_hz),
+            bend_semitones: 0.0,
+            probed: 0,
+            ramp_step: 1.0 / (BOW_RAMP_S * sample_rate_hz),
+            output_scale: kind.output_scale_per_n(),
+        }
+    }
+
+    pub fn kind(&self) -> InstrumentKind {
+        self.kind
+    }
+
+    pub fn sample_rate_hz(&self) -> f64 {
+        self.sample_rate_hz
+    }
+
+    /// Switches instrument: every string is replaced and silenced. Real-time safe.
+    pub fn set_kind(&mut self, kind: InstrumentKind) {
+        if kind == self.kind {
+            return;
+        }
+        self.kind = kind;
+        for (voice, spec) in self.voices.iter_mut().zip(kind.strings()) {
+            voice.string.set_spec(spec);
+            voice.contact.reset();
+            voice.note = None;
+            voice.bow_gain = 0.0;
+            voice.bowed = false;
+            voice.awake = false;
+        }
+        self.body = BodyModes::new(&kind.body_modes(), 1.0, self.sample_rate_hz);
+        self.output_scale = kind.output_scale_per_n();
+    }
+
+    pub fn reset(&mut self) {
+        for voice in &mut self.voices {
+            voice.string.reset();
+            voice.contact.reset();
+            voice.note = None;
+            voice.bow_gain = 0.0;
+            voice.bowed = false;
+            voice.awake = false;
+        }
+        self.body.reset();
+    }
+
+    /// Stops the string for `note` and lands the bow on it. Returns the string index, or
+    /// `None` if the instrument cannot play the note (it is then ignored).
+    pub fn note_on(&mut self, note: u8) -> Option<usize> {
+        let index = self.kind.string_for_note(note)?;
+        let bend = self.bend_semitones;
+        let voice = &mut self.voices[index];
+        voice.string.stop_at(midi_to_hz(note as f64 + bend));
+        voice.note = Some(note);
+        voice.bowed = true;
+        voice.awake = voice.string.is_playable();
+        self.probed = index;
+        Some(index)
+    }
+
+    /// Lifts the bow from the string playing `note`, if any.
+    pub fn note_off(&mut self, note: u8) {
+        for voice in &mut self.voices {
+            if voice.note == Some(note) {
+                voice.bowed = false;
+            }
+        }
+    }
+
+    /// Lifts the bow from every string.
+    pub fn all_notes_off(&mut self) {
+        for voice in &mut self.voices {
+            voice.bowed = false;
+        }
+    }
+
+    /// Pitch bend in semitones (clamped to the bend range): moves every stopping point.
+    pub fn set_pitch_bend(&mut self, semitones: f64) {
+        let semitones = semitones.clamp(-PITCH_BEND_SEMITONES, PITCH_BEND_SEMITONES);
+        if semitones == self.bend_semitones {
+            return;
+        }
+        self.bend_semitones = semitones;
+        for voice in &mut self.voices {
+            if let Some(note) = voice.note {
+                voice.string.bend_to(midi_to_hz(note as f64 + semitones));
+            }
+        }
+    }
+
+    /// The string a note was sent to, with its current tuning (for tests and tools).
+    pub fn string(&self, index: usize) -> &WaveguideString {
+        &self.voices[index].string
+    }
+
+    /// Total wave energy of all strings, J.
+    pub fn energy_j(&self) -> f64 {
+        self.voices.iter().map(|v| v.string.energy_j()).sum()
+    }
+
+    /// Whether any string is awake (bowed or still ringing).
+    pub fn is_sounding(&self) -> bool {
+        self.voices.iter().any(|v| v.awake)
+    }
+
+    /// Puts lifted strings whose energy fell below [`SLEEP_ENERGY_J`] to sleep. Called once
+    /// per block by the plugin and the renderer (it walks the delay lines).
+    pub fn update_sleep(&mut self) {
+        for voice in &mut self.voices {
+            if voice.awake
+                && !voice.bowed
+                && voice.bow_gain == 0.0
+                && voice.string.energy_j() < SLEEP_ENERGY_J
+            {
+                voice.string.reset();
+                voice.awake = false;
+            }
+        }
+    }
+
+    /// One sample.
+    #[inline]
+    pub fn tick(&mut self, bow: BowControl) -> Frame {
+        let mut bridge = 0.0;
+        let mut frame = Frame::default();
+        for (i, voice) in self.voices.iter_mut().enumerate() {
+            if !voice.awake {
+                continue;
+            }
+            let target = if voice.bowed { 1.0 } else { 0.0 };
+            if voice.bow_gain != target {
+                voice.bow_gain = if voice.bowed {
+                    (voice.bow_gain + self.ramp_step).min(1.0)
+                } else {
+                    (voice.bow_gain - self.ramp_step).max(0.0)
+                };
+            }
+            voice.string.set_bow_position(bow.position_beta);
+            let input = BowInput {
+                velocity_m_per_s: bow.velocity_m_per_s,
+                normal_force_n: bow.force_n * voice.bow_gain,
+            };
+            let out = voice.string.tick(&mut voice.contact, input);
+            bridge += out.bridge_force_n;
+            if i == self.probed {
+                frame.bow_point_velocity_m_per_s = out.bow_point_velocity_m_per_s;
+                frame.friction_force_n = out.friction_force_n;
+            }
+        }
+        frame.audio = super::filters::flush_tiny(self.body.tick(bridge) * self.output_scale);
+        if !frame.audio.is_finite() {
+            // Cannot happen with finite inputs; if it ever does, recover to silence rather
+            // than emit garbage.
+            self.reset();
+            frame = Frame::default();
+        }
+        frame
+    }
+
+    /// Whether the contact of the probed string is sticking (for analysis).
+    pub fn probed_is_sticking(&self) -> bool {
+        self.voices[self.probed].contact.is_sticking()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn notes_go_to_the_highest_open_string_at_or_below_them() {
+        let cello = InstrumentKind::Cello;
+        assert_eq!(cello.string_for_note(36), Some(0));
+        assert_eq!(cello.string_for_note(49), Some(1));
+        assert_eq!(cello.string_for_note(50), Some(2));
+        assert_eq!(cello.string_for_note(80), Some(3));
+        assert_eq!(cello.string_for_note(35), None);
+        assert_eq!(cello.string_for_note(57 + MAX_STOP_SEMITONES + 1), None);
+    }
+}

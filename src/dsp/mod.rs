@@ -1,0 +1,9 @@
+//! The DSP core. It never imports the plugin framework: it takes plain settings in SI
+//! units. Parts: friction contacts ([`friction`]), resonators ([`waveguide`]), the body
+//! ([`body`]), the instrument that wires them to notes and a bow ([`instrument`]).
+
+pub mod body;
+pub mod filters;
+pub mod friction;
+pub mod instrument;
+pub mod waveguide;

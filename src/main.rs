@@ -1,0 +1,106 @@
+//! `colophony`: the offline renderer and tools.
+
+use clap::{Parser, Subcommand};
+use colophony::dsp::instrument::{BowControl, InstrumentKind};
+use colophony::render::{parse_note, render, write_wav, RenderSettings};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(
+    name = "colophony",
+    version,
+    about = "Physically modelled bowed strings: offline renderer and tools"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Bow one note and write it to a WAV file.
+    Render {
+        /// Output WAV file.
+        #[arg(long)]
+        out: PathBuf,
+        /// violin, viola or cello.
+        #[arg(long, default_value = "cello", value_parser = parse_instrument)]
+        instrument: InstrumentKind,
+        /// MIDI number or note name (C4 = 60).
+        #[arg(long, default_value = "50", value_parser = parse_note)]
+        note: u8,
+        #[arg(long, default_value_t = 3.0)]
+        seconds: f64,
+        /// m/s, signed (sign = bow direction).
+        #[arg(long, default_value_t = 0.1, allow_negative_numbers = true)]
+        bow_velocity: f64,
+        /// N.
+        #[arg(long, default_value_t = 1.0)]
+        bow_force: f64,
+        /// Distance from the bridge over the vibrating length.
+        #[arg(long, default_value_t = 0.1)]
+        bow_position: f64,
+        #[arg(long, default_value_t = 48_000.0)]
+        sample_rate: f64,
+        /// Lift the bow after this many seconds and let the string ring.
+        #[arg(long)]
+        release: Option<f64>,
+        /// Write a 32-bit float WAV: channel 0 audio, 1 string velocity at the bow (m/s),
+        /// 2 friction force (N).
+        #[arg(long)]
+        probe: bool,
+    },
+}
+
+fn parse_instrument(s: &str) -> Result<InstrumentKind, String> {
+    InstrumentKind::from_name(s)
+        .ok_or_else(|| format!("unknown instrument '{s}': choose violin, viola or cello"))
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Render {
+            out,
+            instrument,
+            note,
+            seconds,
+            bow_velocity,
+            bow_force,
+            bow_position,
+            sample_rate,
+            release,
+            probe,
+        } => {
+            let settings = RenderSettings {
+                instrument,
+                note,
+                seconds,
+                bow: BowControl {
+                    velocity_m_per_s: bow_velocity,
+                    force_n: bow_force,
+                    position_beta: bow_position,
+                },
+                sample_rate_hz: sample_rate,
+                release_s: release,
+            };
+            let started = std::time::Instant::now();
+            match render(&settings).and_then(|r| write_wav(&out, &r, probe)) {
+                Ok(()) => {
+                    let took = started.elapsed().as_secs_f64();
+                    println!(
+                        "wrote {} ({seconds} s in {took:.3} s, {:.1}x real time)",
+                        out.display(),
+                        seconds / took
+                    );
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,101 @@
+//! Plugin parameters. The ids are a contract with hosts, tools and tests: never rename them.
+//!
+//! | id | name | unit | range | default |
+//! |---|---|---|---|---|
+//! | `bow_velocity` | Bow Velocity | m/s | -1.5 .. 1.5 (sign = direction) | 0.1 |
+//! | `bow_force` | Bow Force | N | 0 .. 10 (skewed) | 1.0 |
+//! | `bow_position` | Bow Position | beta | 0.02 .. 0.5 | 0.1 |
+//! | `instrument` | Instrument | - | violin, viola, cello | cello |
+//! | `gain` | Output Gain | dB | -40 .. 12 | 0 |
+
+use crate::dsp::instrument::InstrumentKind;
+use nice_plug::prelude::*;
+
+/// Smoothing time for the bow controls: short enough for sample-accurate gestures to
+/// land within a couple of milliseconds, long enough to avoid zipper noise.
+pub const BOW_SMOOTHING_MS: f32 = 2.0;
+
+#[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InstrumentChoice {
+    #[id = "violin"]
+    Violin,
+    #[id = "viola"]
+    Viola,
+    #[id = "cello"]
+    Cello,
+}
+
+impl From<InstrumentChoice> for InstrumentKind {
+    fn from(choice: InstrumentChoice) -> Self {
+        match choice {
+            InstrumentChoice::Violin => InstrumentKind::Violin,
+            InstrumentChoice::Viola => InstrumentKind::Viola,
+            InstrumentChoice::Cello => InstrumentKind::Cello,
+        }
+    }
+}
+
+#[derive(Params)]
+pub struct ColophonyParams {
+    #[id = "bow_velocity"]
+    pub bow_velocity: FloatParam,
+    #[id = "bow_force"]
+    pub bow_force: FloatParam,
+    #[id = "bow_position"]
+    pub bow_position: FloatParam,
+    #[id = "instrument"]
+    pub instrument: EnumParam<InstrumentChoice>,
+    #[id = "gain"]
+    pub gain: FloatParam,
+}
+
+pub fn bow_velocity_range() -> FloatRange {
+    FloatRange::Linear {
+        min: -1.5,
+        max: 1.5,
+    }
+}
+
+pub fn bow_force_range() -> FloatRange {
+    FloatRange::Skewed {
+        min: 0.0,
+        max: 10.0,
+        factor: FloatRange::skew_factor(-2.0),
+    }
+}
+
+pub fn bow_position_range() -> FloatRange {
+    FloatRange::Linear {
+        min: 0.02,
+        max: 0.5,
+    }
+}
+
+impl Default for ColophonyParams {
+    fn default() -> Self {
+        Self {
+            bow_velocity: FloatParam::new("Bow Velocity", 0.1, bow_velocity_range())
+                .with_unit(" m/s")
+                .with_smoother(SmoothingStyle::Linear(BOW_SMOOTHING_MS)),
+            // Default inside the Schelleng window of the default note (cello D, v_b 0.1 m/s,
+            // beta 0.1): F_max = 2 Z0 v_b / (beta (mu_s - mu_d)) = 5.1 N.
+            bow_force: FloatParam::new("Bow Force", 1.0, bow_force_range())
+                .with_unit(" N")
+                .with_smoother(SmoothingStyle::Linear(BOW_SMOOTHING_MS)),
+            bow_position: FloatParam::new("Bow Position", 0.1, bow_position_range())
+                .with_unit(" beta")
+                .with_smoother(SmoothingStyle::Linear(BOW_SMOOTHING_MS)),
+            instrument: EnumParam::new("Instrument", InstrumentChoice::Cello),
+            gain: FloatParam::new(
+                "Output Gain",
+                0.0,
+                FloatRange::Linear {
+                    min: -40.0,
+                    max: 12.0,
+                },
+            )
+            .with_unit(" dB")
+            .with_smoother(SmoothingStyle::Linear(10.0)),
+        }
+    }
+}

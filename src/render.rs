@@ -1,0 +1,258 @@
+//! Offline rendering straight from the DSP core (no plugin host), and WAV output.
+//!
+//! ```
+//! use colophony::render::{render, RenderSettings};
+//! let settings = RenderSettings { seconds: 0.05, ..RenderSettings::default() };
+//! let out = render(&settings).unwrap();
+//! assert_eq!(out.audio.len(), (0.05f64 * 48_000.0).round() as usize);
+//! ```
+
+use crate::dsp::instrument::{BowControl, Instrument, InstrumentKind};
+use std::fmt;
+use std::path::Path;
+
+/// Block length the renderer uses between sleep checks, as a plugin host would.
+const BLOCK: usize = 256;
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct RenderSettings {
+    pub instrument: InstrumentKind,
+    pub note: u8,
+    pub seconds: f64,
+    pub bow: BowControl,
+    pub sample_rate_hz: f64,
+    /// Lift the bow at this time (s); `None` bows to the end.
+    pub release_s: Option<f64>,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self {
+            instrument: InstrumentKind::Cello,
+            note: 50,
+            seconds: 3.0,
+            bow: BowControl::default(),
+            sample_rate_hz: 48_000.0,
+            release_s: None,
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum RenderError {
+    NoteOutOfRange {
+        note: u8,
+        instrument: InstrumentKind,
+        low: u8,
+        high: u8,
+    },
+    BadSetting(String),
+    Io(String),
+}
+
+impl fmt::Display for RenderError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::NoteOutOfRange {
+                note,
+                instrument,
+                low,
+                high,
+            } => write!(
+                f,
+                "note {note} is out of range for the {}: playable notes are {low}..={high}",
+                instrument.name()
+            ),
+            Self::BadSetting(s) => write!(f, "{s}"),
+            Self::Io(s) => write!(f, "{s}"),
+        }
+    }
+}
+
+impl std::error::Error for RenderError {}
+
+/// Audio plus the contact probe of the bowed string, one value per sample.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Rendered {
+    pub sample_rate_hz: f64,
+    pub audio: Vec<f64>,
+    pub bow_point_velocity_m_per_s: Vec<f64>,
+    pub friction_force_n: Vec<f64>,
+}
+
+fn check(settings: &RenderSettings) -> Result<(), RenderError> {
+    let bad = |s: String| Err(RenderError::BadSetting(s));
+    let b = &settings.bow;
+    if !(settings.seconds.is_finite() && settings.seconds > 0.0 && settings.seconds <= 600.0) {
+        return bad(format!(
+            "--seconds must be in (0, 600], got {}",
+            settings.seconds
+        ));
+    }
+    if !(settings.sample_rate_hz.is_finite()
+        && (1000.0..=768_000.0).contains(&settings.sample_rate_hz))
+    {
+        return bad(format!(
+            "--sample-rate must be 1000..=768000 Hz, got {}",
+            settings.sample_rate_hz
+        ));
+    }
+    if !(b.velocity_m_per_s.is_finite() && b.velocity_m_per_s.abs() <= 1.5) {
+        return bad(format!(
+            "--bow-velocity must be within -1.5..=1.5 m/s, got {}",
+            b.velocity_m_per_s
+        ));
+    }
+    if !(b.force_n.is_finite() && (0.0..=10.0).contains(&b.force_n)) {
+        return bad(format!(
+            "--bow-force must be within 0..=10 N, got {}",
+            b.force_n
+        ));
+    }
+    if !(b.position_beta.is_finite() && (0.02..=0.5).contains(&b.position_beta)) {
+        return bad(format!(
+            "--bow-position must be within 0.02..=0.5, got {}",
+            b.position_beta
+        ));
+    }
+    let (low, high) = settings.instrument.note_range();
+    if !(low..=high).contains(&settings.note) {
+        return Err(RenderError::NoteOutOfRange {
+            note: settings.note,
+            instrument: settings.instrument,
+            low,
+            high,
+        });
+    }
+    Ok(())
+}
+
+/// Bows one note for `seconds` (lifting the bow at `release_s` if set).
+pub fn render(settings: &RenderSettings) -> Result<Rendered, RenderError> {
+    check(settings)?;
+    let fs = settings.sample_rate_hz;
+    let frames = (settings.seconds * fs).round() as usize;
+    let release = settings.release_s.map(|s| (s * fs).round() as usize);
+    let mut instrument = Instrument::new(settings.instrument, fs);
+    instrument.note_on(settings.note);
+    let mut out = Rendered {
+        sample_rate_hz: fs,
+        audio: Vec::with_capacity(frames),
+        bow_point_velocity_m_per_s: Vec::with_capacity(frames),
+        friction_force_n: Vec::with_capacity(frames),
+    };
+    for i in 0..frames {
+        if i % BLOCK == 0 {
+            instrument.update_sleep();
+        }
+        if Some(i) == release {
+            instrument.note_off(settings.note);
+        }
+        let frame = instrument.tick(settings.bow);
+        out.audio.push(frame.audio);
+        out.bow_point_velocity_m_per_s
+            .push(frame.bow_point_velocity_m_per_s);
+        out.friction_force_n.push(frame.friction_force_n);
+    }
+    Ok(out)
+}
+
+/// Writes `rendered` as WAV: 16-bit mono audio, or with `probe` a 32-bit float file whose
+/// channel 0 is the audio, 1 the string velocity at the bow (m/s), 2 the friction force
+/// (N). The file appears whole or not at all (written beside it, then renamed).
+pub fn write_wav(path: &Path, rendered: &Rendered, probe: bool) -> Result<(), RenderError> {
+    let io =
+        |e: &dyn fmt::Display| RenderError::Io(format!("cannot write {}: {e}", path.display()));
+    let spec = if probe {
+        hound::WavSpec {
+            channels: 3,
+            sample_rate: rendered.sample_rate_hz as u32,
+            bits_per_sample: 32,
+            sample_format: hound::SampleFormat::Float,
+        }
+    } else {
+        hound::WavSpec {
+            channels: 1,
+            sample_rate: rendered.sample_rate_hz as u32,
+            bits_per_sample: 16,
+            sample_format: hound::SampleFormat::Int,
+        }
+    };
+    let mut tmp_name = path
+        .file_name()
+        .ok_or_else(|| io(&"not a file path"))?
+        .to_os_string();
+    tmp_name.push(".partial");
+    let tmp = path.with_file_name(tmp_name);
+    let result = (|| -> Result<(), hound::Error> {
+        let mut w = hound::WavWriter::create(&tmp, spec)?;
+        for i in 0..rendered.audio.len() {
+            if probe {
+                w.write_sample(rendered.audio[i] as f32)?;
+                w.write_sample(rendered.bow_point_velocity_m_per_s[i] as f32)?;
+                w.write_sample(rendered.friction_force_n[i] as f32)?;
+            } else {
+                w.write_sample((rendered.audio[i].clamp(-1.0, 1.0) * 32767.0).round() as i16)?;
+            }
+        }
+        w.finalize()
+    })();
+    match result {
+        Ok(()) => std::fs::rename(&tmp, path).map_err(|e| io(&e)),
+        Err(e) => {
+            let _ = std::fs::remove_file(&tmp);
+            Err(io(&e))
+        }
+    }
+}
+
+/// Parses a note as a MIDI number (`50`) or a name with octave (`D3`, `F#4`, `Bb2`;
+/// C4 = 60).
+pub fn parse_note(text: &str) -> Result<u8, String> {
+    let err = || {
+        format!("cannot read note '{text}': give a MIDI number (50) or a name like D3, F#4, Bb2")
+    };
+    if let Ok(n) = text.parse::<u8>() {
+        return if n <= 127 { Ok(n) } else { Err(err()) };
+    }
+    let mut chars = text.chars();
+    let letter = chars.next().ok_or_else(err)?.to_ascii_uppercase();
+    let base: i32 = match letter {
+        'C' => 0,
+        'D' => 2,
+        'E' => 4,
+        'F' => 5,
+        'G' => 7,
+        'A' => 9,
+        'B' => 11,
+        _ => return Err(err()),
+    };
+    let rest: String = chars.collect();
+    let (accidental, octave) = match rest.chars().next() {
+        Some('#') => (1, &rest[1..]),
+        Some('b') => (-1, &rest[1..]),
+        _ => (0, rest.as_str()),
+    };
+    let octave: i32 = octave.parse().map_err(|_| err())?;
+    let midi = 12 * (octave + 1) + base + accidental;
+    u8::try_from(midi)
+        .ok()
+        .filter(|m| *m <= 127)
+        .ok_or_else(err)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn note_names_and_numbers_parse() {
+        assert_eq!(parse_note("50"), Ok(50));
+        assert_eq!(parse_note("D3"), Ok(50));
+        assert_eq!(parse_note("C4"), Ok(60));
+        assert_eq!(parse_note("F#4"), Ok(66));
+        assert_eq!(parse_note("Bb2"), Ok(46));
+        assert!(parse_note("H2").is_err());
+        assert!(parse_note("200").is_err());
+    }
+}
