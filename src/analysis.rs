@@ -61,20 +61,34 @@ pub fn peak_frequency_hz(x: &[f64], sample_rate_hz: f64, guess_hz: f64, search_c
 }
 
 /// Stick/slip statistics of the string velocity at the bow point.
+///
+/// Two slip measures are given because the model's Helmholtz corners are rounded by the
+/// string's frequency-dependent losses (Cremer's corner rounding, physical and stronger at
+/// low bow force):
+/// - `strict_slip_fraction` counts every sample where the string moves relative to the
+///   bow, including the rounded flanks of each corner;
+/// - `slip_fraction` is corner to corner: the time the velocity is beyond the midpoint of
+///   the sticking velocity and the slip plateau velocity. A rounded corner's centre
+///   travels at the wave speed, so this is the quantity Raman's theory predicts (= beta).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SlipStats {
-    /// Fraction of the time the contact slips.
+    /// Corner-to-corner (half-jump) slip fraction of the time.
     pub slip_fraction: f64,
-    /// Slip onsets per period of `f0`.
+    /// Fraction of the time with any relative motion beyond the tolerance.
+    pub strict_slip_fraction: f64,
+    /// Corner-to-corner slips per period of `f0`.
     pub slips_per_period: f64,
     /// Mean string velocity while sticking, m/s.
     pub stick_velocity_m_per_s: f64,
-    /// Mean string velocity while slipping, m/s.
+    /// Mean string velocity between the corners (the slip plateau), m/s.
     pub slip_velocity_m_per_s: f64,
+    /// Sticking velocity minus the slip plateau velocity, m/s (Raman: v_b / beta).
+    pub jump_m_per_s: f64,
 }
 
-/// Classifies each sample as sticking when the string moves with the bow (within
-/// `tolerance_m_per_s`) and counts slips. `v_s` should be a steady stretch of whole periods.
+/// Classifies each sample of the string velocity at the bow `v_s` (a steady stretch of
+/// whole periods) as sticking when it moves with the bow within `tolerance_m_per_s`, and
+/// measures the slips (see [`SlipStats`]).
 pub fn slip_stats(
     v_s: &[f64],
     bow_velocity_m_per_s: f64,
@@ -82,30 +96,55 @@ pub fn slip_stats(
     f0_hz: f64,
     tolerance_m_per_s: f64,
 ) -> SlipStats {
-    let sticking: Vec<bool> = v_s
+    let sticking = |v: f64| (v - bow_velocity_m_per_s).abs() <= tolerance_m_per_s;
+    let (stick_sum, stick_n) = v_s
         .iter()
-        .map(|v| (v - bow_velocity_m_per_s).abs() <= tolerance_m_per_s)
-        .collect();
-    let slips = sticking.iter().filter(|s| !**s).count();
-    let onsets = sticking.windows(2).filter(|w| w[0] && !w[1]).count();
-    let mean = |want: bool| {
+        .filter(|v| sticking(**v))
+        .fold((0.0, 0usize), |(a, n), v| (a + v, n + 1));
+    let stick = if stick_n == 0 {
+        bow_velocity_m_per_s
+    } else {
+        stick_sum / stick_n as f64
+    };
+    let mut slipping: Vec<f64> = v_s.iter().copied().filter(|v| !sticking(*v)).collect();
+    slipping.sort_by(f64::total_cmp);
+    let slip = if slipping.is_empty() {
+        stick
+    } else {
+        slipping[slipping.len() / 2]
+    };
+    // The corners' centres: the midpoint between sticking and slipping levels, refined
+    // once with the mean velocity between corners (the slip plateau).
+    let sign = if slip < stick { -1.0 } else { 1.0 };
+    let classify = |level: f64| -> Vec<bool> {
+        let midpoint = 0.5 * (stick + level);
+        v_s.iter()
+            .map(|v| !slipping.is_empty() && sign * (v - midpoint) > 0.0)
+            .collect()
+    };
+    let plateau = |beyond: &[bool]| {
         let (sum, n) = v_s
             .iter()
-            .zip(&sticking)
-            .filter(|(_, s)| **s == want)
+            .zip(beyond)
+            .filter(|(_, b)| **b)
             .fold((0.0, 0usize), |(a, n), (v, _)| (a + v, n + 1));
-        if n == 0 {
-            0.0
-        } else {
-            sum / n as f64
-        }
+        if n == 0 { stick } else { sum / n as f64 }
     };
+    let first = classify(slip);
+    let slip = plateau(&first);
+    let beyond = classify(slip);
+    let slip = plateau(&beyond);
+    let corner = beyond.iter().filter(|b| **b).count();
+    let onsets = beyond.windows(2).filter(|w| !w[0] && w[1]).count();
+    let n = v_s.len().max(1) as f64;
     let periods = v_s.len() as f64 * f0_hz / sample_rate_hz;
     SlipStats {
-        slip_fraction: slips as f64 / v_s.len() as f64,
+        slip_fraction: corner as f64 / n,
+        strict_slip_fraction: slipping.len() as f64 / n,
         slips_per_period: onsets as f64 / periods,
-        stick_velocity_m_per_s: mean(true),
-        slip_velocity_m_per_s: mean(false),
+        stick_velocity_m_per_s: stick,
+        slip_velocity_m_per_s: slip,
+        jump_m_per_s: stick - slip,
     }
 }
 

@@ -30,7 +30,7 @@ enum Command {
         /// MIDI number or note name (C4 = 60).
         #[arg(long, default_value = "50", value_parser = parse_note)]
         note: u8,
-        #[arg(long, default_value_t = 3.0)]
+        #[arg(long, default_value_t = 3.0, allow_negative_numbers = true)]
         seconds: f64,
         /// m/s, signed (sign = bow direction).
         #[arg(long, default_value_t = 0.1, allow_negative_numbers = true)]

@@ -21,72 +21,103 @@ fn window(x: &[f64], from_s: f64, to_s: f64, fs: f64) -> &[f64] {
     &x[(from_s * fs) as usize..(to_s * fs) as usize]
 }
 
+/// Slip statistics of cello D3 bowed for 2.5 s with `bow`, over 1.5..2.5 s.
+fn cello_d3_slips(bow: BowControl) -> colophony::analysis::SlipStats {
+    let out = render(&RenderSettings {
+        seconds: 2.5,
+        bow,
+        ..settings(InstrumentKind::Cello, 50)
+    })
+    .unwrap();
+    let v = window(&out.bow_point_velocity_m_per_s, 1.5, 2.5, FS);
+    // Sticking is exact in the model (v_s = v_b to rounding): 1e-9 m/s separates it.
+    slip_stats(v, bow.velocity_m_per_s, FS, midi_to_hz(50.0), 1e-9)
+}
+
 #[test]
 fn helmholtz_slip_fraction_equals_beta_with_one_slip_per_period() {
     let s = settings(InstrumentKind::Cello, 50);
-    let out = render(&RenderSettings {
-        seconds: 3.0,
-        ..s.clone()
-    })
-    .unwrap();
-    let f0 = midi_to_hz(50.0);
-    // whole periods of a steady stretch after the attack
-    let v = window(&out.bow_point_velocity_m_per_s, 1.5, 2.5, FS);
-    // sticking is exact in the model (v_s = v_b to rounding): 1e-9 m/s separates it
-    let stats = slip_stats(v, s.bow.velocity_m_per_s, FS, f0, 1e-9);
+    let stats = cello_d3_slips(s.bow);
     let beta = s.bow.position_beta;
     println!("cello D3 at defaults: {stats:?}, beta {beta}");
-    // Raman: slip for a fraction beta of the period. 10 %: the bow position is rounded to
-    // the spatial grid (2 samples of round trip in ~327) and the slip edges are smeared
-    // by the loop filters over a few samples.
+    // Raman: the corners pass the bow beta of a period apart. 10 % is the issue's bound;
+    // the bow position itself is rounded to the grid by under 1 %.
     assert!(
         (stats.slip_fraction - beta).abs() < 0.1 * beta,
-        "slip fraction {}",
+        "corner-to-corner slip fraction {}",
         stats.slip_fraction
     );
-    // one slip per period (counting over ~147 periods: rounding at the window edges only)
+    // One slip per period (over ~147 periods; only the window edges can add a fraction).
     assert!(
         (stats.slips_per_period - 1.0).abs() < 0.02,
         "slips/period {}",
         stats.slips_per_period
     );
-    // sticking velocity is the bow velocity (within 10 %)
-    assert!((stats.stick_velocity_m_per_s - s.bow.velocity_m_per_s).abs() < 0.01);
-    // Raman's slip velocity -v_b (1 - beta) / beta = -0.9 m/s; 15 %: the corners of
-    // the Helmholtz wave are rounded by the losses, so the mean over the slip is lower
-    let ideal = -s.bow.velocity_m_per_s * (1.0 - beta) / beta;
+    // Sticking velocity is the bow velocity (within 10 %).
+    let vb = s.bow.velocity_m_per_s;
+    assert!((stats.stick_velocity_m_per_s - vb).abs() < 0.1 * vb);
+    // Raman's slip velocity -v_b (1 - beta) / beta is not asserted: the rounded corners
+    // take part of the slip plateau between the half-jump points (see the next test).
     println!(
-        "mean slip velocity {:.4} m/s, Raman {ideal:.4}",
-        stats.slip_velocity_m_per_s
+        "slip plateau {:.3} m/s, Raman {:.3}; velocity jump {:.3} m/s, Raman v_b/beta {:.3}",
+        stats.slip_velocity_m_per_s,
+        -vb * (1.0 - beta) / beta,
+        stats.jump_m_per_s,
+        vb / beta
     );
-    assert!((stats.slip_velocity_m_per_s - ideal).abs() < 0.15 * ideal.abs());
+}
+
+#[test]
+fn corner_rounding_shrinks_as_bow_force_rises() {
+    // Cremer: the losses round the Helmholtz corner, the friction force sharpens it at each
+    // slip; more force, sharper corners, so the strict slip time falls toward beta.
+    let base = settings(InstrumentKind::Cello, 50).bow;
+    let strict: Vec<(f64, f64)> = [0.5, 1.0, 2.0, 3.0]
+        .into_iter()
+        .map(|force_n| {
+            let stats = cello_d3_slips(BowControl { force_n, ..base });
+            assert!(
+                (stats.slips_per_period - 1.0).abs() < 0.02,
+                "{force_n} N: {stats:?}"
+            );
+            (force_n, stats.strict_slip_fraction)
+        })
+        .collect();
+    println!("strict slip fraction against bow force (beta {}): {strict:?}", base.position_beta);
+    for pair in strict.windows(2) {
+        assert!(pair[1].1 < pair[0].1, "rounding grew with force: {pair:?}");
+    }
+    // Always at least beta: the flanks only add time to the ideal slip.
+    assert!(strict.iter().all(|(_, f)| *f >= 0.95 * base.position_beta));
 }
 
 #[test]
 fn helmholtz_amplitude_scales_as_bow_velocity_over_beta() {
-    // Raman: the velocity jump at the bow is v_b / beta, so the peak-to-peak string
-    // velocity at the bow doubles when v_b doubles or beta halves.
-    let peak_to_peak = |velocity: f64, beta: f64| {
+    // Raman: the velocity jump at the bow is v_b / beta, so it doubles when v_b doubles or
+    // beta halves.
+    // Bow force scaled so each case sits at the same place in its Schelleng window
+    // (F_max ~ v_b / beta, F_min ~ v_b / beta^2: force ~ v_b / beta^1.5), so the corner
+    // rounding, which depends on that place, is comparable.
+    let jump = |velocity_m_per_s: f64, position_beta: f64| {
         let bow = BowControl {
-            velocity_m_per_s: velocity,
-            force_n: 1.5,
-            position_beta: beta,
+            velocity_m_per_s,
+            force_n: 1.5 * (velocity_m_per_s / 0.1) * (0.12 / position_beta).powf(1.5),
+            position_beta,
         };
-        let out = render(&RenderSettings {
-            bow,
-            seconds: 2.0,
-            ..settings(InstrumentKind::Cello, 50)
-        })
-        .unwrap();
-        let v = window(&out.bow_point_velocity_m_per_s, 1.0, 2.0, FS);
-        v.iter().cloned().fold(f64::MIN, f64::max) - v.iter().cloned().fold(f64::MAX, f64::min)
+        let stats = cello_d3_slips(bow);
+        assert!((stats.slips_per_period - 1.0).abs() < 0.02, "{bow:?}: {stats:?}");
+        stats.jump_m_per_s
     };
-    let base = peak_to_peak(0.1, 0.12);
-    let faster = peak_to_peak(0.2, 0.12);
-    let closer = peak_to_peak(0.1, 0.06);
-    println!("peak-to-peak: base {base:.4}, 2 v_b {faster:.4}, beta/2 {closer:.4}; Raman v_b/beta = {:.4}", 0.1 / 0.12);
-    // 10 %: rounding of the corners by the loop losses, as above
-    assert!((base - 0.1 / 0.12).abs() < 0.1 * base);
+    let base = jump(0.1, 0.12);
+    let faster = jump(0.2, 0.12);
+    let closer = jump(0.1, 0.06);
+    println!(
+        "velocity jump at the bow: base {base:.4}, 2 v_b {faster:.4}, beta/2 {closer:.4} m/s; \
+         Raman v_b/beta = {:.4}",
+        0.1 / 0.12
+    );
+    // 10 % of Raman's value for the base case, and the two doublings within 10 %.
+    assert!((base - 0.1 / 0.12).abs() < 0.1 * (0.1 / 0.12));
     assert!((faster / base - 2.0).abs() < 0.2);
     assert!((closer / base - 2.0).abs() < 0.2);
 }

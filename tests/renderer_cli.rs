@@ -1,0 +1,99 @@
+//! The `colophony` binary as a user runs it: `render --probe` shows Raman's Helmholtz
+//! motion, and bad arguments fail with a one-line error, a non-zero exit and no file.
+
+use colophony::analysis::slip_stats;
+use colophony::dsp::instrument::midi_to_hz;
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn colophony(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_colophony"))
+        .args(args)
+        .output()
+        .expect("running colophony")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("renderer_cli");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    let _ = std::fs::remove_file(&path);
+    path
+}
+
+#[test]
+fn probe_at_default_settings_shows_one_slip_per_period_of_length_beta_at_bow_velocity() {
+    let out = scratch("probe.wav");
+    let run = colophony(&["render", "--out", out.to_str().unwrap(), "--probe", "--seconds", "2.5"]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let mut reader = hound::WavReader::open(&out).unwrap();
+    let spec = reader.spec();
+    assert_eq!(spec.channels, 3);
+    assert_eq!(spec.sample_format, hound::SampleFormat::Float);
+    let samples: Vec<f32> = reader.samples::<f32>().map(Result::unwrap).collect();
+    let fs = spec.sample_rate as f64;
+    // Channel 1: string velocity at the bow, over 1.5..2.5 s (steady Helmholtz motion).
+    let v: Vec<f64> = samples
+        .chunks(3)
+        .map(|frame| frame[1] as f64)
+        .skip((1.5 * fs) as usize)
+        .collect();
+    let friction: Vec<f64> = samples.chunks(3).map(|frame| frame[2] as f64).collect();
+    // Defaults of the renderer (and of the plugin): cello D3, v_b 0.1 m/s, beta 0.1.
+    let (vb, beta) = (0.1, 0.1);
+    // 1e-6 m/s: the probe is f32, which rounds the sticking velocity 0.1 to ~1e-8.
+    let stats = slip_stats(&v, vb, fs, midi_to_hz(50.0), 1e-6);
+    println!("probe of the default note: {stats:?}");
+    assert!(
+        (stats.slips_per_period - 1.0).abs() < 0.02,
+        "{} slips per period",
+        stats.slips_per_period
+    );
+    assert!(
+        (stats.slip_fraction - beta).abs() < 0.1 * beta,
+        "slip fraction {} (beta {beta})",
+        stats.slip_fraction
+    );
+    assert!(
+        (stats.stick_velocity_m_per_s - vb).abs() < 0.1 * vb,
+        "sticking at {} m/s",
+        stats.stick_velocity_m_per_s
+    );
+    // Channel 2 is the friction force, bounded by mu_s F_N = 0.4 N at the default 1 N.
+    let peak = friction.iter().fold(0.0f64, |m, f| m.max(f.abs()));
+    assert!(peak > 0.1 && peak <= 0.4 + 1e-6, "friction peak {peak} N");
+}
+
+#[test]
+fn bad_arguments_fail_with_one_line_and_write_nothing() {
+    let cases: [(&str, &[&str]); 6] = [
+        ("instrument", &["--instrument", "banjo"]),
+        ("note-range", &["--note", "C1"]),
+        ("note-name", &["--note", "H2"]),
+        ("seconds", &["--seconds", "-1"]),
+        ("sample-rate", &["--sample-rate", "0"]),
+        ("force", &["--bow-force", "NaN"]),
+    ];
+    for (name, extra) in cases {
+        let out = scratch(&format!("bad-{name}.wav"));
+        let mut args = vec!["render", "--out", out.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        let run = colophony(&args);
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        println!("{extra:?}: {}", stderr.trim());
+        assert!(!run.status.success(), "{extra:?} succeeded");
+        assert!(stderr.contains("error"), "{extra:?}: no error message");
+        assert!(!out.exists(), "{extra:?} left {}", out.display());
+        let partial = out.with_extension("wav.partial");
+        assert!(!partial.exists(), "{extra:?} left a partial file");
+    }
+}
+
+#[test]
+fn an_unwritable_output_path_fails_cleanly() {
+    let run = colophony(&["render", "--out", "/nonexistent-dir/x.wav", "--seconds", "0.1"]);
+    assert!(!run.status.success());
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(stderr.starts_with("error"), "{stderr}");
+    assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
+}
