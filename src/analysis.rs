@@ -128,7 +128,11 @@ pub fn slip_stats(
             .zip(beyond)
             .filter(|(_, b)| **b)
             .fold((0.0, 0usize), |(a, n), (v, _)| (a + v, n + 1));
-        if n == 0 { stick } else { sum / n as f64 }
+        if n == 0 {
+            stick
+        } else {
+            sum / n as f64
+        }
     };
     let first = classify(slip);
     let slip = plateau(&first);

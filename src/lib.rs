@@ -71,7 +71,8 @@ impl Plugin for Colophony {
         ..AudioIOLayout::const_default()
     }];
 
-    const MIDI_INPUT: MidiConfig = MidiConfig::Basic;
+    // `MidiCCs`: pitch bend arrives as `MidiPitchBend` only at this level.
+    const MIDI_INPUT: MidiConfig = MidiConfig::MidiCCs;
     const SAMPLE_ACCURATE_AUTOMATION: bool = true;
 
     type Editor = ();

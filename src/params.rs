@@ -76,14 +76,17 @@ impl Default for ColophonyParams {
         Self {
             bow_velocity: FloatParam::new("Bow Velocity", 0.1, bow_velocity_range())
                 .with_unit(" m/s")
+                .with_value_to_string(formatters::v2s_f32_rounded(3))
                 .with_smoother(SmoothingStyle::Linear(BOW_SMOOTHING_MS)),
             // Default inside the Schelleng window of the default note (cello D, v_b 0.1 m/s,
             // beta 0.1): F_max = 2 Z0 v_b / (beta (mu_s - mu_d)) = 5.1 N.
             bow_force: FloatParam::new("Bow Force", 1.0, bow_force_range())
                 .with_unit(" N")
+                .with_value_to_string(formatters::v2s_f32_rounded(3))
                 .with_smoother(SmoothingStyle::Linear(BOW_SMOOTHING_MS)),
             bow_position: FloatParam::new("Bow Position", 0.1, bow_position_range())
                 .with_unit(" beta")
+                .with_value_to_string(formatters::v2s_f32_rounded(3))
                 .with_smoother(SmoothingStyle::Linear(BOW_SMOOTHING_MS)),
             instrument: EnumParam::new("Instrument", InstrumentChoice::Cello),
             gain: FloatParam::new(
@@ -95,6 +98,7 @@ impl Default for ColophonyParams {
                 },
             )
             .with_unit(" dB")
+            .with_value_to_string(formatters::v2s_f32_rounded(1))
             .with_smoother(SmoothingStyle::Linear(10.0)),
         }
     }

@@ -83,7 +83,10 @@ fn corner_rounding_shrinks_as_bow_force_rises() {
             (force_n, stats.strict_slip_fraction)
         })
         .collect();
-    println!("strict slip fraction against bow force (beta {}): {strict:?}", base.position_beta);
+    println!(
+        "strict slip fraction against bow force (beta {}): {strict:?}",
+        base.position_beta
+    );
     for pair in strict.windows(2) {
         assert!(pair[1].1 < pair[0].1, "rounding grew with force: {pair:?}");
     }
@@ -105,7 +108,10 @@ fn helmholtz_amplitude_scales_as_bow_velocity_over_beta() {
             position_beta,
         };
         let stats = cello_d3_slips(bow);
-        assert!((stats.slips_per_period - 1.0).abs() < 0.02, "{bow:?}: {stats:?}");
+        assert!(
+            (stats.slips_per_period - 1.0).abs() < 0.02,
+            "{bow:?}: {stats:?}"
+        );
         stats.jump_m_per_s
     };
     let base = jump(0.1, 0.12);

@@ -482,3 +482,46 @@ fn pitch_bend_moves_the_pitch_by_up_to_two_semitones() {
         );
     }
 }
+
+#[test]
+fn every_parameter_survives_a_value_text_value_round_trip() {
+    // What clap-validator's param-conversions case checks: the text the plugin shows for a
+    // value parses back to a value that shows the same text.
+    let mut plugin = active_plugin(FS, BLOCK);
+    let params = plugin.params().to_vec();
+    let names: Vec<&str> = params.iter().map(|p| p.name.as_str()).collect();
+    for expected in [
+        "Bow Velocity",
+        "Bow Force",
+        "Bow Position",
+        "Instrument",
+        "Output Gain",
+    ] {
+        assert!(names.contains(&expected), "no {expected:?} in {names:?}");
+    }
+    for p in &params {
+        for i in 0..=20 {
+            let value = p.min + (p.max - p.min) * i as f64 / 20.0;
+            let text = plugin.clap_to_text(&p.name, value);
+            let back = plugin.text_to_clap(&p.name, &text);
+            let again = plugin.clap_to_text(&p.name, back);
+            assert_eq!(
+                text, again,
+                "{}: {value} -> {text:?} -> {back} -> {again:?}",
+                p.name
+            );
+            assert!(
+                back >= p.min && back <= p.max,
+                "{}: {back} out of range",
+                p.name
+            );
+        }
+        println!(
+            "{}: {} .. {} (default {})",
+            p.name,
+            plugin.clap_to_text(&p.name, p.min),
+            plugin.clap_to_text(&p.name, p.max),
+            plugin.clap_to_text(&p.name, p.default)
+        );
+    }
+}

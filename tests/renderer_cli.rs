@@ -24,8 +24,19 @@ fn scratch(name: &str) -> PathBuf {
 #[test]
 fn probe_at_default_settings_shows_one_slip_per_period_of_length_beta_at_bow_velocity() {
     let out = scratch("probe.wav");
-    let run = colophony(&["render", "--out", out.to_str().unwrap(), "--probe", "--seconds", "2.5"]);
-    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let run = colophony(&[
+        "render",
+        "--out",
+        out.to_str().unwrap(),
+        "--probe",
+        "--seconds",
+        "2.5",
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
     let mut reader = hound::WavReader::open(&out).unwrap();
     let spec = reader.spec();
     assert_eq!(spec.channels, 3);
@@ -91,7 +102,13 @@ fn bad_arguments_fail_with_one_line_and_write_nothing() {
 
 #[test]
 fn an_unwritable_output_path_fails_cleanly() {
-    let run = colophony(&["render", "--out", "/nonexistent-dir/x.wav", "--seconds", "0.1"]);
+    let run = colophony(&[
+        "render",
+        "--out",
+        "/nonexistent-dir/x.wav",
+        "--seconds",
+        "0.1",
+    ]);
     assert!(!run.status.success());
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert!(stderr.starts_with("error"), "{stderr}");
