@@ -1,6 +1,7 @@
 //! `colophony`: the offline renderer and tools.
 
 use clap::{Parser, Subcommand};
+use colophony::dsp::friction::FrictionModel;
 use colophony::dsp::instrument::{BowControl, InstrumentKind};
 use colophony::render::{parse_note, render, write_wav, RenderSettings};
 use std::path::PathBuf;
@@ -50,7 +51,16 @@ enum Command {
         /// 2 friction force (N).
         #[arg(long)]
         probe: bool,
+        /// Friction law: hyperbolic, static (Stribeck), lugre or elasto-plastic.
+        #[arg(long, default_value = "hyperbolic", value_parser = parse_friction)]
+        friction: FrictionModel,
     },
+}
+
+fn parse_friction(s: &str) -> Result<FrictionModel, String> {
+    FrictionModel::from_name(s).ok_or_else(|| {
+        format!("unknown friction model '{s}': choose hyperbolic, static, lugre or elasto-plastic")
+    })
 }
 
 fn parse_instrument(s: &str) -> Result<InstrumentKind, String> {
@@ -72,6 +82,7 @@ fn main() -> ExitCode {
             sample_rate,
             release,
             probe,
+            friction,
         } => {
             let settings = RenderSettings {
                 instrument,
@@ -84,6 +95,7 @@ fn main() -> ExitCode {
                 },
                 sample_rate_hz: sample_rate,
                 release_s: release,
+                friction,
             };
             let started = std::time::Instant::now();
             match render(&settings).and_then(|r| write_wav(&out, &r, probe)) {

@@ -7,6 +7,8 @@
 //! assert_eq!(out.audio.len(), (0.05f64 * 48_000.0).round() as usize);
 //! ```
 
+use crate::dsp::friction::bristle::SolverStats;
+use crate::dsp::friction::FrictionModel;
 use crate::dsp::instrument::{BowControl, Instrument, InstrumentKind};
 use std::fmt;
 use std::path::Path;
@@ -23,6 +25,7 @@ pub struct RenderSettings {
     pub sample_rate_hz: f64,
     /// Lift the bow at this time (s); `None` bows to the end.
     pub release_s: Option<f64>,
+    pub friction: FrictionModel,
 }
 
 impl Default for RenderSettings {
@@ -34,6 +37,7 @@ impl Default for RenderSettings {
             bow: BowControl::default(),
             sample_rate_hz: 48_000.0,
             release_s: None,
+            friction: FrictionModel::Hyperbolic,
         }
     }
 }
@@ -78,6 +82,8 @@ pub struct Rendered {
     pub audio: Vec<f64>,
     pub bow_point_velocity_m_per_s: Vec<f64>,
     pub friction_force_n: Vec<f64>,
+    /// Newton statistics of the bowed string's contact (bristle models only).
+    pub newton: SolverStats,
 }
 
 fn check(settings: &RenderSettings) -> Result<(), RenderError> {
@@ -134,12 +140,14 @@ pub fn render(settings: &RenderSettings) -> Result<Rendered, RenderError> {
     let frames = (settings.seconds * fs).round() as usize;
     let release = settings.release_s.map(|s| (s * fs).round() as usize);
     let mut instrument = Instrument::new(settings.instrument, fs);
+    instrument.set_friction_model(settings.friction);
     instrument.note_on(settings.note);
     let mut out = Rendered {
         sample_rate_hz: fs,
         audio: Vec::with_capacity(frames),
         bow_point_velocity_m_per_s: Vec::with_capacity(frames),
         friction_force_n: Vec::with_capacity(frames),
+        newton: SolverStats::default(),
     };
     for i in 0..frames {
         if i % BLOCK == 0 {
@@ -154,6 +162,7 @@ pub fn render(settings: &RenderSettings) -> Result<Rendered, RenderError> {
             .push(frame.bow_point_velocity_m_per_s);
         out.friction_force_n.push(frame.friction_force_n);
     }
+    out.newton = instrument.probed_solver_stats();
     Ok(out)
 }
 

@@ -221,6 +221,7 @@ fn output_is_finite_and_free_of_subnormals_at_extreme_rates_and_settings() {
                         bow,
                         sample_rate_hz: fs,
                         release_s: Some(seconds / 2.0),
+                        ..RenderSettings::default()
                     };
                     let out = render(&s).unwrap();
                     for x in out.audio.iter().map(|&x| x as f32) {

@@ -13,7 +13,8 @@
 //! cleared and skipped until the next note on it.
 
 use super::body::{BodyMode, BodyModes};
-use super::friction::{BowInput, FrictionContact, HyperbolicFriction};
+use super::friction::bristle::{BristleParams, SolverStats};
+use super::friction::{AnyFriction, BowInput, FrictionContact, FrictionModel};
 use super::waveguide::{StringSpec, WaveguideString};
 
 pub const STRINGS: usize = 4;
@@ -170,7 +171,7 @@ pub struct Frame {
 #[derive(Debug, Clone)]
 struct StringVoice {
     string: WaveguideString,
-    contact: HyperbolicFriction,
+    contact: AnyFriction,
     note: Option<u8>,
     /// Bow envelope, 0 (lifted) to 1 (full force).
     bow_gain: f64,
@@ -198,7 +199,12 @@ impl Instrument {
         let specs = kind.strings();
         let voices = std::array::from_fn(|i| StringVoice {
             string: WaveguideString::new(specs[i], sample_rate_hz, lowest_hz),
-            contact: HyperbolicFriction::default(),
+            contact: AnyFriction::new(
+                FrictionModel::Hyperbolic,
+                BristleParams::waveguide_string(),
+                sample_rate_hz,
+            )
+            .expect("the built-in bristle parameters are valid"),
             note: None,
             bow_gain: 0.0,
             bowed: false,
@@ -365,6 +371,22 @@ impl Instrument {
             frame = Frame::default();
         }
         frame
+    }
+
+    /// Switches every string's friction law, handing over force and stick state (no click).
+    pub fn set_friction_model(&mut self, model: FrictionModel) {
+        for voice in &mut self.voices {
+            voice.contact.set_model(model);
+        }
+    }
+
+    pub fn friction_model(&self) -> FrictionModel {
+        self.voices[0].contact.model()
+    }
+
+    /// Newton statistics of the probed string's bristle contact.
+    pub fn probed_solver_stats(&self) -> SolverStats {
+        self.voices[self.probed].contact.bristle().stats
     }
 
     /// Whether the contact of the probed string is sticking (for analysis).

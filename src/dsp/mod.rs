@@ -6,4 +6,5 @@ pub mod body;
 pub mod filters;
 pub mod friction;
 pub mod instrument;
+pub mod modal;
 pub mod waveguide;

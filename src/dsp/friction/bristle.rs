@@ -1,0 +1,594 @@
+//! Bristle friction: LuGre and elasto-plastic (Dupont et al. 2002), solved without delay by
+//! the K-method and a safeguarded Newton-Raphson iteration, as in Serafin, Avanzini and
+//! Rocchesso, "Bowed string simulation using an elasto-plastic friction model" (paper A,
+//! MODELS.md §A).
+//!
+//! ```text
+//! f   = sigma0 z + sigma1 zdot + sigma2 v                         friction force
+//! zdot = v (1 - alpha(v, z) z / z_ss(v))                           bristle dynamics
+//! z_ss(v) = sgn(v) (f_c + (f_s - f_c) exp(-(v / v_s)^2)) / sigma0  Stribeck steady state
+//! ```
+//!
+//! LuGre is `alpha = 1`; elasto-plastic uses the adhesion map `alpha(v, z)`, zero while
+//! `|z| <= z_ba` (purely elastic presliding) or when `z` and `v` disagree in sign, one
+//! beyond `|z_ss(v)|`, a raised sine in between.
+//!
+//! **K-method.** The resonator offers a load line `v_s = v_h + Y F` (see the parent
+//! module), so the relative velocity is `v = v_free - Y F` with `v_free = v_b - v_h`. The
+//! bristle equation is discretised by the trapezoidal rule, `z(n) = z~ + (T/2) y` with
+//! `y = zdot(n)` and `z~ = z(n-1) + (T/2) y(n-1)`. Substituting `F` gives
+//! `v = v~ + k1 y`, `z = z~ + k2 y` with
+//! `v~ = (v_free - Y sigma0 z~) / (1 + Y sigma2)`, `k1 = -Y (sigma0 T/2 + sigma1) / (1 + Y sigma2)`,
+//! `k2 = T/2`, and the scalar equation `g(y) = f_NL(v~ + k1 y, z~ + k2 y) - y = 0`. No
+//! unit delay enters the loop.
+//!
+//! **Solver.** Newton-Raphson from `y(n-1)` with the analytic derivative, each step damped
+//! (halved up to [`MAX_DAMPING_HALVINGS`] times) until `|g|` falls. If it has not converged
+//! after [`NEWTON_CAP`] iterations, or a step is not finite, a bracketing fallback takes
+//! over: `g` is positive for very negative `y` and negative for very positive `y` (there
+//! `alpha = 0` and `g ~ (k1 - 1) y`), so a bracket is found by doubling steps and bisected.
+//! Either way the result is finite. Iterations and fallbacks are counted in
+//! [`SolverStats`].
+//!
+//! | symbol | meaning | unit | source |
+//! |---|---|---|---|
+//! | `sigma0` | bristle stiffness | N/m | paper A (1e4 for modal objects) |
+//! | `sigma1` | bristle damping | kg/s | paper A: 0.1 sqrt(sigma0) |
+//! | `sigma2` | viscous friction | kg/s | paper A: 0.4 |
+//! | `v_s` | Stribeck velocity | m/s | paper A: 0.1 |
+//! | `mu_s`, `mu_d` | static and Coulomb coefficients: `f_s = mu_s F_N`, `f_c = mu_d F_N` | 1 | paper A: 0.4, 0.2 |
+//! | `c` | breakaway ratio, `z_ba = c f_c / sigma0`, `0 <= c < 1` | 1 | paper A code: 0.7 |
+//! | `T` | sample period | s | |
+//!
+//! ```
+//! use colophony::dsp::friction::bristle::{BristleFriction, BristleLaw, BristleParams};
+//! use colophony::dsp::friction::{BowInput, FrictionContact, LoadLine};
+//! let mut contact =
+//!     BristleFriction::new(BristleParams::modal_scenario(), BristleLaw::ElastoPlastic, 44_100.0)
+//!         .unwrap();
+//! let load = LoadLine { free_velocity_m_per_s: 0.0, admittance_s_per_kg: 0.01 };
+//! let f = contact.solve(load, BowInput { velocity_m_per_s: 0.1, normal_force_n: 1.0 });
+//! assert!(f.is_finite());
+//! ```
+
+use super::{BowInput, FrictionContact, LoadLine};
+
+/// Newton iterations before the bracketing fallback takes over.
+pub const NEWTON_CAP: u32 = 20;
+/// Step halvings per Newton iteration when `|g|` does not fall.
+pub const MAX_DAMPING_HALVINGS: u32 = 8;
+/// Convergence: `|dy| <= Y_TOLERANCE_M_PER_S * max(1, |y|)`.
+pub const Y_TOLERANCE_M_PER_S: f64 = 1e-10;
+/// The contact counts as sticking while `|v|` is below this fraction of `v_s`.
+pub const STICK_FRACTION_OF_STRIBECK: f64 = 0.01;
+
+/// Bristle parameters in SI units (see the module's symbol table).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BristleParams {
+    pub sigma0_n_per_m: f64,
+    pub sigma1_kg_per_s: f64,
+    pub sigma2_kg_per_s: f64,
+    pub stribeck_m_per_s: f64,
+    pub mu_s: f64,
+    pub mu_d: f64,
+    /// `c` in `z_ba = c f_c / sigma0`.
+    pub breakaway_ratio: f64,
+}
+
+impl BristleParams {
+    /// Paper A's modal scenario (the authors' SMAC-03 script, PARAMETERS.md §1.7 row 1).
+    pub fn modal_scenario() -> Self {
+        Self {
+            sigma0_n_per_m: 1e4,
+            sigma1_kg_per_s: 0.1 * 1e4f64.sqrt(),
+            sigma2_kg_per_s: 0.4,
+            stribeck_m_per_s: 0.1,
+            mu_s: 0.4,
+            mu_d: 0.2,
+            breakaway_ratio: 0.7,
+        }
+    }
+
+    /// Values chosen for the waveguide string (paper A's cello D scenario). The modal set
+    /// does not give Helmholtz motion there (MODELS.md, pitfalls): `sigma2 = 0.4 kg/s` lifts
+    /// sliding friction at 1 m/s above the static level, and `sigma1 = 10 kg/s`, far above
+    /// the string's `2 Z0 ~ 1 kg/s`, makes the contact chatter. Here `sigma2 = 0`; `sigma0`
+    /// is raised to 1e5 N/m so presliding stays below a micrometre and the bristle time
+    /// constant `2 Z0 / sigma0 ~ 10 us` is under a sample at 48 kHz; `sigma1` is the
+    /// critical damping of the bristle against the string's load, `2 sqrt(sigma0 m)` with
+    /// no mass, so it is set to a small fraction of `2 Z0` (0.1 kg/s) to damp presliding
+    /// without taking over the contact.
+    pub fn waveguide_string() -> Self {
+        Self {
+            sigma0_n_per_m: 1e5,
+            sigma1_kg_per_s: 0.1,
+            sigma2_kg_per_s: 0.0,
+            stribeck_m_per_s: 0.1,
+            mu_s: 0.4,
+            mu_d: 0.2,
+            breakaway_ratio: 0.7,
+        }
+    }
+
+    /// Checks the physical domain: every value finite, `sigma0 > 0`, `sigma1, sigma2 >= 0`,
+    /// `v_s > 0`, `0 <= mu_d <= mu_s`, `0 <= c < 1`.
+    pub fn validate(&self) -> Result<(), String> {
+        let all = [
+            self.sigma0_n_per_m,
+            self.sigma1_kg_per_s,
+            self.sigma2_kg_per_s,
+            self.stribeck_m_per_s,
+            self.mu_s,
+            self.mu_d,
+            self.breakaway_ratio,
+        ];
+        if all.iter().any(|x| !x.is_finite()) {
+            return Err("friction parameters must be finite".into());
+        }
+        if self.sigma0_n_per_m <= 0.0 {
+            return Err(format!(
+                "sigma0 must be positive, got {} N/m",
+                self.sigma0_n_per_m
+            ));
+        }
+        if self.sigma1_kg_per_s < 0.0 || self.sigma2_kg_per_s < 0.0 {
+            return Err("sigma1 and sigma2 must be non-negative".into());
+        }
+        if self.stribeck_m_per_s <= 0.0 {
+            return Err("the Stribeck velocity must be positive".into());
+        }
+        if !(0.0 <= self.mu_d && self.mu_d <= self.mu_s) {
+            return Err(format!(
+                "need 0 <= mu_d <= mu_s, got mu_d {} and mu_s {}",
+                self.mu_d, self.mu_s
+            ));
+        }
+        if !(0.0..1.0).contains(&self.breakaway_ratio) {
+            return Err(format!(
+                "the breakaway ratio c in z_ba = c f_c / sigma0 must satisfy 0 <= c < 1 (so \
+                 that z_ba < |z_ss| always), got {}",
+                self.breakaway_ratio
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Which bristle law: LuGre (`alpha = 1`) or elasto-plastic (adhesion map).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BristleLaw {
+    LuGre,
+    ElastoPlastic,
+}
+
+/// Solver counters since the last [`SolverStats::clear`].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SolverStats {
+    /// `histogram[k]`: samples that took `k` Newton iterations (the last bin collects
+    /// `NEWTON_CAP` and more, which always went on to the fallback).
+    pub histogram: [u64; NEWTON_CAP as usize + 1],
+    /// Samples solved by the bracketing fallback.
+    pub fallbacks: u64,
+    /// Newton iterations on the last sample.
+    pub last_iterations: u32,
+}
+
+impl SolverStats {
+    pub fn clear(&mut self) {
+        *self = Self::default();
+    }
+
+    pub fn samples(&self) -> u64 {
+        self.histogram.iter().sum()
+    }
+
+    /// Fraction of samples solved in at most `k` Newton iterations without fallback.
+    pub fn fraction_within(&self, k: u32) -> f64 {
+        let n = self.samples().max(1) as f64;
+        let within: u64 = self.histogram[..=(k as usize).min(NEWTON_CAP as usize)]
+            .iter()
+            .sum();
+        within as f64 / n
+    }
+}
+
+/// A LuGre or elasto-plastic contact (see the module doc).
+#[derive(Debug, Clone)]
+pub struct BristleFriction {
+    params: BristleParams,
+    law: BristleLaw,
+    half_period_s: f64,
+    /// Mean bristle displacement `z(n-1)`, m.
+    z_m: f64,
+    /// `zdot(n-1)`, m/s.
+    y_m_per_s: f64,
+    /// Relative velocity `v(n-1)`, m/s.
+    v_m_per_s: f64,
+    pub stats: SolverStats,
+}
+
+/// Normal-force-dependent constants for one sample.
+#[derive(Debug, Clone, Copy)]
+struct Curve {
+    sigma0: f64,
+    f_c: f64,
+    f_s: f64,
+    v_s: f64,
+    z_ba: f64,
+    elasto_plastic: bool,
+}
+
+impl Curve {
+    /// `f_NL(v, z)` and its partial derivatives `(f, df/dv, df/dz)`.
+    #[inline]
+    fn eval(&self, v: f64, z: f64) -> (f64, f64, f64) {
+        // Stribeck: h(v) = f_c + (f_s - f_c) e^{-(v/v_s)^2}, |z_ss| = h / sigma0.
+        let r = v / self.v_s;
+        let e = (-(r * r)).exp();
+        let h = self.f_c + (self.f_s - self.f_c) * e;
+        if h <= 0.0 {
+            // No normal force: no bristle resistance.
+            return (v, 1.0, 0.0);
+        }
+        let dh = (self.f_s - self.f_c) * e * (-2.0 * r / self.v_s);
+        let zss = h / self.sigma0;
+        let az = z.abs();
+        let same_sign = v * z > 0.0;
+        // alpha and its partials
+        let (alpha, dalpha_dz, dalpha_dv) = if !self.elasto_plastic {
+            (1.0, 0.0, 0.0)
+        } else if !same_sign || az <= self.z_ba {
+            (0.0, 0.0, 0.0)
+        } else if az >= zss {
+            (1.0, 0.0, 0.0)
+        } else {
+            let width = zss - self.z_ba;
+            let theta = std::f64::consts::PI * (az - 0.5 * (zss + self.z_ba)) / width;
+            let c = theta.cos();
+            let dtheta_dabsz = std::f64::consts::PI / width;
+            let dtheta_dzss = std::f64::consts::PI * (self.z_ba - az) / (width * width);
+            (
+                0.5 * (1.0 + theta.sin()),
+                0.5 * c * dtheta_dabsz * z.signum(),
+                0.5 * c * dtheta_dzss * dh / self.sigma0,
+            )
+        };
+        if alpha == 0.0 {
+            return (v, 1.0, 0.0);
+        }
+        // f = v - alpha z |v| sigma0 / h   (z_ss carries the sign of v)
+        let phi = v.abs() * self.sigma0 / h;
+        let dphi_dv = self.sigma0 * (v.signum() * h - v.abs() * dh) / (h * h);
+        let f = v - alpha * z * phi;
+        let df_dz = -(dalpha_dz * z + alpha) * phi;
+        let df_dv = 1.0 - z * (dalpha_dv * phi + alpha * dphi_dv);
+        (f, df_dv, df_dz)
+    }
+}
+
+impl BristleFriction {
+    /// A contact for `sample_rate_hz`; rejects parameters outside the physical domain
+    /// (notably `c >= 1`) with a clear error.
+    pub fn new(
+        params: BristleParams,
+        law: BristleLaw,
+        sample_rate_hz: f64,
+    ) -> Result<Self, String> {
+        params.validate()?;
+        if !(sample_rate_hz.is_finite() && sample_rate_hz > 0.0) {
+            return Err(format!("invalid sample rate {sample_rate_hz}"));
+        }
+        Ok(Self {
+            params,
+            law,
+            half_period_s: 0.5 / sample_rate_hz,
+            z_m: 0.0,
+            y_m_per_s: 0.0,
+            v_m_per_s: 0.0,
+            stats: SolverStats::default(),
+        })
+    }
+
+    pub fn params(&self) -> BristleParams {
+        self.params
+    }
+
+    pub fn law(&self) -> BristleLaw {
+        self.law
+    }
+
+    pub fn set_law(&mut self, law: BristleLaw) {
+        self.law = law;
+    }
+
+    /// Mean bristle displacement, m.
+    pub fn bristle_displacement_m(&self) -> f64 {
+        self.z_m
+    }
+
+    /// Relative (sliding) velocity `v_b - v_s` on the last sample, m/s.
+    pub fn relative_velocity_m_per_s(&self) -> f64 {
+        self.v_m_per_s
+    }
+
+    /// Breakaway displacement for a normal force, m.
+    pub fn breakaway_displacement_m(&self, normal_force_n: f64) -> f64 {
+        self.params.breakaway_ratio * self.params.mu_d * normal_force_n / self.params.sigma0_n_per_m
+    }
+
+    /// Takes over from another contact that was pushing with `force_n`: the bristles start
+    /// deflected so that `sigma0 z = force_n` and at rest, so the force does not jump.
+    pub fn take_over(&mut self, force_n: f64) {
+        self.z_m = if force_n.is_finite() {
+            force_n / self.params.sigma0_n_per_m
+        } else {
+            0.0
+        };
+        self.y_m_per_s = 0.0;
+    }
+
+    fn curve(&self, normal_force_n: f64) -> Curve {
+        let p = &self.params;
+        Curve {
+            sigma0: p.sigma0_n_per_m,
+            f_c: p.mu_d * normal_force_n,
+            f_s: p.mu_s * normal_force_n,
+            v_s: p.stribeck_m_per_s,
+            z_ba: p.breakaway_ratio * p.mu_d * normal_force_n / p.sigma0_n_per_m,
+            elasto_plastic: self.law == BristleLaw::ElastoPlastic,
+        }
+    }
+
+    /// Solves `g(y) = 0` (see the module doc); returns `y` and the Newton iteration count
+    /// (`None` if the fallback was used).
+    fn solve_y(
+        &self,
+        curve: &Curve,
+        v_tilde: f64,
+        k1: f64,
+        z_tilde: f64,
+        k2: f64,
+    ) -> (f64, Option<u32>) {
+        let g = |y: f64| {
+            let (f, dfv, dfz) = curve.eval(v_tilde + k1 * y, z_tilde + k2 * y);
+            (f - y, dfv * k1 + dfz * k2 - 1.0)
+        };
+        let mut y = if self.y_m_per_s.is_finite() {
+            self.y_m_per_s
+        } else {
+            0.0
+        };
+        let (mut gy, mut dg) = g(y);
+        for iteration in 1..=NEWTON_CAP {
+            if !(gy.is_finite() && dg.is_finite()) || dg == 0.0 {
+                break;
+            }
+            let step = -gy / dg;
+            let mut t = 1.0;
+            let mut accepted = None;
+            for _ in 0..=MAX_DAMPING_HALVINGS {
+                let candidate = y + t * step;
+                let (gc, dc) = g(candidate);
+                if gc.is_finite() && gc.abs() < gy.abs() {
+                    accepted = Some((candidate, gc, dc));
+                    break;
+                }
+                t *= 0.5;
+            }
+            let Some((candidate, gc, dc)) = accepted else {
+                // No descent along the Newton direction: either converged to rounding or
+                // stuck at a kink; the fallback decides.
+                if (t * step).abs() <= Y_TOLERANCE_M_PER_S * y.abs().max(1.0) || gy == 0.0 {
+                    return (y, Some(iteration));
+                }
+                break;
+            };
+            let moved = (candidate - y).abs();
+            y = candidate;
+            gy = gc;
+            dg = dc;
+            if moved <= Y_TOLERANCE_M_PER_S * y.abs().max(1.0) || gy == 0.0 {
+                return (y, Some(iteration));
+            }
+        }
+        (bracketed_root(&g, y), None)
+    }
+}
+
+/// Bisection fallback: `g` decreases from positive to negative over a wide enough range
+/// (see the module doc). Always returns a finite value.
+fn bracketed_root(g: &impl Fn(f64) -> (f64, f64), start: f64) -> f64 {
+    let start = if start.is_finite() { start } else { 0.0 };
+    let (g0, _) = g(start);
+    if g0 == 0.0 {
+        return start;
+    }
+    // Walk in the direction of the sign of g (g > 0: the root is above).
+    let dir = if g0 > 0.0 { 1.0 } else { -1.0 };
+    let mut step = 1e-6_f64.max(start.abs() * 1e-3);
+    let mut near = start;
+    let mut far = start;
+    let mut found = false;
+    for _ in 0..200 {
+        far = start + dir * step;
+        let (gf, _) = g(far);
+        if !gf.is_finite() {
+            break;
+        }
+        if gf * g0 <= 0.0 {
+            found = true;
+            break;
+        }
+        near = far;
+        step *= 2.0;
+    }
+    if !found {
+        return 0.0;
+    }
+    let (mut lo, mut hi) = if dir > 0.0 { (near, far) } else { (far, near) };
+    // g(lo) > 0 >= g(hi)
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if mid == lo || mid == hi {
+            break;
+        }
+        let (gm, _) = g(mid);
+        if !gm.is_finite() {
+            break;
+        }
+        if gm > 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+impl FrictionContact for BristleFriction {
+    fn solve(&mut self, load: LoadLine, bow: BowInput) -> f64 {
+        let f_n = bow.normal_force_n;
+        let admittance = load.admittance_s_per_kg;
+        let v_free = bow.velocity_m_per_s - load.free_velocity_m_per_s;
+        if !(f_n > 0.0) || !v_free.is_finite() || !(admittance >= 0.0) {
+            // Bow off the string: the bristles let go.
+            self.z_m = 0.0;
+            self.y_m_per_s = 0.0;
+            self.v_m_per_s = if v_free.is_finite() { v_free } else { 0.0 };
+            self.stats.last_iterations = 0;
+            return 0.0;
+        }
+        let p = self.params;
+        let curve = self.curve(f_n);
+        let k2 = self.half_period_s;
+        let z_tilde = self.z_m + k2 * self.y_m_per_s;
+        let denominator = 1.0 + admittance * p.sigma2_kg_per_s;
+        let v_tilde = (v_free - admittance * p.sigma0_n_per_m * z_tilde) / denominator;
+        let k1 = -admittance * (p.sigma0_n_per_m * k2 + p.sigma1_kg_per_s) / denominator;
+        let (y, iterations) = self.solve_y(&curve, v_tilde, k1, z_tilde, k2);
+        match iterations {
+            Some(k) => {
+                self.stats.histogram[(k as usize).min(NEWTON_CAP as usize)] += 1;
+                self.stats.last_iterations = k;
+            }
+            None => {
+                self.stats.histogram[NEWTON_CAP as usize] += 1;
+                self.stats.fallbacks += 1;
+                self.stats.last_iterations = NEWTON_CAP;
+            }
+        }
+        let v = v_tilde + k1 * y;
+        let z = z_tilde + k2 * y;
+        self.z_m = super::super::filters::flush_tiny(z);
+        self.y_m_per_s = super::super::filters::flush_tiny(y);
+        self.v_m_per_s = v;
+        p.sigma0_n_per_m * z + p.sigma1_kg_per_s * y + p.sigma2_kg_per_s * v
+    }
+
+    fn is_sticking(&self) -> bool {
+        self.v_m_per_s.abs() < STICK_FRACTION_OF_STRIBECK * self.params.stribeck_m_per_s
+    }
+
+    fn reset(&mut self) {
+        self.z_m = 0.0;
+        self.y_m_per_s = 0.0;
+        self.v_m_per_s = 0.0;
+        self.stats.last_iterations = 0;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn curve(elasto_plastic: bool) -> Curve {
+        let p = BristleParams::modal_scenario();
+        Curve {
+            sigma0: p.sigma0_n_per_m,
+            f_c: 0.2,
+            f_s: 0.4,
+            v_s: 0.1,
+            z_ba: 0.7 * 0.2 / p.sigma0_n_per_m,
+            elasto_plastic,
+        }
+    }
+
+    #[test]
+    fn analytic_derivatives_match_finite_differences() {
+        for ep in [false, true] {
+            let c = curve(ep);
+            for &(v, z) in &[
+                (0.05, 2.5e-5),
+                (0.3, 1.8e-5),
+                (-0.2, -3e-5),
+                (0.01, 3.9e-5),
+                (0.5, 1e-6),
+            ] {
+                let (_, dv, dz) = c.eval(v, z);
+                let hv = 1e-7;
+                let hz = 1e-11;
+                let nv = (c.eval(v + hv, z).0 - c.eval(v - hv, z).0) / (2.0 * hv);
+                let nz = (c.eval(v, z + hz).0 - c.eval(v, z - hz).0) / (2.0 * hz);
+                // 1e-5 relative: central differences in f64 at these steps
+                assert!(
+                    (dv - nv).abs() <= 1e-5 * nv.abs().max(1.0),
+                    "ep {ep} v {v} z {z}: {dv} vs {nv}"
+                );
+                assert!(
+                    (dz - nz).abs() <= 1e-5 * nz.abs().max(1.0),
+                    "ep {ep} v {v} z {z}: {dz} vs {nz}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn breakaway_ratio_of_one_or_more_is_rejected() {
+        let p = BristleParams {
+            breakaway_ratio: 1.0,
+            ..BristleParams::modal_scenario()
+        };
+        let err = BristleFriction::new(p, BristleLaw::ElastoPlastic, 44_100.0).unwrap_err();
+        assert!(err.contains("0 <= c < 1"), "{err}");
+    }
+
+    #[test]
+    fn the_solution_satisfies_the_discretised_bristle_equation() {
+        let mut c = BristleFriction::new(
+            BristleParams::waveguide_string(),
+            BristleLaw::ElastoPlastic,
+            48_000.0,
+        )
+        .unwrap();
+        let load_y = 1.0 / (2.0 * 0.506);
+        for n in 0..2000 {
+            let v_h = 0.8 * (n as f64 * 0.01).sin();
+            let z_prev = c.z_m;
+            let y_prev = c.y_m_per_s;
+            let bow = BowInput {
+                velocity_m_per_s: 0.1,
+                normal_force_n: 1.1,
+            };
+            let f = c.solve(
+                LoadLine {
+                    free_velocity_m_per_s: v_h,
+                    admittance_s_per_kg: load_y,
+                },
+                bow,
+            );
+            // trapezoid, force law and load line all hold to rounding
+            let p = c.params;
+            let z = c.z_m;
+            let y = c.y_m_per_s;
+            let v = c.v_m_per_s;
+            assert!((z - (z_prev + c.half_period_s * (y_prev + y))).abs() < 1e-15);
+            let curve = c.curve(1.1);
+            assert!((curve.eval(v, z).0 - y).abs() < 1e-8, "sample {n}");
+            assert!(
+                (f - (p.sigma0_n_per_m * z + p.sigma1_kg_per_s * y + p.sigma2_kg_per_s * v)).abs()
+                    < 1e-12
+            );
+            assert!((v - (0.1 - v_h - load_y * f)).abs() < 1e-9, "sample {n}");
+        }
+    }
+}
