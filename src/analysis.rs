@@ -78,7 +78,7 @@ pub struct SlipStats {
     pub strict_slip_fraction: f64,
     /// Corner-to-corner slips per period of `f0`.
     pub slips_per_period: f64,
-    /// Mean string velocity while sticking, m/s.
+    /// Median string velocity on the sticking side of the corners, m/s.
     pub stick_velocity_m_per_s: f64,
     /// Mean string velocity between the corners (the slip plateau), m/s.
     pub slip_velocity_m_per_s: f64,
@@ -96,55 +96,60 @@ pub fn slip_stats(
     f0_hz: f64,
     tolerance_m_per_s: f64,
 ) -> SlipStats {
-    let sticking = |v: f64| (v - bow_velocity_m_per_s).abs() <= tolerance_m_per_s;
-    let (stick_sum, stick_n) = v_s
+    let n = v_s.len().max(1) as f64;
+    let strict = v_s
         .iter()
-        .filter(|v| sticking(**v))
-        .fold((0.0, 0usize), |(a, n), v| (a + v, n + 1));
-    let stick = if stick_n == 0 {
-        bow_velocity_m_per_s
+        .filter(|v| (**v - bow_velocity_m_per_s).abs() > tolerance_m_per_s)
+        .count();
+    // The string slips against the bow direction.
+    let sign = if bow_velocity_m_per_s >= 0.0 {
+        -1.0
     } else {
-        stick_sum / stick_n as f64
+        1.0
     };
-    let mut slipping: Vec<f64> = v_s.iter().copied().filter(|v| !sticking(*v)).collect();
-    slipping.sort_by(f64::total_cmp);
-    let slip = if slipping.is_empty() {
+    let mut sorted: Vec<f64> = v_s.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    // Start from the bow velocity and the 1st percentile on the slipping side, then
+    // alternate: split at the midpoint, slip level = mean beyond it, stick level = median
+    // on the sticking side (robust to ripple while sticking).
+    let mut stick = bow_velocity_m_per_s;
+    let mut slip = if sorted.is_empty() {
         stick
+    } else if sign < 0.0 {
+        sorted[sorted.len() / 100]
     } else {
-        slipping[slipping.len() / 2]
+        sorted[sorted.len() - 1 - sorted.len() / 100]
     };
-    // The corners' centres: the midpoint between sticking and slipping levels, refined
-    // once with the mean velocity between corners (the slip plateau).
-    let sign = if slip < stick { -1.0 } else { 1.0 };
-    let classify = |level: f64| -> Vec<bool> {
-        let midpoint = 0.5 * (stick + level);
-        v_s.iter()
-            .map(|v| !slipping.is_empty() && sign * (v - midpoint) > 0.0)
-            .collect()
-    };
-    let plateau = |beyond: &[bool]| {
-        let (sum, n) = v_s
-            .iter()
-            .zip(beyond)
-            .filter(|(_, b)| **b)
-            .fold((0.0, 0usize), |(a, n), (v, _)| (a + v, n + 1));
-        if n == 0 {
-            stick
-        } else {
-            sum / n as f64
+    let mut beyond = vec![false; v_s.len()];
+    for _ in 0..4 {
+        let midpoint = 0.5 * (stick + slip);
+        for (b, v) in beyond.iter_mut().zip(v_s) {
+            *b = sign * (v - midpoint) > 0.0;
         }
-    };
-    let first = classify(slip);
-    let slip = plateau(&first);
-    let beyond = classify(slip);
-    let slip = plateau(&beyond);
+        let (sum, count) = v_s
+            .iter()
+            .zip(&beyond)
+            .filter(|(_, b)| **b)
+            .fold((0.0, 0usize), |(a, c), (v, _)| (a + v, c + 1));
+        if count == 0 || count == v_s.len() {
+            break;
+        }
+        slip = sum / count as f64;
+        let mut sticking: Vec<f64> = v_s
+            .iter()
+            .zip(&beyond)
+            .filter(|(_, b)| !**b)
+            .map(|(v, _)| *v)
+            .collect();
+        sticking.sort_by(f64::total_cmp);
+        stick = sticking[sticking.len() / 2];
+    }
     let corner = beyond.iter().filter(|b| **b).count();
     let onsets = beyond.windows(2).filter(|w| !w[0] && w[1]).count();
-    let n = v_s.len().max(1) as f64;
     let periods = v_s.len() as f64 * f0_hz / sample_rate_hz;
     SlipStats {
         slip_fraction: corner as f64 / n,
-        strict_slip_fraction: slipping.len() as f64 / n,
+        strict_slip_fraction: strict as f64 / n,
         slips_per_period: onsets as f64 / periods,
         stick_velocity_m_per_s: stick,
         slip_velocity_m_per_s: slip,

@@ -96,6 +96,7 @@ fn main() -> ExitCode {
                 sample_rate_hz: sample_rate,
                 release_s: release,
                 friction,
+                ..RenderSettings::default()
             };
             let started = std::time::Instant::now();
             match render(&settings).and_then(|r| write_wav(&out, &r, probe)) {

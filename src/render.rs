@@ -7,7 +7,7 @@
 //! assert_eq!(out.audio.len(), (0.05f64 * 48_000.0).round() as usize);
 //! ```
 
-use crate::dsp::friction::bristle::SolverStats;
+use crate::dsp::friction::bristle::{BristleParams, SolverStats};
 use crate::dsp::friction::FrictionModel;
 use crate::dsp::instrument::{BowControl, Instrument, InstrumentKind};
 use std::fmt;
@@ -26,6 +26,8 @@ pub struct RenderSettings {
     /// Lift the bow at this time (s); `None` bows to the end.
     pub release_s: Option<f64>,
     pub friction: FrictionModel,
+    /// Bristle parameters for the LuGre and elasto-plastic laws.
+    pub bristle: BristleParams,
 }
 
 impl Default for RenderSettings {
@@ -38,6 +40,7 @@ impl Default for RenderSettings {
             sample_rate_hz: 48_000.0,
             release_s: None,
             friction: FrictionModel::Hyperbolic,
+            bristle: BristleParams::waveguide_string(),
         }
     }
 }
@@ -140,6 +143,9 @@ pub fn render(settings: &RenderSettings) -> Result<Rendered, RenderError> {
     let frames = (settings.seconds * fs).round() as usize;
     let release = settings.release_s.map(|s| (s * fs).round() as usize);
     let mut instrument = Instrument::new(settings.instrument, fs);
+    instrument
+        .set_bristle_params(settings.bristle)
+        .map_err(RenderError::BadSetting)?;
     instrument.set_friction_model(settings.friction);
     instrument.note_on(settings.note);
     let mut out = Rendered {

@@ -373,11 +373,28 @@ impl Instrument {
         frame
     }
 
+    /// Renders `out.len()` samples of audio with constant bow settings: a loop over
+    /// [`Instrument::tick`], tested to give the same output bit for bit.
+    pub fn process(&mut self, bow: BowControl, out: &mut [f64]) {
+        for sample in out {
+            *sample = self.tick(bow).audio;
+        }
+    }
+
     /// Switches every string's friction law, handing over force and stick state (no click).
     pub fn set_friction_model(&mut self, model: FrictionModel) {
         for voice in &mut self.voices {
             voice.contact.set_model(model);
         }
+    }
+
+    /// Replaces the bristle parameters of every string (validated; real-time safe).
+    pub fn set_bristle_params(&mut self, params: BristleParams) -> Result<(), String> {
+        for voice in &mut self.voices {
+            let model = voice.contact.model();
+            voice.contact = AnyFriction::new(model, params, self.sample_rate_hz)?;
+        }
+        Ok(())
     }
 
     pub fn friction_model(&self) -> FrictionModel {

@@ -7,4 +7,5 @@ pub mod filters;
 pub mod friction;
 pub mod instrument;
 pub mod modal;
+pub mod rubbed;
 pub mod waveguide;

@@ -1,0 +1,285 @@
+//! Rubbed modal objects: paper A's modal scenario and the friction sound effects of its
+//! §5.2 (squeaking door, chalk on a board, rubbed wine glass, brake squeal), each a
+//! [`FrictionPair`] with documented modal data and friction parameters.
+//!
+//! The modal data are *designed*, not measured: mode frequencies from the physics of each
+//! object (a hinge pin's bending modes, a slate board's plate modes, a wine glass's (n, 0)
+//! bell modes, a brake disc's out-of-plane modes) with decay times typical of the material;
+//! friction parameters start from the Sound Design Toolkit's rubbing preset
+//! (PARAMETERS.md §1.1, §1.7) and are adjusted so each preset locks into stick-slip.
+//!
+//! ```
+//! use colophony::dsp::rubbed::{RubbedPreset, RubbedScene};
+//! let mut scene = RubbedScene::new(RubbedPreset::WineGlass, 48_000.0).unwrap();
+//! let mut peak = 0.0f64;
+//! for _ in 0..4800 {
+//!     peak = peak.max(scene.tick().audio.abs());
+//! }
+//! assert!(peak.is_finite());
+//! ```
+
+use super::friction::bristle::{BristleParams, SolverStats};
+use super::friction::{AnyFriction, BowInput, FrictionContact, FrictionModel};
+use super::modal::{Exciter, FrictionPair, ModalObject, ModeSpec, PairOutput};
+
+/// The built-in rubbed scenes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RubbedPreset {
+    /// Paper A's modal scenario: the authors' SMAC-03 script (PARAMETERS.md §1.7 row 1).
+    PaperModal,
+    DoorHinge,
+    Chalk,
+    WineGlass,
+    BrakeSqueal,
+}
+
+impl RubbedPreset {
+    pub const ALL: [RubbedPreset; 5] = [
+        RubbedPreset::PaperModal,
+        RubbedPreset::DoorHinge,
+        RubbedPreset::Chalk,
+        RubbedPreset::WineGlass,
+        RubbedPreset::BrakeSqueal,
+    ];
+
+    /// Command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            RubbedPreset::PaperModal => "paper-modal",
+            RubbedPreset::DoorHinge => "door-hinge",
+            RubbedPreset::Chalk => "chalk",
+            RubbedPreset::WineGlass => "wine-glass",
+            RubbedPreset::BrakeSqueal => "brake-squeal",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|p| p.name() == name)
+    }
+
+    /// The scene's data.
+    pub fn spec(self) -> RubbedSpec {
+        let mode = |freq_hz: f64, q: f64, mass_kg: f64| ModeSpec {
+            freq_hz,
+            q,
+            mass_kg,
+            weight: 1.0,
+        };
+        match self {
+            // Two string-like modes at 140 and 280 Hz, Q 500, 1 g each; the bow a free
+            // 50 g mass (Q irrelevant without stiffness) pushed at the steady friction of
+            // 0.5 m/s; F_N 1 N; sigma0 1e4, sigma1 10, sigma2 0.4, v_s 0.1, mu 0.4/0.2,
+            // c 0.7. Exactly the values of the authors' script.
+            RubbedPreset::PaperModal => RubbedSpec {
+                resonator: vec![mode(140.0, 500.0, 1e-3), mode(280.0, 500.0, 1e-3)],
+                exciter: Some(vec![mode(0.0, 1e5, 50e-3)]),
+                bristle: BristleParams::modal_scenario(),
+                velocity_m_per_s: 0.5,
+                normal_force_n: 1.0,
+                output_gain: 2.0,
+            },
+            // A door hinge: a steel pin and leaf, bending modes 500, 1300, 1700 Hz with
+            // decays 30, 20, 10 ms (the SDT rubbing preset's object, Q = pi f tau), 10 g
+            // modal masses; slow rotation (2 cm/s at the pin surface) under 4 N.
+            // Dry steel friction: mu_s 0.8, mu_d 0.4 (the SDT defaults' range).
+            RubbedPreset::DoorHinge => RubbedSpec {
+                resonator: vec![
+                    mode(500.0, 47.0, 0.01),
+                    mode(1300.0, 82.0, 0.01),
+                    mode(1700.0, 53.0, 0.01),
+                ],
+                exciter: None,
+                bristle: BristleParams {
+                    sigma0_n_per_m: 1e5,
+                    sigma1_kg_per_s: 1.0,
+                    sigma2_kg_per_s: 0.0,
+                    stribeck_m_per_s: 0.01,
+                    mu_s: 0.8,
+                    mu_d: 0.4,
+                    breakaway_ratio: 0.7,
+                },
+                velocity_m_per_s: 0.02,
+                normal_force_n: 4.0,
+                output_gain: 30.0,
+            },
+            // Chalk on a slate board: plate modes from 1.1 to 4.3 kHz, Q 30-60, 20 g modal
+            // masses; the chalk a velocity source at 0.2 m/s under 3 N; chalky friction
+            // mu_s 0.7, mu_d 0.3 with a broad Stribeck drop (0.2 m/s), so the friction still
+            // falls with speed at the drawing speed.
+            RubbedPreset::Chalk => RubbedSpec {
+                resonator: vec![
+                    mode(1100.0, 40.0, 0.02),
+                    mode(2300.0, 60.0, 0.02),
+                    mode(3150.0, 50.0, 0.02),
+                    mode(4300.0, 30.0, 0.02),
+                ],
+                exciter: None,
+                bristle: BristleParams {
+                    sigma0_n_per_m: 1e5,
+                    sigma1_kg_per_s: 1.0,
+                    sigma2_kg_per_s: 0.0,
+                    stribeck_m_per_s: 0.2,
+                    mu_s: 0.7,
+                    mu_d: 0.3,
+                    breakaway_ratio: 0.7,
+                },
+                velocity_m_per_s: 0.2,
+                normal_force_n: 3.0,
+                output_gain: 5.0,
+            },
+            // A wine glass rubbed at the rim by a wet finger: bell modes (2,0) 660 Hz,
+            // (3,0) 1780 Hz, (4,0) 3340 Hz (ratios of a thin-walled glass), Q 1500-3000
+            // (glass rings for seconds), 5 g modal masses; the finger a velocity source at
+            // 8 cm/s under 1 N; wet skin on glass: mu_s 0.6, mu_d 0.25, low Stribeck
+            // velocity.
+            RubbedPreset::WineGlass => RubbedSpec {
+                resonator: vec![
+                    mode(660.0, 3000.0, 0.005),
+                    mode(1780.0, 2000.0, 0.005),
+                    mode(3340.0, 1500.0, 0.005),
+                ],
+                exciter: None,
+                bristle: BristleParams {
+                    sigma0_n_per_m: 5e4,
+                    sigma1_kg_per_s: 0.5,
+                    sigma2_kg_per_s: 0.0,
+                    stribeck_m_per_s: 0.02,
+                    mu_s: 0.6,
+                    mu_d: 0.25,
+                    breakaway_ratio: 0.7,
+                },
+                velocity_m_per_s: 0.08,
+                normal_force_n: 1.0,
+                output_gain: 20.0,
+            },
+            // Brake squeal: out-of-plane disc modes 1.9, 3.6, 5.8 kHz, Q 300-500, 0.2 kg
+            // modal masses; the pad a velocity source at 0.8 m/s sliding speed under 40 N;
+            // pad on cast iron: mu_s 0.55, mu_d 0.4, falling over 1 m/s.
+            RubbedPreset::BrakeSqueal => RubbedSpec {
+                resonator: vec![
+                    mode(1900.0, 500.0, 0.2),
+                    mode(3600.0, 400.0, 0.2),
+                    mode(5800.0, 300.0, 0.2),
+                ],
+                exciter: None,
+                bristle: BristleParams {
+                    sigma0_n_per_m: 1e6,
+                    sigma1_kg_per_s: 5.0,
+                    sigma2_kg_per_s: 0.0,
+                    stribeck_m_per_s: 1.0,
+                    mu_s: 0.55,
+                    mu_d: 0.4,
+                    breakaway_ratio: 0.7,
+                },
+                velocity_m_per_s: 0.8,
+                normal_force_n: 40.0,
+                output_gain: 40.0,
+            },
+        }
+    }
+}
+
+/// A rubbed scene as data.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RubbedSpec {
+    pub resonator: Vec<ModeSpec>,
+    /// Modes of a modal exciter pushed by a force; `None`: a rigid velocity source.
+    pub exciter: Option<Vec<ModeSpec>>,
+    pub bristle: BristleParams,
+    /// Exciter velocity (rigid) or target sliding velocity (modal), m/s.
+    pub velocity_m_per_s: f64,
+    pub normal_force_n: f64,
+    /// Audio = gain x resonator velocity at the contact.
+    pub output_gain: f64,
+}
+
+/// One sample of a rubbed scene.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct RubbedFrame {
+    pub audio: f64,
+    pub contact: PairOutput,
+    /// Relative velocity exciter minus resonator, m/s.
+    pub relative_velocity_m_per_s: f64,
+}
+
+/// A preset set up at a sample rate, with its friction contact.
+#[derive(Debug, Clone)]
+pub struct RubbedScene {
+    pub spec: RubbedSpec,
+    pair: FrictionPair,
+    contact: AnyFriction,
+    push_n: f64,
+}
+
+impl RubbedScene {
+    /// The preset with the elasto-plastic law.
+    pub fn new(preset: RubbedPreset, sample_rate_hz: f64) -> Result<Self, String> {
+        Self::from_spec(preset.spec(), FrictionModel::ElastoPlastic, sample_rate_hz)
+    }
+
+    pub fn from_spec(
+        spec: RubbedSpec,
+        model: FrictionModel,
+        sample_rate_hz: f64,
+    ) -> Result<Self, String> {
+        let resonator = ModalObject::new(&spec.resonator, sample_rate_hz)?;
+        let exciter = match &spec.exciter {
+            None => Exciter::Rigid,
+            Some(modes) => Exciter::Modal(ModalObject::new(modes, sample_rate_hz)?),
+        };
+        let contact = AnyFriction::new(model, spec.bristle, sample_rate_hz)?;
+        // A modal exciter is pushed with the steady sliding friction at the target
+        // velocity (the authors' fe_b), so it settles there on average.
+        let p = spec.bristle;
+        let v = spec.velocity_m_per_s;
+        let f_c = p.mu_d * spec.normal_force_n;
+        let f_s = p.mu_s * spec.normal_force_n;
+        let push_n = v.signum() * (f_c + (f_s - f_c) * (-(v / p.stribeck_m_per_s).powi(2)).exp())
+            + p.sigma2_kg_per_s * v;
+        Ok(Self {
+            spec,
+            pair: FrictionPair { resonator, exciter },
+            contact,
+            push_n,
+        })
+    }
+
+    pub fn set_friction_model(&mut self, model: FrictionModel) {
+        self.contact.set_model(model);
+    }
+
+    pub fn solver_stats(&self) -> SolverStats {
+        self.contact.bristle().stats
+    }
+
+    pub fn is_sticking(&self) -> bool {
+        self.contact.is_sticking()
+    }
+
+    /// One sample at the preset's velocity and force.
+    pub fn tick(&mut self) -> RubbedFrame {
+        let bow = BowInput {
+            velocity_m_per_s: self.spec.velocity_m_per_s,
+            normal_force_n: self.spec.normal_force_n,
+        };
+        self.tick_with(bow)
+    }
+
+    /// One sample with an explicit exciter velocity and normal force.
+    pub fn tick_with(&mut self, bow: BowInput) -> RubbedFrame {
+        let out = self.pair.tick(&mut self.contact, bow, self.push_n);
+        let audio =
+            super::filters::flush_tiny(self.spec.output_gain * out.resonator_velocity_m_per_s);
+        RubbedFrame {
+            audio: if audio.is_finite() { audio } else { 0.0 },
+            contact: out,
+            relative_velocity_m_per_s: out.exciter_velocity_m_per_s
+                - out.resonator_velocity_m_per_s,
+        }
+    }
+
+    /// Resonator plus exciter modal energy, J.
+    pub fn resonator_energy_j(&self) -> f64 {
+        self.pair.resonator.energy_j()
+    }
+}
