@@ -5,8 +5,10 @@
 //! plugin framework. [`render`] is the offline renderer behind the `colophony` binary and
 //! [`analysis`] the signal measurements the tests and tools share.
 
+pub mod admittance_fit;
 pub mod analysis;
 pub mod dsp;
+pub mod figures;
 pub mod params;
 pub mod render;
 

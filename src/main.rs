@@ -3,6 +3,7 @@
 use clap::{Parser, Subcommand};
 use colophony::dsp::friction::FrictionModel;
 use colophony::dsp::instrument::{BowControl, InstrumentKind};
+use colophony::dsp::rubbed::RubbedPreset;
 use colophony::render::{parse_note, render, write_wav, RenderSettings};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -54,7 +55,52 @@ enum Command {
         /// Friction law: hyperbolic, static (Stribeck), lugre or elasto-plastic.
         #[arg(long, default_value = "hyperbolic", value_parser = parse_friction)]
         friction: FrictionModel,
+        /// Rub a modal object instead of bowing a string: paper-modal, door-hinge, chalk,
+        /// wine-glass or brake-squeal (the other bow settings are then the preset's).
+        #[arg(long, value_parser = parse_preset)]
+        preset: Option<RubbedPreset>,
     },
+    /// Draw a figure as PNG: serafin-fig7, serafin-modal, bridge-fit.
+    Figure {
+        name: String,
+        #[arg(long)]
+        out: PathBuf,
+        /// Measured admittance CSV (bridge-fit).
+        #[arg(long = "in")]
+        input: Option<PathBuf>,
+        /// Fitted bridge JSON (bridge-fit).
+        #[arg(long)]
+        fit: Option<PathBuf>,
+    },
+    /// Fit a passive modal bridge admittance to measured data (CSV in, JSON out).
+    FitBridge {
+        input: PathBuf,
+        /// Number of modes.
+        #[arg(long)]
+        modes: usize,
+        #[arg(long)]
+        out: PathBuf,
+    },
+}
+
+fn parse_preset(s: &str) -> Result<RubbedPreset, String> {
+    RubbedPreset::from_name(s).ok_or_else(|| {
+        let names: Vec<&str> = RubbedPreset::ALL.iter().map(|p| p.name()).collect();
+        format!("unknown preset '{s}': choose one of {}", names.join(", "))
+    })
+}
+
+fn report(result: Result<String, String>) -> ExitCode {
+    match result {
+        Ok(message) => {
+            println!("{message}");
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
 }
 
 fn parse_friction(s: &str) -> Result<FrictionModel, String> {
@@ -83,7 +129,21 @@ fn main() -> ExitCode {
             release,
             probe,
             friction,
+            preset,
         } => {
+            if let Some(preset) = preset {
+                return report(
+                    colophony::render::render_rubbed(
+                        preset,
+                        friction_or_default(friction),
+                        seconds,
+                        sample_rate,
+                    )
+                    .and_then(|r| write_wav(&out, &r, probe))
+                    .map(|()| format!("wrote {} ({} preset)", out.display(), preset.name()))
+                    .map_err(|e| e.to_string()),
+                );
+            }
             let settings = RenderSettings {
                 instrument,
                 note,
@@ -115,5 +175,32 @@ fn main() -> ExitCode {
                 }
             }
         }
+        Command::Figure {
+            name,
+            out,
+            input,
+            fit,
+        } => report(match name.as_str() {
+            "bridge-fit" => match (input, fit) {
+                (Some(input), Some(fit)) => {
+                    colophony::admittance_fit::draw_figure(&input, &fit, &out)
+                }
+                _ => Err("bridge-fit needs --in DATA.csv and --fit FIT.json".into()),
+            },
+            other => colophony::figures::draw(other, &out),
+        }),
+        Command::FitBridge { input, modes, out } => {
+            report(colophony::admittance_fit::run_cli(&input, modes, &out))
+        }
+    }
+}
+
+/// `--friction` defaults to hyperbolic for strings; rubbed presets use elasto-plastic
+/// unless another bristle or static law is asked for.
+fn friction_or_default(friction: FrictionModel) -> FrictionModel {
+    if friction == FrictionModel::Hyperbolic {
+        FrictionModel::ElastoPlastic
+    } else {
+        friction
     }
 }

@@ -10,6 +10,7 @@
 use crate::dsp::friction::bristle::{BristleParams, SolverStats};
 use crate::dsp::friction::FrictionModel;
 use crate::dsp::instrument::{BowControl, Instrument, InstrumentKind};
+use crate::dsp::rubbed::{RubbedPreset, RubbedScene};
 use std::fmt;
 use std::path::Path;
 
@@ -169,6 +170,45 @@ pub fn render(settings: &RenderSettings) -> Result<Rendered, RenderError> {
         out.friction_force_n.push(frame.friction_force_n);
     }
     out.newton = instrument.probed_solver_stats();
+    Ok(out)
+}
+
+/// Rubs one of the modal presets for `seconds` with the given friction law. The probe
+/// channels hold the resonator velocity at the contact and the friction force.
+pub fn render_rubbed(
+    preset: RubbedPreset,
+    friction: FrictionModel,
+    seconds: f64,
+    sample_rate_hz: f64,
+) -> Result<Rendered, RenderError> {
+    if !(seconds.is_finite() && seconds > 0.0 && seconds <= 600.0) {
+        return Err(RenderError::BadSetting(format!(
+            "--seconds must be in (0, 600], got {seconds}"
+        )));
+    }
+    if !(sample_rate_hz.is_finite() && (1000.0..=768_000.0).contains(&sample_rate_hz)) {
+        return Err(RenderError::BadSetting(format!(
+            "--sample-rate must be 1000..=768000 Hz, got {sample_rate_hz}"
+        )));
+    }
+    let mut scene = RubbedScene::from_spec(preset.spec(), friction, sample_rate_hz)
+        .map_err(RenderError::BadSetting)?;
+    let frames = (seconds * sample_rate_hz).round() as usize;
+    let mut out = Rendered {
+        sample_rate_hz,
+        audio: Vec::with_capacity(frames),
+        bow_point_velocity_m_per_s: Vec::with_capacity(frames),
+        friction_force_n: Vec::with_capacity(frames),
+        newton: SolverStats::default(),
+    };
+    for _ in 0..frames {
+        let frame = scene.tick();
+        out.audio.push(frame.audio);
+        out.bow_point_velocity_m_per_s
+            .push(frame.contact.resonator_velocity_m_per_s);
+        out.friction_force_n.push(frame.contact.friction_force_n);
+    }
+    out.newton = scene.solver_stats();
     Ok(out)
 }
 

@@ -1,0 +1,217 @@
+//! Figures as PNG (plotters, bitmap backend; text with egui's bundled Ubuntu font, so no
+//! system fonts are needed).
+//!
+//! - `serafin-fig7`: paper A's Figure 7 reproduced: the elasto-plastic bow on the waveguide
+//!   cello D string (147 Hz, Q 500, v_b 0.1 m/s, F_N 1.1 N, beta 0.1): string velocity at the
+//!   bow point (Helmholtz motion) and the friction coefficient against relative velocity
+//!   (the hysteresis loop).
+//! - `serafin-modal`: paper A's modal scenario (the authors' script): a 50 g bow pushed
+//!   into two 140/280 Hz modes: velocities, friction force, bristle state.
+
+use crate::dsp::friction::bristle::BristleParams;
+use crate::dsp::friction::FrictionModel;
+use crate::dsp::instrument::{BowControl, InstrumentKind};
+use crate::dsp::rubbed::{RubbedPreset, RubbedScene};
+use crate::render::{render, RenderSettings};
+use plotters::prelude::*;
+use plotters::style::{register_font, FontStyle};
+use std::path::Path;
+use std::sync::Once;
+
+const WIDTH: u32 = 1400;
+const HEIGHT: u32 = 560;
+
+fn fonts() {
+    static REGISTER: Once = Once::new();
+    REGISTER.call_once(|| {
+        // Only fails for invalid font data; the bundled font is valid.
+        let _ = register_font(
+            "sans-serif",
+            FontStyle::Normal,
+            epaint_default_fonts::UBUNTU_LIGHT,
+        );
+    });
+}
+
+/// Draws the figure called `name` to `out`.
+pub fn draw(name: &str, out: &Path) -> Result<String, String> {
+    match name {
+        "serafin-fig7" => serafin_fig7(out),
+        "serafin-modal" => serafin_modal(out),
+        other => Err(format!(
+            "unknown figure '{other}': choose serafin-fig7, serafin-modal or bridge-fit"
+        )),
+    }
+}
+
+fn err(e: impl std::fmt::Display) -> String {
+    e.to_string()
+}
+
+fn range(x: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = x.fold((f64::MAX, f64::MIN), |(a, b), v| (a.min(v), b.max(v)));
+    let pad = 0.05 * (hi - lo).max(1e-12);
+    (lo - pad, hi + pad)
+}
+
+/// Paper A, Figure 7.
+pub fn serafin_fig7(out: &Path) -> Result<String, String> {
+    fonts();
+    let fs = 48_000.0;
+    let settings = RenderSettings {
+        instrument: InstrumentKind::Cello,
+        note: 50,
+        seconds: 2.6,
+        bow: BowControl {
+            velocity_m_per_s: 0.1,
+            force_n: 1.1,
+            position_beta: 0.1,
+        },
+        sample_rate_hz: fs,
+        friction: FrictionModel::ElastoPlastic,
+        bristle: BristleParams::waveguide_string(),
+        ..RenderSettings::default()
+    };
+    let r = render(&settings).map_err(err)?;
+    let start = (1.5 * fs) as usize;
+    let shown = (4.0 * fs / 146.83) as usize; // four periods
+    let t: Vec<f64> = (0..shown).map(|i| 1e3 * i as f64 / fs).collect();
+    let v = &r.bow_point_velocity_m_per_s[start..start + shown];
+    let root = BitMapBackend::new(out, (WIDTH, HEIGHT)).into_drawing_area();
+    root.fill(&WHITE).map_err(err)?;
+    let root = root
+        .titled(
+            "Paper A, Fig. 7: elasto-plastic bow on the cello D string (v_b 0.1 m/s, F_N 1.1 N, beta 0.1)",
+            ("sans-serif", 22),
+        )
+        .map_err(err)?;
+    let (left, right) = root.split_horizontally(WIDTH / 2);
+    let (vlo, vhi) = range(v.iter().copied());
+    let mut chart = ChartBuilder::on(&left)
+        .margin(15)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .caption("String velocity at the bow", ("sans-serif", 18))
+        .build_cartesian_2d(0.0..t[shown - 1], vlo..vhi)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("time (ms)")
+        .y_desc("velocity (m/s)")
+        .draw()
+        .map_err(err)?;
+    chart
+        .draw_series(LineSeries::new(
+            t.iter().copied().zip(v.iter().copied()),
+            &BLUE,
+        ))
+        .map_err(err)?;
+
+    // Hysteresis: friction coefficient F / F_N against relative velocity v_b - v_s, over
+    // one second of steady bowing.
+    let pts: Vec<(f64, f64)> = r.bow_point_velocity_m_per_s[start..start + fs as usize]
+        .iter()
+        .zip(&r.friction_force_n[start..start + fs as usize])
+        .map(|(vs, f)| (0.1 - vs, f / 1.1))
+        .collect();
+    let (xlo, xhi) = range(pts.iter().map(|p| p.0));
+    let (ylo, yhi) = range(pts.iter().map(|p| p.1));
+    let mut chart = ChartBuilder::on(&right)
+        .margin(15)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .caption(
+            "Friction coefficient against relative velocity",
+            ("sans-serif", 18),
+        )
+        .build_cartesian_2d(xlo..xhi, ylo.min(0.0)..yhi)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("relative velocity v_b - v_s (m/s)")
+        .y_desc("F / F_N")
+        .draw()
+        .map_err(err)?;
+    chart
+        .draw_series(LineSeries::new(pts.iter().copied(), &RED.mix(0.6)))
+        .map_err(err)?;
+    root.present().map_err(err)?;
+    Ok(format!("wrote {}", out.display()))
+}
+
+/// Paper A's modal scenario.
+pub fn serafin_modal(out: &Path) -> Result<String, String> {
+    fonts();
+    let fs = 44_100.0;
+    let mut scene = RubbedScene::new(RubbedPreset::PaperModal, fs).map_err(err)?;
+    let n = (0.25 * fs) as usize;
+    let mut t = Vec::with_capacity(n);
+    let (mut vr, mut vb, mut f) = (Vec::new(), Vec::new(), Vec::new());
+    for i in 0..n {
+        let frame = scene.tick();
+        t.push(1e3 * i as f64 / fs);
+        vr.push(frame.contact.resonator_velocity_m_per_s);
+        vb.push(frame.contact.exciter_velocity_m_per_s);
+        f.push(frame.contact.friction_force_n);
+    }
+    let root = BitMapBackend::new(out, (WIDTH, HEIGHT)).into_drawing_area();
+    root.fill(&WHITE).map_err(err)?;
+    let root = root
+        .titled(
+            "Paper A, modal scenario: 50 g bow pushed to 0.5 m/s into 140/280 Hz modes (F_N 1 N)",
+            ("sans-serif", 22),
+        )
+        .map_err(err)?;
+    let (left, right) = root.split_horizontally(WIDTH / 2);
+    let (lo, hi) = range(vr.iter().chain(&vb).copied());
+    let mut chart = ChartBuilder::on(&left)
+        .margin(15)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .caption(
+            "Velocities: bow (green), resonator (blue)",
+            ("sans-serif", 18),
+        )
+        .build_cartesian_2d(0.0..t[n - 1], lo..hi)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("time (ms)")
+        .y_desc("velocity (m/s)")
+        .draw()
+        .map_err(err)?;
+    chart
+        .draw_series(LineSeries::new(
+            t.iter().copied().zip(vb.iter().copied()),
+            &GREEN,
+        ))
+        .map_err(err)?;
+    chart
+        .draw_series(LineSeries::new(
+            t.iter().copied().zip(vr.iter().copied()),
+            &BLUE,
+        ))
+        .map_err(err)?;
+    let (lo, hi) = range(f.iter().copied());
+    let mut chart = ChartBuilder::on(&right)
+        .margin(15)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .caption("Friction force", ("sans-serif", 18))
+        .build_cartesian_2d(0.0..t[n - 1], lo..hi)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("time (ms)")
+        .y_desc("force (N)")
+        .draw()
+        .map_err(err)?;
+    chart
+        .draw_series(LineSeries::new(
+            t.iter().copied().zip(f.iter().copied()),
+            &RED,
+        ))
+        .map_err(err)?;
+    root.present().map_err(err)?;
+    Ok(format!("wrote {}", out.display()))
+}
