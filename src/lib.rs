@@ -12,7 +12,16 @@ pub mod figures;
 pub mod params;
 pub mod render;
 
+use dsp::friction::FrictionModel;
 use dsp::instrument::{BowControl, Instrument, InstrumentKind, PITCH_BEND_SEMITONES};
+use dsp::rubbed::{RubbedInstrument, RubbedPreset};
+
+/// The bow settings at which a rubbed preset plays at its own velocity and force.
+const DEFAULT_BOW: BowControl = BowControl {
+    velocity_m_per_s: 0.1,
+    force_n: 1.0,
+    position_beta: 0.1,
+};
 use nice_plug::midi::Key;
 use nice_plug::prelude::*;
 use params::ColophonyParams;
@@ -21,6 +30,11 @@ use std::sync::Arc;
 pub struct Colophony {
     params: Arc<ColophonyParams>,
     instrument: Instrument,
+    rubbed: RubbedInstrument,
+    /// The rubbed preset in use, `None` while the strings are bowed.
+    resonator: Option<RubbedPreset>,
+    /// Held notes, so a resonator switch can move them to the new resonator.
+    held: [bool; 128],
 }
 
 impl Default for Colophony {
@@ -29,29 +43,82 @@ impl Default for Colophony {
         let kind: InstrumentKind = params.instrument.value().into();
         Self {
             instrument: Instrument::new(kind, 48_000.0),
+            rubbed: RubbedInstrument::new(48_000.0),
+            resonator: None,
+            held: [false; 128],
             params,
         }
     }
 }
 
 impl Colophony {
+    fn note_on(&mut self, note: u8) {
+        match self.resonator {
+            // Notes the instrument cannot play are ignored.
+            None => {
+                if self.instrument.note_on(note).is_some() {
+                    self.held[note as usize & 127] = true;
+                }
+            }
+            Some(_) => {
+                if !self.held[note as usize & 127] {
+                    self.held[note as usize & 127] = true;
+                    self.rubbed.note_on();
+                }
+            }
+        }
+    }
+
+    fn note_off(&mut self, note: u8) {
+        let was_held = std::mem::replace(&mut self.held[note as usize & 127], false);
+        match self.resonator {
+            None => self.instrument.note_off(note),
+            Some(_) if was_held => self.rubbed.note_off(),
+            Some(_) => {}
+        }
+    }
+
+    fn all_notes_off(&mut self) {
+        self.held = [false; 128];
+        self.instrument.all_notes_off();
+        self.rubbed.all_notes_off();
+    }
+
+    /// Applies the block's resonator choice: held notes move to the new resonator (its
+    /// bow lands over the usual ramp) and the old one rings on, so there is no click.
+    fn apply_resonator(&mut self, choice: Option<RubbedPreset>) {
+        if choice == self.resonator {
+            return;
+        }
+        let held = self.held;
+        self.instrument.all_notes_off();
+        self.rubbed.all_notes_off();
+        self.held = [false; 128];
+        self.resonator = choice;
+        if let Some(preset) = choice {
+            self.rubbed.set_preset(preset);
+        }
+        for (note, down) in held.iter().enumerate() {
+            if *down {
+                self.note_on(note as u8);
+            }
+        }
+    }
+
     fn handle_event(&mut self, event: NoteEvent<()>) {
         match event {
             NoteEvent::NoteOn {
                 key: Key::Number(note),
                 ..
-            } => {
-                // Notes the instrument cannot play are ignored.
-                let _ = self.instrument.note_on(note);
-            }
+            } => self.note_on(note),
             NoteEvent::NoteOff {
                 key: Key::Number(note),
                 ..
-            } => self.instrument.note_off(note),
+            } => self.note_off(note),
             NoteEvent::NoteOff {
                 key: Key::Wildcard, ..
             }
-            | NoteEvent::Choke { .. } => self.instrument.all_notes_off(),
+            | NoteEvent::Choke { .. } => self.all_notes_off(),
             NoteEvent::MidiPitchBend { value, .. } => self
                 .instrument
                 .set_pitch_bend((value as f64 - 0.5) * 2.0 * PITCH_BEND_SEMITONES),
@@ -93,12 +160,18 @@ impl Plugin for Colophony {
     ) -> bool {
         // Every buffer is sized here, never in `process`.
         let kind: InstrumentKind = self.params.instrument.value().into();
-        self.instrument = Instrument::new(kind, buffer_config.sample_rate as f64);
+        let fs = buffer_config.sample_rate as f64;
+        self.instrument = Instrument::new(kind, fs);
+        self.rubbed = RubbedInstrument::new(fs);
+        self.resonator = None;
+        self.held = [false; 128];
         true
     }
 
     fn reset(&mut self) {
         self.instrument.reset();
+        self.rubbed.reset();
+        self.held = [false; 128];
         let p = &self.params;
         p.bow_velocity.smoothed.reset(p.bow_velocity.value());
         p.bow_force.smoothed.reset(p.bow_force.value());
@@ -112,9 +185,14 @@ impl Plugin for Colophony {
         _aux: &mut AuxiliaryBuffers,
         context: &mut impl ProcessContext<Self>,
     ) -> ProcessStatus {
-        self.instrument
-            .set_kind(self.params.instrument.value().into());
+        let p = &self.params;
+        self.instrument.set_kind(p.instrument.value().into());
+        let friction: FrictionModel = p.friction_model.value().into();
+        self.instrument.set_friction_model(friction);
+        self.rubbed.set_friction_model(friction);
+        self.apply_resonator(p.resonator.value().preset());
         self.instrument.update_sleep();
+        self.rubbed.update_sleep();
         let mut next_event = context.next_event();
         for (sample, mut channels) in buffer.iter_samples().enumerate() {
             while let Some(event) = next_event {
@@ -131,7 +209,15 @@ impl Plugin for Colophony {
                 position_beta: p.bow_position.smoothed.next() as f64,
             };
             let gain = util::db_to_gain(p.gain.smoothed.next()) as f64;
-            let out = dsp::filters::flush_tiny(self.instrument.tick(bow).audio * gain) as f32;
+            // Both sources tick while they sound: the one just switched away from rings on.
+            let mut audio = self.instrument.tick(bow).audio;
+            if self.rubbed.is_sounding() {
+                audio += self.rubbed.tick(
+                    bow.velocity_m_per_s / DEFAULT_BOW.velocity_m_per_s,
+                    bow.force_n / DEFAULT_BOW.force_n,
+                );
+            }
+            let out = dsp::filters::flush_tiny(audio * gain) as f32;
             for s in channels.iter_mut() {
                 *s = out;
             }
@@ -141,7 +227,7 @@ impl Plugin for Colophony {
             self.handle_event(event);
             next_event = context.next_event();
         }
-        if self.instrument.is_sounding() {
+        if self.instrument.is_sounding() || self.rubbed.is_sounding() {
             ProcessStatus::KeepAlive
         } else {
             ProcessStatus::Normal

@@ -7,8 +7,12 @@
 //! | `bow_position` | Bow Position | beta | 0.02 .. 0.5 | 0.1 |
 //! | `instrument` | Instrument | - | violin, viola, cello | cello |
 //! | `gain` | Output Gain | dB | -40 .. 12 | 0 |
+//! | `friction_model` | Friction Model | - | hyperbolic, static (Stribeck), LuGre, elasto-plastic | hyperbolic |
+//! | `resonator` | Resonator | - | strings, paper A modal, door hinge, chalk, wine glass, brake squeal | strings |
 
+use crate::dsp::friction::FrictionModel;
 use crate::dsp::instrument::InstrumentKind;
+use crate::dsp::rubbed::RubbedPreset;
 use nice_plug::prelude::*;
 
 /// Smoothing time for the bow controls: short enough for sample-accurate gestures to
@@ -35,6 +39,68 @@ impl From<InstrumentChoice> for InstrumentKind {
     }
 }
 
+/// The friction law at the bow (paper A; paper B's thermal law joins later).
+#[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FrictionChoice {
+    #[id = "hyperbolic"]
+    Hyperbolic,
+    #[id = "static"]
+    #[name = "Static (Stribeck)"]
+    Static,
+    #[id = "lugre"]
+    #[name = "LuGre"]
+    LuGre,
+    #[id = "elasto-plastic"]
+    #[name = "Elasto-plastic"]
+    ElastoPlastic,
+}
+
+impl From<FrictionChoice> for FrictionModel {
+    fn from(choice: FrictionChoice) -> Self {
+        match choice {
+            FrictionChoice::Hyperbolic => FrictionModel::Hyperbolic,
+            FrictionChoice::Static => FrictionModel::Stribeck,
+            FrictionChoice::LuGre => FrictionModel::LuGre,
+            FrictionChoice::ElastoPlastic => FrictionModel::ElastoPlastic,
+        }
+    }
+}
+
+/// What the bow rubs: the instrument's strings, or a modal object (paper A §5.2 presets).
+#[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ResonatorChoice {
+    #[id = "strings"]
+    Strings,
+    #[id = "paper-modal"]
+    #[name = "Paper A modal"]
+    PaperModal,
+    #[id = "door-hinge"]
+    #[name = "Door hinge"]
+    DoorHinge,
+    #[id = "chalk"]
+    Chalk,
+    #[id = "wine-glass"]
+    #[name = "Wine glass"]
+    WineGlass,
+    #[id = "brake-squeal"]
+    #[name = "Brake squeal"]
+    BrakeSqueal,
+}
+
+impl ResonatorChoice {
+    /// The rubbed preset, or `None` for the strings.
+    pub fn preset(self) -> Option<RubbedPreset> {
+        match self {
+            ResonatorChoice::Strings => None,
+            ResonatorChoice::PaperModal => Some(RubbedPreset::PaperModal),
+            ResonatorChoice::DoorHinge => Some(RubbedPreset::DoorHinge),
+            ResonatorChoice::Chalk => Some(RubbedPreset::Chalk),
+            ResonatorChoice::WineGlass => Some(RubbedPreset::WineGlass),
+            ResonatorChoice::BrakeSqueal => Some(RubbedPreset::BrakeSqueal),
+        }
+    }
+}
+
 #[derive(Params)]
 pub struct ColophonyParams {
     #[id = "bow_velocity"]
@@ -47,6 +113,10 @@ pub struct ColophonyParams {
     pub instrument: EnumParam<InstrumentChoice>,
     #[id = "gain"]
     pub gain: FloatParam,
+    #[id = "friction_model"]
+    pub friction_model: EnumParam<FrictionChoice>,
+    #[id = "resonator"]
+    pub resonator: EnumParam<ResonatorChoice>,
 }
 
 pub fn bow_velocity_range() -> FloatRange {
@@ -100,6 +170,8 @@ impl Default for ColophonyParams {
             .with_unit(" dB")
             .with_value_to_string(formatters::v2s_f32_rounded(1))
             .with_smoother(SmoothingStyle::Linear(10.0)),
+            friction_model: EnumParam::new("Friction Model", FrictionChoice::Hyperbolic),
+            resonator: EnumParam::new("Resonator", ResonatorChoice::Strings),
         }
     }
 }

@@ -525,3 +525,50 @@ fn every_parameter_survives_a_value_text_value_round_trip() {
         );
     }
 }
+
+#[test]
+fn friction_model_and_resonator_switch_during_notes_without_allocation_nan_or_click() {
+    let mut plugin = active_plugin(FS, BLOCK);
+    let switch_at = [12_001u64, 24_007, 36_011, 48_013, 60_017, 72_019, 84_023];
+    let events = [
+        plugin.text("Friction Model", "Elasto-plastic"),
+        plugin.text("Friction Model", "LuGre"),
+        plugin.text("Friction Model", "Static (Stribeck)"),
+        plugin.text("Resonator", "Wine glass"),
+        plugin.text("Friction Model", "Elasto-plastic"),
+        plugin.text("Resonator", "Door hinge"),
+        plugin.text("Resonator", "Strings"),
+    ];
+    let mut score = Score::new().at(0, Event::note_on(50));
+    for (at, event) in switch_at.iter().zip(events) {
+        score.push(*at, event);
+    }
+    score.push(96_000, Event::note_off(50));
+    let out = plugin.render(108_000, BLOCK, &score);
+    write_wav("friction-and-resonator-switches", FS, &out);
+    let x = channel_f64(&out, 0);
+    assert!(x.iter().all(|v| v.is_finite()));
+    let peak = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    // Largest sample-to-sample step right at each switch against the largest anywhere in
+    // the 10 ms before it (the waveform's own corners).
+    for at in switch_at {
+        let at = at as usize;
+        let step = |r: std::ops::Range<usize>| {
+            x[r].windows(2)
+                .map(|w| (w[1] - w[0]).abs())
+                .fold(0.0f64, f64::max)
+        };
+        let at_switch = step(at - 1..at + 3);
+        let before = step(at - 480..at - 1);
+        println!(
+            "switch at {at}: step {at_switch:.4}, largest step in the 10 ms before {before:.4}"
+        );
+        // 1.5x: a step no larger than the waveform's own corners is not a click.
+        assert!(at_switch <= 1.5 * before.max(1e-4), "click at sample {at}");
+    }
+    println!("peak {peak:.3}");
+    assert!(peak < 1.0, "peak {peak}");
+    for (from, to) in [(12_000, 24_000), (48_100, 60_000), (72_100, 84_000)] {
+        assert!(rms(&x[from..to]) > 1e-3, "silent between {from} and {to}");
+    }
+}

@@ -8,6 +8,14 @@
 //! friction parameters start from the Sound Design Toolkit's rubbing preset
 //! (PARAMETERS.md §1.1, §1.7) and are adjusted so each preset locks into stick-slip.
 //!
+//! **Why each preset sings.** Steady sliding at velocity `v` is unstable, so the object
+//! self-excites even when the exciter lands gently, when the friction force falls with
+//! speed faster than the mode's damping: `-F_N dmu/dv > r = 2 pi f m / Q`. With the
+//! Stribeck curve the fall is steepest at `v = v_s / sqrt(2)`, so each preset rubs at a
+//! velocity below `v_s`, where `-F_N dmu/dv` exceeds the first mode's `r` (door hinge
+//! 12 against 0.7 kg/s, chalk 10 against 3.5, wine glass 3 against 0.007, brake 8.5 against
+//! 4.8).
+//!
 //! ```
 //! use colophony::dsp::rubbed::{RubbedPreset, RubbedScene};
 //! let mut scene = RubbedScene::new(RubbedPreset::WineGlass, 48_000.0).unwrap();
@@ -100,10 +108,10 @@ impl RubbedPreset {
                 },
                 velocity_m_per_s: 0.02,
                 normal_force_n: 4.0,
-                output_gain: 30.0,
+                output_gain: 18.0,
             },
             // Chalk on a slate board: plate modes from 1.1 to 4.3 kHz, Q 30-60, 20 g modal
-            // masses; the chalk a velocity source at 0.2 m/s under 3 N; chalky friction
+            // masses (a stiff chalk contact: sigma0 1e6 N/m, sigma1 0.1 kg/s); the chalk a velocity source at 0.14 m/s under 6 N; chalky friction
             // mu_s 0.7, mu_d 0.3 with a broad Stribeck drop (0.2 m/s), so the friction still
             // falls with speed at the drawing speed.
             RubbedPreset::Chalk => RubbedSpec {
@@ -115,23 +123,22 @@ impl RubbedPreset {
                 ],
                 exciter: None,
                 bristle: BristleParams {
-                    sigma0_n_per_m: 1e5,
-                    sigma1_kg_per_s: 1.0,
+                    sigma0_n_per_m: 1e6,
+                    sigma1_kg_per_s: 0.1,
                     sigma2_kg_per_s: 0.0,
                     stribeck_m_per_s: 0.2,
                     mu_s: 0.7,
                     mu_d: 0.3,
                     breakaway_ratio: 0.7,
                 },
-                velocity_m_per_s: 0.2,
-                normal_force_n: 3.0,
-                output_gain: 5.0,
+                velocity_m_per_s: 0.14,
+                normal_force_n: 6.0,
+                output_gain: 3.5,
             },
             // A wine glass rubbed at the rim by a wet finger: bell modes (2,0) 660 Hz,
             // (3,0) 1780 Hz, (4,0) 3340 Hz (ratios of a thin-walled glass), Q 1500-3000
             // (glass rings for seconds), 5 g modal masses; the finger a velocity source at
-            // 8 cm/s under 1 N; wet skin on glass: mu_s 0.6, mu_d 0.25, low Stribeck
-            // velocity.
+            // 7 cm/s under 1 N; wet skin on glass: mu_s 0.6, mu_d 0.25, v_s 0.1 m/s.
             RubbedPreset::WineGlass => RubbedSpec {
                 resonator: vec![
                     mode(660.0, 3000.0, 0.005),
@@ -143,18 +150,18 @@ impl RubbedPreset {
                     sigma0_n_per_m: 5e4,
                     sigma1_kg_per_s: 0.5,
                     sigma2_kg_per_s: 0.0,
-                    stribeck_m_per_s: 0.02,
+                    stribeck_m_per_s: 0.1,
                     mu_s: 0.6,
                     mu_d: 0.25,
                     breakaway_ratio: 0.7,
                 },
-                velocity_m_per_s: 0.08,
+                velocity_m_per_s: 0.07,
                 normal_force_n: 1.0,
-                output_gain: 20.0,
+                output_gain: 5.0,
             },
             // Brake squeal: out-of-plane disc modes 1.9, 3.6, 5.8 kHz, Q 300-500, 0.2 kg
-            // modal masses; the pad a velocity source at 0.8 m/s sliding speed under 40 N;
-            // pad on cast iron: mu_s 0.55, mu_d 0.4, falling over 1 m/s.
+            // modal masses; the pad a velocity source at 0.45 m/s sliding speed under 40 N;
+            // pad on cast iron: mu_s 0.55, mu_d 0.4, falling over 0.6 m/s.
             RubbedPreset::BrakeSqueal => RubbedSpec {
                 resonator: vec![
                     mode(1900.0, 500.0, 0.2),
@@ -166,14 +173,14 @@ impl RubbedPreset {
                     sigma0_n_per_m: 1e6,
                     sigma1_kg_per_s: 5.0,
                     sigma2_kg_per_s: 0.0,
-                    stribeck_m_per_s: 1.0,
+                    stribeck_m_per_s: 0.6,
                     mu_s: 0.55,
                     mu_d: 0.4,
                     breakaway_ratio: 0.7,
                 },
-                velocity_m_per_s: 0.8,
+                velocity_m_per_s: 0.45,
                 normal_force_n: 40.0,
-                output_gain: 40.0,
+                output_gain: 1.5,
             },
         }
     }
@@ -278,8 +285,155 @@ impl RubbedScene {
         }
     }
 
-    /// Resonator plus exciter modal energy, J.
+    pub fn reset(&mut self) {
+        self.pair.reset();
+        self.contact.reset();
+    }
+
+    /// Resonator modal energy, J.
     pub fn resonator_energy_j(&self) -> f64 {
         self.pair.resonator.energy_j()
+    }
+}
+
+/// Bow landing/lifting time on a rubbed object, s (as on the strings).
+const RUB_RAMP_S: f64 = 0.02;
+/// Below this modal energy (J) with the exciter lifted, a rubbed object is silent.
+const RUB_SLEEP_ENERGY_J: f64 = 1e-16;
+
+/// The rubbed presets as a playable instrument: note on presses the exciter onto the
+/// active object (force ramps over 20 ms), note off lifts it and the object rings on. The
+/// bow controls scale the preset's own velocity and force: 1.0 at the plugin's defaults
+/// (0.1 m/s, 1 N); a modal exciter (paper-modal) keeps its own push. Every preset is built
+/// when the instrument is made, so switching never allocates; an object switched away from
+/// is lifted and rings on (no click) until it falls asleep.
+#[derive(Debug, Clone)]
+pub struct RubbedInstrument {
+    voices: Vec<RubbedVoice>,
+    active: usize,
+    notes_down: u32,
+    ramp_step: f64,
+}
+
+#[derive(Debug, Clone)]
+struct RubbedVoice {
+    scene: RubbedScene,
+    bow_gain: f64,
+    awake: bool,
+}
+
+impl RubbedInstrument {
+    pub fn new(sample_rate_hz: f64) -> Self {
+        let voices = RubbedPreset::ALL
+            .iter()
+            .map(|p| RubbedVoice {
+                scene: RubbedScene::new(*p, sample_rate_hz).expect("built-in presets are valid"),
+                bow_gain: 0.0,
+                awake: false,
+            })
+            .collect();
+        Self {
+            voices,
+            active: 1,
+            notes_down: 0,
+            ramp_step: 1.0 / (RUB_RAMP_S * sample_rate_hz),
+        }
+    }
+
+    pub fn preset(&self) -> RubbedPreset {
+        RubbedPreset::ALL[self.active]
+    }
+
+    /// Switches the object that receives the notes. Held notes stay held: the exciter
+    /// lifts off the old object and lands on the new one.
+    pub fn set_preset(&mut self, preset: RubbedPreset) {
+        let index = RubbedPreset::ALL
+            .iter()
+            .position(|p| *p == preset)
+            .unwrap_or(0);
+        if index != self.active {
+            self.active = index;
+            if self.notes_down > 0 {
+                self.voices[index].awake = true;
+            }
+        }
+    }
+
+    pub fn set_friction_model(&mut self, model: FrictionModel) {
+        for voice in &mut self.voices {
+            voice.scene.set_friction_model(model);
+        }
+    }
+
+    pub fn note_on(&mut self) {
+        self.notes_down += 1;
+        self.voices[self.active].awake = true;
+    }
+
+    pub fn note_off(&mut self) {
+        self.notes_down = self.notes_down.saturating_sub(1);
+    }
+
+    pub fn all_notes_off(&mut self) {
+        self.notes_down = 0;
+    }
+
+    pub fn is_bowed(&self) -> bool {
+        self.notes_down > 0
+    }
+
+    pub fn is_sounding(&self) -> bool {
+        self.voices.iter().any(|v| v.awake)
+    }
+
+    pub fn reset(&mut self) {
+        for voice in &mut self.voices {
+            voice.scene.reset();
+            voice.bow_gain = 0.0;
+            voice.awake = false;
+        }
+        self.notes_down = 0;
+    }
+
+    /// Once per block: an object sleeps when lifted and quiet.
+    pub fn update_sleep(&mut self) {
+        for (i, voice) in self.voices.iter_mut().enumerate() {
+            let bowed = i == self.active && self.notes_down > 0;
+            if voice.awake
+                && !bowed
+                && voice.bow_gain == 0.0
+                && voice.scene.resonator_energy_j() < RUB_SLEEP_ENERGY_J
+            {
+                voice.scene.reset();
+                voice.awake = false;
+            }
+        }
+    }
+
+    /// One sample; `velocity_scale` and `force_scale` multiply the preset's own values.
+    pub fn tick(&mut self, velocity_scale: f64, force_scale: f64) -> f64 {
+        let mut audio = 0.0;
+        for (i, voice) in self.voices.iter_mut().enumerate() {
+            if !voice.awake {
+                continue;
+            }
+            let target = if i == self.active && self.notes_down > 0 {
+                1.0
+            } else {
+                0.0
+            };
+            if voice.bow_gain < target {
+                voice.bow_gain = (voice.bow_gain + self.ramp_step).min(1.0);
+            } else if voice.bow_gain > target {
+                voice.bow_gain = (voice.bow_gain - self.ramp_step).max(0.0);
+            }
+            let spec = &voice.scene.spec;
+            let bow = BowInput {
+                velocity_m_per_s: spec.velocity_m_per_s * velocity_scale,
+                normal_force_n: spec.normal_force_n * (force_scale * voice.bow_gain).max(0.0),
+            };
+            audio += voice.scene.tick_with(bow).audio;
+        }
+        audio
     }
 }
