@@ -7,6 +7,7 @@
 
 pub mod admittance_fit;
 pub mod analysis;
+pub mod bench;
 pub mod dsp;
 pub mod figures;
 pub mod params;

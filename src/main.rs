@@ -72,6 +72,9 @@ enum Command {
         #[arg(long)]
         fit: Option<PathBuf>,
     },
+    /// Print real-time ratios (run a release build): `friction` times 10 s of cello D at
+    /// 48 kHz with each friction law.
+    Bench { what: String },
     /// Fit a passive modal bridge admittance to measured data (CSV in, JSON out).
     FitBridge {
         input: PathBuf,
@@ -188,6 +191,10 @@ fn main() -> ExitCode {
                 _ => Err("bridge-fit needs --in DATA.csv and --fit FIT.json".into()),
             },
             other => colophony::figures::draw(other, &out),
+        }),
+        Command::Bench { what } => report(match what.as_str() {
+            "friction" => colophony::bench::friction_table(),
+            other => Err(format!("unknown bench '{other}': choose friction")),
         }),
         Command::FitBridge { input, modes, out } => {
             report(colophony::admittance_fit::run_cli(&input, modes, &out))

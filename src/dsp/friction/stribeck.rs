@@ -59,7 +59,8 @@ impl StribeckFriction {
             let lo = abs_free * k as f64 / SCAN_CELLS as f64;
             if q(lo) <= 0.0 {
                 let (mut a, mut b) = (lo, hi);
-                for _ in 0..80 {
+                // Bisect to 1e-12 relative (about 40 halvings of a grid cell).
+                while b - a > 1e-12 * b {
                     let mid = 0.5 * (a + b);
                     if mid == a || mid == b {
                         break;
