@@ -21,6 +21,7 @@
 use clack_extensions::audio_ports::{AudioPortInfoBuffer, PluginAudioPorts};
 use clack_extensions::note_ports::{NoteDialects, NotePortInfoBuffer, PluginNotePorts};
 use clack_extensions::params::{ParamInfoBuffer, PluginParams};
+use clack_extensions::state::PluginState;
 use clack_host::events::event_types::{MidiEvent, NoteOffEvent, NoteOnEvent, ParamValueEvent};
 use clack_host::events::Match;
 use clack_host::prelude::*;
@@ -314,6 +315,27 @@ impl HostedPlugin {
             .get_extension::<PluginParams>()
             .expect("no params extension");
         ext.get_value(&handle, id).expect("get_value failed")
+    }
+
+    /// The plugin's saved state (CLAP state extension).
+    pub fn save_state(&mut self) -> Vec<u8> {
+        let handle = self.instance.plugin_handle();
+        let ext = handle
+            .get_extension::<PluginState>()
+            .expect("no state extension");
+        let mut bytes = Vec::new();
+        ext.save(&handle, &mut bytes).expect("saving state failed");
+        bytes
+    }
+
+    /// Loads a saved state; `Err` if the plugin refuses it.
+    pub fn load_state(&mut self, bytes: &[u8]) -> Result<(), String> {
+        let handle = self.instance.plugin_handle();
+        let ext = handle
+            .get_extension::<PluginState>()
+            .expect("no state extension");
+        let mut reader = bytes;
+        ext.load(&handle, &mut reader).map_err(|e| format!("{e:?}"))
     }
 
     /// A parameter change to the plain value `plain` in the parameter's own unit (0.5 for
