@@ -8,4 +8,5 @@ pub mod friction;
 pub mod instrument;
 pub mod modal;
 pub mod rubbed;
+pub mod thermal;
 pub mod waveguide;

@@ -1,0 +1,654 @@
+//! Paper B (Maestre, Spa and Smith, "A bowed string physical model including finite-width
+//! thermal friction and hair dynamics"; MODELS.md §B): a bow of `N_B` hair nodes across its
+//! width `w` on a string with two transverse polarisations, run at the internal rate
+//! `fs = c / dx` (`dx = w / N_B`) so that the waveguide segments between nodes are one
+//! sample long.
+//!
+//! **Horizontal plane, per node** (eqs. 3-8): load line `v_s = v_s^p + F / (2 Z)`, hair as a
+//! massless spring-dashpot by the trapezoid rule, `v_h = -a F + b` with
+//! `a = 1 / (c_h + k_h T / 2)`, `b = -a k_h (x_h + T v_h / 2)` from the previous sample.
+//! Sticking means `v_s = v_b + v_h`, so the sticking force is
+//! `F_stick = (v_b + b - v_s^p) / (1 / (2Z) + a)`; the node sticks if
+//! `|F_stick| <= mu(T) F_N`, else it slips with `F = sgn(F_stick) mu(T) F_N`. Friction does
+//! not depend on velocity, so the crossing is unique: no iteration, no hysteresis rule
+//! (hysteresis comes from the temperature). `F` is the force of the bow on the string,
+//! positive along the bow's motion.
+//!
+//! **Thermal friction** (eq. 1): `dT/dt = alpha d2T/dx2 - C_C T |v_D| + C_H |f v_D|` on a grid
+//! of spacing `dx` covering the bow plus a margin each side, `T = 0` beyond it, with `f`
+//! the friction force per unit length (`F / dx`). Forward Euler in time, centred in space:
+//! stable only if `alpha dt / dx^2 < 1/2` (eq. 2). Every change of the grid checks it and
+//! sub-steps the update (`ceil(r / 0.45)` steps of `dt / n`), so it never runs unstable.
+//! `mu(T)` is piecewise linear: `mu_cold` below `T_cold`, `mu_hot` above `T_hot`.
+//!
+//! **Vertical plane, per node** (eqs. 9-10): a lumped junction loaded by the hair's vertical
+//! admittance, a mass on a parallel spring-dashpot discretised by the trapezoid rule. The
+//! dynamic hair force `F_h^y` adds to the player's force: `F_N = F_b + F_h^y` (clamped at
+//! zero: the string can leave the hair), which couples the planes.
+//!
+//! **Terminations.** At each end the two polarisations reflect through a real 2x2
+//! admittance `Y` (nut) or `Y` plus a one-pole loss per polarisation (bridge):
+//! `R = -(I + Z Y)^-1 (I - Z Y)`, passive for any PSD `Y`. The four-string modal bridge of
+//! paper B is not in this struct (see the issue notes).
+//!
+//! Values paper B does not publish are chosen here and justified in
+//! [`ThermalParams::default`] and [`HairParams::default`].
+//!
+//! | symbol | meaning | unit |
+//! |---|---|---|
+//! | `N_B`, `w`, `dx` | nodes, bow width, node spacing `w / N_B` | 1, m, m |
+//! | `Z` | string impedance | kg/s |
+//! | `k_h`, `c_h` | hair stiffness and damping per metre of ribbon | N/m/m, kg/s/m |
+//! | `m_y`, `k_y`, `c_y` | hair vertical mass, stiffness, damping per metre | kg/m, N/m/m, kg/s/m |
+//! | `alpha` | thermal diffusivity | m^2/s |
+//! | `C_C` | convective loss per metre slid | 1/m |
+//! | `C_H` | heating per unit frictional power per length | K m/J |
+//! | `F_b` | bow force per unit length | N/m |
+
+use super::filters::{flush_tiny, Allpass1, OnePoleLoss};
+use std::f64::consts::PI;
+
+/// Largest `alpha dt / dx^2` used per thermal sub-step (the bound is 1/2).
+pub const FTCS_TARGET: f64 = 0.45;
+/// Most thermal sub-steps per sample before a configuration is refused.
+pub const MAX_THERMAL_SUBSTEPS: usize = 64;
+
+/// Temperature-dependent friction and heat (see the module doc).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ThermalParams {
+    pub mu_cold: f64,
+    pub mu_hot: f64,
+    pub t_cold_kelvin: f64,
+    pub t_hot_kelvin: f64,
+    pub diffusivity_m2_per_s: f64,
+    pub c_c_per_m: f64,
+    pub c_h_kelvin_m_per_j: f64,
+    /// Grid margin beyond each edge of the bow, m.
+    pub margin_m: f64,
+}
+
+impl Default for ThermalParams {
+    /// Paper B publishes none of these (PARAMETERS.md §1.3: [NF]); chosen so that:
+    /// - the equilibrium temperature of steady sliding, `T_eq = C_H f / C_C`, is
+    ///   `250 * 0.4 * 300 / 2000 = 15 K` at paper B's 300 N/m, inside the 10-25 K swing
+    ///   reported for rosin (van Walstijn et al., PARAMETERS.md §1.3), and independent of
+    ///   the sliding speed;
+    /// - a slip of ~1 ms at ~0.5 m/s relaxes toward it (`C_C |v| ~ 1000 /s`);
+    /// - diffusion cools the contact within about a period of a low string: with
+    ///   `alpha = 4e-3 m^2/s` over the 1.4 cm grid, `tau = L^2 / (pi^2 alpha) ~ 5 ms`. This is
+    ///   an equivalent diffusivity (heat also leaves into the string core and the air,
+    ///   which eq. 1 does not model), far above steel's 1.2e-5;
+    /// - `mu` falls from 0.8 when cool to 0.3 when hot (the spread of measured static and
+    ///   sliding rosin friction), over 2-14 K.
+    fn default() -> Self {
+        Self {
+            mu_cold: 0.8,
+            mu_hot: 0.3,
+            t_cold_kelvin: 2.0,
+            t_hot_kelvin: 14.0,
+            diffusivity_m2_per_s: 4e-3,
+            c_c_per_m: 2000.0,
+            c_h_kelvin_m_per_j: 250.0,
+            margin_m: 2e-3,
+        }
+    }
+}
+
+impl ThermalParams {
+    /// Piecewise-linear `mu(T)` (paper B, Figure 2).
+    #[inline]
+    pub fn mu(&self, t_kelvin: f64) -> f64 {
+        let u = ((t_kelvin - self.t_cold_kelvin) / (self.t_hot_kelvin - self.t_cold_kelvin))
+            .clamp(0.0, 1.0);
+        self.mu_cold + (self.mu_hot - self.mu_cold) * u
+    }
+
+    pub fn validate(&self) -> Result<(), String> {
+        let all = [
+            self.mu_cold,
+            self.mu_hot,
+            self.t_cold_kelvin,
+            self.t_hot_kelvin,
+            self.diffusivity_m2_per_s,
+            self.c_c_per_m,
+            self.c_h_kelvin_m_per_j,
+            self.margin_m,
+        ];
+        if all.iter().any(|x| !x.is_finite()) {
+            return Err("thermal parameters must be finite".into());
+        }
+        if !(self.mu_cold >= 0.0 && self.mu_hot >= 0.0) {
+            return Err("friction coefficients must be non-negative".into());
+        }
+        if !(self.t_hot_kelvin > self.t_cold_kelvin) {
+            return Err("need T_hot > T_cold".into());
+        }
+        if !(self.diffusivity_m2_per_s > 0.0
+            && self.c_c_per_m >= 0.0
+            && self.c_h_kelvin_m_per_j >= 0.0)
+        {
+            return Err("need alpha > 0, C_C >= 0, C_H >= 0".into());
+        }
+        if !(self.margin_m >= 0.0) {
+            return Err("the grid margin must be non-negative".into());
+        }
+        Ok(())
+    }
+}
+
+/// Hair per metre of ribbon (divided among the nodes).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HairParams {
+    pub k_n_per_m_per_m: f64,
+    pub c_kg_per_s_per_m: f64,
+    pub vertical_mass_kg_per_m: f64,
+    pub vertical_k_n_per_m_per_m: f64,
+    pub vertical_c_kg_per_s_per_m: f64,
+}
+
+impl Default for HairParams {
+    /// Horizontal: the lumped ribbon of Matusiak's code (k 4.83e4 N/m, d 5.77 kg/s over
+    /// 1 cm; PARAMETERS.md §1.5) per metre. Vertical: [NF] in paper B; a ribbon of ~50
+    /// active hairs (0.1 g/m each, so 5 g/m) on the bow's vertical stiffness, chosen at the
+    /// same per-metre stiffness and damping as the horizontal hair.
+    fn default() -> Self {
+        Self {
+            k_n_per_m_per_m: 4.83e4 / 0.01,
+            c_kg_per_s_per_m: 5.77 / 0.01,
+            vertical_mass_kg_per_m: 5e-3,
+            vertical_k_n_per_m_per_m: 4.83e4 / 0.01,
+            vertical_c_kg_per_s_per_m: 5.77 / 0.01,
+        }
+    }
+}
+
+/// One string with a finite-width thermal bow.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ThermalStringSpec {
+    pub f0_hz: f64,
+    pub z0_kg_per_s: f64,
+    pub length_m: f64,
+    /// Quality factor of the fundamental (loss at the bridge).
+    pub q1: f64,
+    /// Nut admittance (real, PSD), s/kg, [[hh, hv], [hv, vv]].
+    pub nut_admittance: [[f64; 2]; 2],
+    /// Bridge admittance (real, PSD), s/kg.
+    pub bridge_admittance: [[f64; 2]; 2],
+}
+
+impl ThermalStringSpec {
+    /// Cello open C (PARAMETERS.md §1.7: Z0 ~ 1.85-1.91 kg/s, L 0.67-0.69 m).
+    pub fn cello_c() -> Self {
+        Self {
+            f0_hz: 65.41,
+            z0_kg_per_s: 1.88,
+            length_m: 0.69,
+            q1: 500.0,
+            // Small resistive terminations with polarisation coupling (eigenvalues > 0).
+            nut_admittance: [[2e-3, 5e-4], [5e-4, 3e-3]],
+            bridge_admittance: [[1e-2, 3e-3], [3e-3, 2e-2]],
+        }
+    }
+}
+
+/// The player's bow on a thermal string.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ThermalBowControl {
+    pub velocity_m_per_s: f64,
+    /// Bow force per unit length, N/m (paper B's 300 N/m over 1 cm is 3 N).
+    pub force_per_m: f64,
+    /// Bow centre from the bridge over the string length.
+    pub position_beta: f64,
+}
+
+/// Per-sample signals of the middle node and the contact (for figures and tests).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ThermalFrame {
+    /// Horizontal force on the bridge, N (the audio source).
+    pub bridge_force_n: f64,
+    /// Horizontal string velocity at the bow's middle node, m/s.
+    pub string_velocity_m_per_s: f64,
+    /// Total friction force over the bow, N.
+    pub friction_force_n: f64,
+    /// Total normal force over the bow, N (effective bow force).
+    pub normal_force_n: f64,
+    /// Hair horizontal velocity at the middle node, m/s.
+    pub hair_velocity_m_per_s: f64,
+    /// Nodes slipping this sample.
+    pub slipping_nodes: usize,
+}
+
+/// Structure-of-arrays state of the contact nodes.
+#[derive(Debug, Clone, Default)]
+struct Nodes {
+    hair_x: Vec<f64>,
+    hair_v: Vec<f64>,
+    vy: Vec<f64>,
+    y: Vec<f64>,
+    fy: Vec<f64>,
+    force: Vec<f64>,
+    v_delta: Vec<f64>,
+    slipping: Vec<bool>,
+}
+
+/// A string with a finite-width thermal bow (see the module doc).
+#[derive(Debug, Clone)]
+pub struct ThermalString {
+    spec: ThermalStringSpec,
+    thermal: ThermalParams,
+    hair: HairParams,
+    nodes_count: usize,
+    width_m: f64,
+    dx_m: f64,
+    internal_rate_hz: f64,
+    /// Samples along the string (bridge at 0, nut at m - 1).
+    m: usize,
+    /// Position index of the first (bridge-side) bow node.
+    bow_start: usize,
+    /// Delay lines per polarisation: `[h, v]`.
+    right: [Vec<f64>; 2],
+    left: [Vec<f64>; 2],
+    t: usize,
+    nodes: Nodes,
+    /// Temperature grid: margin, bow nodes, margin.
+    temperature: Vec<f64>,
+    temperature_next: Vec<f64>,
+    margin_nodes: usize,
+    substeps: usize,
+    loss: [OnePoleLoss; 2],
+    /// Thiran fractional delay at the nut, per polarisation (tuning).
+    fraction: [Allpass1; 2],
+    nut_reflection: [[f64; 2]; 2],
+    bridge_reflection: [[f64; 2]; 2],
+}
+
+/// `R = -(I + Z Y)^-1 (I - Z Y)` for a real 2x2 `Y`.
+fn reflection(z: f64, y: [[f64; 2]; 2]) -> [[f64; 2]; 2] {
+    let a = [
+        [1.0 + z * y[0][0], z * y[0][1]],
+        [z * y[1][0], 1.0 + z * y[1][1]],
+    ];
+    let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+    let inv = [
+        [a[1][1] / det, -a[0][1] / det],
+        [-a[1][0] / det, a[0][0] / det],
+    ];
+    let b = [
+        [1.0 - z * y[0][0], -z * y[0][1]],
+        [-z * y[1][0], 1.0 - z * y[1][1]],
+    ];
+    let mut r = [[0.0; 2]; 2];
+    for i in 0..2 {
+        for j in 0..2 {
+            r[i][j] = -(inv[i][0] * b[0][j] + inv[i][1] * b[1][j]);
+        }
+    }
+    r
+}
+
+fn check_psd(name: &str, y: [[f64; 2]; 2]) -> Result<(), String> {
+    let ok = y.iter().flatten().all(|v| v.is_finite())
+        && (y[0][1] - y[1][0]).abs() <= 1e-12 * (y[0][1].abs() + 1e-30)
+        && y[0][0] >= 0.0
+        && y[1][1] >= 0.0
+        && y[0][0] * y[1][1] >= y[0][1] * y[0][1];
+    if ok {
+        Ok(())
+    } else {
+        Err(format!(
+            "the {name} admittance must be a finite symmetric PSD matrix, got {y:?}"
+        ))
+    }
+}
+
+impl ThermalString {
+    /// Builds the string with `nodes` bow nodes over `width_m`. Errors name the bad value.
+    pub fn new(
+        spec: ThermalStringSpec,
+        nodes: usize,
+        width_m: f64,
+        thermal: ThermalParams,
+        hair: HairParams,
+    ) -> Result<Self, String> {
+        thermal.validate()?;
+        check_psd("nut", spec.nut_admittance)?;
+        check_psd("bridge", spec.bridge_admittance)?;
+        if !(1..=200).contains(&nodes) {
+            return Err(format!("the node count must be 1..=200, got {nodes}"));
+        }
+        if !(width_m.is_finite() && (1e-4..=0.03).contains(&width_m)) {
+            return Err(format!("the bow width must be 0.1..30 mm, got {width_m} m"));
+        }
+        if !(spec.f0_hz > 0.0 && spec.z0_kg_per_s > 0.0 && spec.length_m > 0.0 && spec.q1 > 0.0) {
+            return Err("string frequency, impedance, length and Q must be positive".into());
+        }
+        let dx = width_m / nodes as f64;
+        let c = 2.0 * spec.length_m * spec.f0_hz;
+        let fs = c / dx;
+        let w1 = 2.0 * PI * spec.f0_hz / fs;
+        let w2 = (20.0 * w1).min(0.4 * PI);
+        // Per round trip: the fundamental decays at Q1, twenty times the frequency at Q1/2.
+        let g1 = (-PI / spec.q1).exp();
+        let g2 = (-PI * (w2 / w1) / (0.5 * spec.q1)).exp();
+        let loss = OnePoleLoss::fit(w1, g1, w2, g2);
+        // Tuning: 2 m + d = fs / f0 - loss delay, with a Thiran delay d in [0.5, 2.5).
+        let remainder = fs / spec.f0_hz - loss.phase_delay(w1);
+        let m = ((remainder - 0.5) / 2.0).floor().max(0.0) as usize;
+        if m < nodes + 4 {
+            return Err("the bow is wider than the string".into());
+        }
+        let fraction = Allpass1::new(Allpass1::coefficient_for_delay(
+            remainder - 2.0 * m as f64,
+            w1,
+        ));
+        let margin_nodes = (thermal.margin_m / dx).round() as usize;
+        let dt = 1.0 / fs;
+        let r = thermal.diffusivity_m2_per_s * dt / (dx * dx);
+        let substeps = (r / FTCS_TARGET).ceil().max(1.0) as usize;
+        if substeps > MAX_THERMAL_SUBSTEPS {
+            return Err(format!(
+                "thermal grid too fine: alpha dt / dx^2 = {r:.3} needs {substeps} sub-steps \
+                 (at most {MAX_THERMAL_SUBSTEPS}); use fewer nodes or a lower diffusivity"
+            ));
+        }
+        let grid = nodes + 2 * margin_nodes;
+        let zeros = |n: usize| vec![0.0; n];
+        Ok(Self {
+            spec,
+            thermal,
+            hair,
+            nodes_count: nodes,
+            width_m,
+            dx_m: dx,
+            internal_rate_hz: fs,
+            m,
+            bow_start: 0,
+            right: [zeros(m + 1), zeros(m + 1)],
+            left: [zeros(m + 1), zeros(m + 1)],
+            t: 0,
+            nodes: Nodes {
+                hair_x: zeros(nodes),
+                hair_v: zeros(nodes),
+                vy: zeros(nodes),
+                y: zeros(nodes),
+                fy: zeros(nodes),
+                force: zeros(nodes),
+                v_delta: zeros(nodes),
+                slipping: vec![false; nodes],
+            },
+            temperature: zeros(grid),
+            temperature_next: zeros(grid),
+            margin_nodes,
+            substeps,
+            loss: [loss, loss],
+            fraction: [fraction, fraction],
+            nut_reflection: reflection(spec.z0_kg_per_s, spec.nut_admittance),
+            bridge_reflection: reflection(spec.z0_kg_per_s, spec.bridge_admittance),
+        })
+    }
+
+    pub fn internal_rate_hz(&self) -> f64 {
+        self.internal_rate_hz
+    }
+
+    pub fn nodes(&self) -> usize {
+        self.nodes_count
+    }
+
+    pub fn width_m(&self) -> f64 {
+        self.width_m
+    }
+
+    /// Thermal sub-steps per sample chosen from the FTCS bound.
+    pub fn thermal_substeps(&self) -> usize {
+        self.substeps
+    }
+
+    /// `alpha dt / dx^2` per sub-step (always below 1/2).
+    pub fn ftcs_ratio(&self) -> f64 {
+        self.thermal.diffusivity_m2_per_s
+            / (self.internal_rate_hz * self.substeps as f64)
+            / (self.dx_m * self.dx_m)
+    }
+
+    /// Integer part of the loop at the internal rate (the filters add the rest).
+    pub fn loop_samples(&self) -> usize {
+        2 * self.m
+    }
+
+    /// Temperatures of the bow nodes, K above ambient.
+    pub fn node_temperatures(&self) -> &[f64] {
+        &self.temperature[self.margin_nodes..self.margin_nodes + self.nodes_count]
+    }
+
+    /// The whole thermal grid (margins included).
+    pub fn temperature_grid(&self) -> &[f64] {
+        &self.temperature
+    }
+
+    /// Which nodes slipped on the last sample.
+    pub fn slipping(&self) -> &[bool] {
+        &self.nodes.slipping
+    }
+
+    /// Friction force per node on the last sample, N.
+    pub fn node_forces(&self) -> &[f64] {
+        &self.nodes.force
+    }
+
+    /// Sliding velocity per node on the last sample, m/s.
+    pub fn node_sliding_velocities(&self) -> &[f64] {
+        &self.nodes.v_delta
+    }
+
+    /// Wave energy of both polarisations plus the hair's stored energy, J.
+    pub fn energy_j(&self) -> f64 {
+        let z = self.spec.z0_kg_per_s;
+        let fs = self.internal_rate_hz;
+        let cap = self.m + 1;
+        let mut sum = 0.0;
+        for p in 0..2 {
+            for x in 0..self.m {
+                let a = self.right[p][(self.t + cap - x) % cap];
+                let b = self.left[p][(self.t + cap - (self.m - 1 - x)) % cap];
+                sum += a * a + b * b;
+            }
+        }
+        let dx = self.dx_m;
+        let hair: f64 = (0..self.nodes_count)
+            .map(|i| {
+                0.5 * self.hair.k_n_per_m_per_m * dx * self.nodes.hair_x[i].powi(2)
+                    + 0.5 * self.hair.vertical_mass_kg_per_m * dx * self.nodes.vy[i].powi(2)
+                    + 0.5 * self.hair.vertical_k_n_per_m_per_m * dx * self.nodes.y[i].powi(2)
+            })
+            .sum();
+        z / fs * sum + hair
+    }
+
+    pub fn reset(&mut self) {
+        for p in 0..2 {
+            self.right[p].fill(0.0);
+            self.left[p].fill(0.0);
+            self.loss[p].reset();
+            self.fraction[p].reset();
+        }
+        let n = &mut self.nodes;
+        for v in [
+            &mut n.hair_x,
+            &mut n.hair_v,
+            &mut n.vy,
+            &mut n.y,
+            &mut n.fy,
+            &mut n.force,
+            &mut n.v_delta,
+        ] {
+            v.fill(0.0);
+        }
+        n.slipping.fill(false);
+        self.temperature.fill(0.0);
+    }
+
+    /// One sample at the internal rate. A bow force of zero lifts the bow (no contact in
+    /// either plane).
+    pub fn tick(&mut self, bow: ThermalBowControl) -> ThermalFrame {
+        let cap = self.m + 1;
+        let m = self.m;
+        let t = self.t;
+        let at = |delay: usize| (t + cap - delay) % cap;
+        let z = self.spec.z0_kg_per_s;
+        let half_y = 0.5 / z;
+        let dt = 1.0 / self.internal_rate_hz;
+        let n_b = self.nodes_count;
+        let centre = (bow.position_beta.clamp(0.01, 0.5) * m as f64).round() as usize;
+        self.bow_start = centre.saturating_sub(n_b / 2).clamp(1, m - n_b - 1);
+        let dx = self.dx_m;
+        let f_b = bow.force_per_m.max(0.0) * dx;
+        let on = f_b > 0.0;
+        let mut frame = ThermalFrame::default();
+        let mid = n_b / 2;
+
+        // Hair constants per node (trapezoid).
+        let k_h = self.hair.k_n_per_m_per_m * dx;
+        let c_h = self.hair.c_kg_per_s_per_m * dx;
+        let a = 1.0 / (c_h + 0.5 * k_h * dt);
+        let m_y = self.hair.vertical_mass_kg_per_m * dx;
+        let k_y = self.hair.vertical_k_n_per_m_per_m * dx;
+        let c_y = self.hair.vertical_c_kg_per_s_per_m * dx;
+        let d_y = m_y / dt + 0.5 * c_y + 0.25 * k_y * dt;
+        let e_y = m_y / dt - 0.5 * c_y - 0.25 * k_y * dt;
+
+        for i in 0..n_b {
+            let x = self.bow_start + i;
+            let (ir, il) = (at(x), at(m - 1 - x));
+            if !on {
+                self.nodes.force[i] = 0.0;
+                self.nodes.fy[i] = 0.0;
+                self.nodes.slipping[i] = false;
+                self.nodes.v_delta[i] = 0.0;
+                // The hair relaxes off the string.
+                self.nodes.hair_x[i] = 0.0;
+                self.nodes.hair_v[i] = 0.0;
+                self.nodes.y[i] = 0.0;
+                self.nodes.vy[i] = 0.0;
+                continue;
+            }
+            // Vertical junction: the string and the hair mass move together.
+            let vp_y = self.right[1][ir] + self.left[1][il];
+            let rhs = -0.5 * self.nodes.fy[i] + e_y * self.nodes.vy[i] - k_y * self.nodes.y[i];
+            let fy = (rhs / d_y - vp_y) / (half_y + 0.5 / d_y);
+            let vy = vp_y + fy * half_y;
+            self.nodes.y[i] += 0.5 * dt * (vy + self.nodes.vy[i]);
+            self.nodes.vy[i] = vy;
+            self.nodes.fy[i] = fy;
+            self.right[1][ir] += fy * half_y;
+            self.left[1][il] += fy * half_y;
+            let f_n = (f_b + fy).max(0.0);
+
+            // Horizontal: Friedlander with the hair's compliance.
+            let vp = self.right[0][ir] + self.left[0][il];
+            let b = -a * k_h * (self.nodes.hair_x[i] + 0.5 * dt * self.nodes.hair_v[i]);
+            let mu = self.thermal.mu(self.temperature[self.margin_nodes + i]);
+            let f_stick = (bow.velocity_m_per_s + b - vp) / (half_y + a);
+            let limit = mu * f_n;
+            let (force, slipping) = if f_stick.abs() <= limit {
+                (f_stick, false)
+            } else {
+                (f_stick.signum() * limit, true)
+            };
+            let v_s = vp + force * half_y;
+            let v_h = -a * force + b;
+            self.nodes.hair_x[i] += 0.5 * dt * (v_h + self.nodes.hair_v[i]);
+            self.nodes.hair_v[i] = v_h;
+            self.nodes.force[i] = force;
+            self.nodes.slipping[i] = slipping;
+            self.nodes.v_delta[i] = if slipping {
+                v_s - (bow.velocity_m_per_s + v_h)
+            } else {
+                0.0
+            };
+            self.right[0][ir] += force * half_y;
+            self.left[0][il] += force * half_y;
+            frame.friction_force_n += force;
+            frame.normal_force_n += f_n;
+            frame.slipping_nodes += slipping as usize;
+            if i == mid {
+                frame.string_velocity_m_per_s = v_s;
+                frame.hair_velocity_m_per_s = v_h;
+            }
+        }
+        if !on {
+            let x = self.bow_start + mid;
+            frame.string_velocity_m_per_s = self.right[0][at(x)] + self.left[0][at(m - 1 - x)];
+        }
+        self.update_temperature(dt, dx);
+
+        // Terminations.
+        let mut at_bridge = [0.0; 2];
+        let mut at_nut = [0.0; 2];
+        for p in 0..2 {
+            at_bridge[p] = self.loss[p].tick(self.left[p][at(m - 1)]);
+            at_nut[p] = self.fraction[p].tick(self.right[p][at(m - 1)]);
+        }
+        let rb = self.bridge_reflection;
+        let rn = self.nut_reflection;
+        let next = (t + 1) % cap;
+        for p in 0..2 {
+            self.right[p][next] = flush_tiny(rb[p][0] * at_bridge[0] + rb[p][1] * at_bridge[1]);
+            self.left[p][next] = flush_tiny(rn[p][0] * at_nut[0] + rn[p][1] * at_nut[1]);
+        }
+        // Force on the bridge: incoming plus outgoing waves, horizontal.
+        frame.bridge_force_n = z * (at_bridge[0] - self.right[0][next]);
+        self.t = next;
+        frame
+    }
+
+    /// Eq. (1) by FTCS with the sub-steps the stability bound asks for.
+    fn update_temperature(&mut self, dt: f64, dx: f64) {
+        let p = self.thermal;
+        let h = dt / self.substeps as f64;
+        let r = p.diffusivity_m2_per_s * h / (dx * dx);
+        let n = self.temperature.len();
+        for _ in 0..self.substeps {
+            for j in 0..n {
+                let left = if j == 0 { 0.0 } else { self.temperature[j - 1] };
+                let right = if j + 1 == n {
+                    0.0
+                } else {
+                    self.temperature[j + 1]
+                };
+                let here = self.temperature[j];
+                let mut next = here + r * (left - 2.0 * here + right);
+                if j >= self.margin_nodes && j < self.margin_nodes + self.nodes_count {
+                    let i = j - self.margin_nodes;
+                    let v = self.nodes.v_delta[i].abs();
+                    let f_len = self.nodes.force[i].abs() / dx;
+                    next += h * (p.c_h_kelvin_m_per_j * f_len * v - p.c_c_per_m * here * v);
+                }
+                self.temperature_next[j] = flush_tiny(next);
+            }
+            std::mem::swap(&mut self.temperature, &mut self.temperature_next);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reflections_of_psd_admittances_are_passive() {
+        let r = reflection(1.88, [[1e-2, 3e-3], [3e-3, 2e-2]]);
+        // Singular values of R below 1: check ||R v|| < ||v|| on many directions.
+        for k in 0..64 {
+            let th = k as f64 * PI / 32.0;
+            let v = [th.cos(), th.sin()];
+            let rv = [
+                r[0][0] * v[0] + r[0][1] * v[1],
+                r[1][0] * v[0] + r[1][1] * v[1],
+            ];
+            assert!(rv[0].hypot(rv[1]) < 1.0);
+        }
+        // Rigid: -I.
+        assert_eq!(reflection(1.0, [[0.0; 2]; 2]), [[-1.0, 0.0], [0.0, -1.0]]);
+    }
+}
