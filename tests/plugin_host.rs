@@ -590,7 +590,9 @@ fn saved_state_restores_parameters_and_reproduces_output_exactly() {
     let values: Vec<f64> = names.iter().map(|n| first.clap_value(n)).collect();
 
     let mut second = HostedPlugin::load_test_build();
-    second.load_state(&state).expect("the plugin refused its own state");
+    second
+        .load_state(&state)
+        .expect("the plugin refused its own state");
     second.activate(FS, BLOCK);
     for (name, value) in names.iter().zip(&values) {
         assert_eq!(second.clap_value(name), *value, "{name} not restored");
@@ -602,9 +604,16 @@ fn saved_state_restores_parameters_and_reproduces_output_exactly() {
         .at(secs(0.3, FS), Event::note_off(69));
     let a = first.render(secs(0.5, FS) as usize, BLOCK, &score);
     let b = second.render(secs(0.5, FS) as usize, BLOCK, &score);
-    assert!(rms(&channel_f64(&a, 0)) > 1e-3, "the restored patch is silent");
+    assert!(
+        rms(&channel_f64(&a, 0)) > 1e-3,
+        "the restored patch is silent"
+    );
     assert_eq!(a, b, "restored state renders differently");
-    println!("state: {} bytes, {} parameters restored", state.len(), names.len());
+    println!(
+        "state: {} bytes, {} parameters restored",
+        state.len(),
+        names.len()
+    );
 
     // A broken state is refused (or ignored) without losing the current one.
     let mut broken = state.clone();
@@ -613,12 +622,19 @@ fn saved_state_restores_parameters_and_reproduces_output_exactly() {
         let result = second.load_state(&garbage);
         println!("loading {} bytes of garbage: {result:?}", garbage.len());
         for (name, value) in names.iter().zip(&values) {
-            assert_eq!(second.clap_value(name), *value, "{name} lost after a bad state");
+            assert_eq!(
+                second.clap_value(name),
+                *value,
+                "{name} lost after a bad state"
+            );
         }
         let note = Score::new().at(0, Event::note_on(69));
         let out = second.render(secs(0.2, FS) as usize, BLOCK, &note);
         assert!(out.iter().flatten().all(|x| x.is_finite()));
-        assert!(rms(&channel_f64(&out, 0)) > 1e-3, "silent after a bad state");
+        assert!(
+            rms(&channel_f64(&out, 0)) > 1e-3,
+            "silent after a bad state"
+        );
         second.render(BLOCK, BLOCK, &Score::new().at(0, Event::note_off(69)));
     }
 }

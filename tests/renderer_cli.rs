@@ -118,14 +118,38 @@ fn an_unwritable_output_path_fails_cleanly() {
 #[test]
 fn presets_and_friction_laws_render_and_unknown_names_fail_cleanly() {
     let out = scratch("glass.wav");
-    let run = colophony(&["render", "--preset", "wine-glass", "--seconds", "0.5", "--out", out.to_str().unwrap()]);
-    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let run = colophony(&[
+        "render",
+        "--preset",
+        "wine-glass",
+        "--seconds",
+        "0.5",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
     let reader = hound::WavReader::open(&out).unwrap();
     assert_eq!(reader.duration(), 24_000);
     for law in ["static", "lugre", "elasto-plastic", "hyperbolic"] {
         let out = scratch(&format!("law-{law}.wav"));
-        let run = colophony(&["render", "--friction", law, "--seconds", "0.3", "--out", out.to_str().unwrap()]);
-        assert!(run.status.success(), "{law}: {}", String::from_utf8_lossy(&run.stderr));
+        let run = colophony(&[
+            "render",
+            "--friction",
+            law,
+            "--seconds",
+            "0.3",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(
+            run.status.success(),
+            "{law}: {}",
+            String::from_utf8_lossy(&run.stderr)
+        );
     }
     for bad in [["--preset", "kazoo"], ["--friction", "sticky"]] {
         let out = scratch("bad-name.wav");
@@ -133,7 +157,10 @@ fn presets_and_friction_laws_render_and_unknown_names_fail_cleanly() {
         args.extend_from_slice(&bad);
         let run = colophony(&args);
         let stderr = String::from_utf8_lossy(&run.stderr);
-        assert!(!run.status.success() && stderr.contains("error"), "{bad:?}: {stderr}");
+        assert!(
+            !run.status.success() && stderr.contains("error"),
+            "{bad:?}: {stderr}"
+        );
         assert!(!out.exists());
     }
 }
@@ -143,11 +170,24 @@ fn paper_a_figures_are_written_as_png() {
     for name in ["serafin-fig7", "serafin-modal"] {
         let out = scratch(&format!("{name}.png"));
         let run = colophony(&["figure", name, "--out", out.to_str().unwrap()]);
-        assert!(run.status.success(), "{name}: {}", String::from_utf8_lossy(&run.stderr));
+        assert!(
+            run.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&run.stderr)
+        );
         let bytes = std::fs::read(&out).unwrap();
         assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{name} is not a PNG");
-        assert!(bytes.len() > 20_000, "{name}: suspiciously small ({} bytes)", bytes.len());
+        assert!(
+            bytes.len() > 20_000,
+            "{name}: suspiciously small ({} bytes)",
+            bytes.len()
+        );
     }
-    let run = colophony(&["figure", "nonsense", "--out", scratch("x.png").to_str().unwrap()]);
+    let run = colophony(&[
+        "figure",
+        "nonsense",
+        "--out",
+        scratch("x.png").to_str().unwrap(),
+    ]);
     assert!(!run.status.success());
 }
