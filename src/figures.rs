@@ -38,8 +38,9 @@ pub fn draw(name: &str, out: &Path) -> Result<String, String> {
     match name {
         "serafin-fig7" => serafin_fig7(out),
         "serafin-modal" => serafin_modal(out),
+        "maestre-fig6" => maestre_fig6(out),
         other => Err(format!(
-            "unknown figure '{other}': choose serafin-fig7, serafin-modal or bridge-fit"
+            "unknown figure '{other}': choose serafin-fig7, serafin-modal, maestre-fig6 or bridge-fit"
         )),
     }
 }
@@ -209,6 +210,229 @@ pub fn serafin_modal(out: &Path) -> Result<String, String> {
     chart
         .draw_series(LineSeries::new(
             t.iter().copied().zip(f.iter().copied()),
+            &RED,
+        ))
+        .map_err(err)?;
+    root.present().map_err(err)?;
+    Ok(format!("wrote {}", out.display()))
+}
+
+/// Paper B, Figure 6: cello open C, v_b 0.15 m/s, beta 0.07, 300 N/m, 60 nodes over 1 cm.
+pub fn maestre_fig6(out: &Path) -> Result<String, String> {
+    use crate::dsp::thermal::{
+        HairParams, ThermalBowControl, ThermalParams, ThermalString, ThermalStringSpec,
+    };
+    fonts();
+    let nodes = 60;
+    let mut s = ThermalString::new(
+        ThermalStringSpec::cello_c(),
+        nodes,
+        0.01,
+        ThermalParams::default(),
+        HairParams::default(),
+    )?;
+    let bow = ThermalBowControl {
+        velocity_m_per_s: 0.15,
+        force_per_m: 300.0,
+        position_beta: 0.07,
+    };
+    let fs = s.internal_rate_hz();
+    for _ in 0..(0.5 * fs) as usize {
+        s.tick(bow);
+    }
+    let shown = (2.0 * fs / 65.41) as usize;
+    let columns = 700usize;
+    let every = (shown / columns).max(1);
+    let (mut t, mut vs, mut ff, mut vh, mut fnn) = (vec![], vec![], vec![], vec![], vec![]);
+    let mut slip_map: Vec<Vec<bool>> = Vec::new();
+    let mut temp_map: Vec<Vec<f64>> = Vec::new();
+    let mut loop_pts: Vec<(f64, f64, usize)> = Vec::new();
+    for k in 0..shown {
+        let f = s.tick(bow);
+        let ms = 1e3 * k as f64 / fs;
+        t.push(ms);
+        vs.push(f.string_velocity_m_per_s);
+        ff.push(f.friction_force_n);
+        vh.push(f.hair_velocity_m_per_s);
+        fnn.push(f.normal_force_n);
+        if k % every == 0 {
+            slip_map.push(s.slipping().to_vec());
+            temp_map.push(s.node_temperatures().to_vec());
+            // Nut-side half of the contact: higher node indices are nearer the nut.
+            for i in nodes / 2..nodes {
+                let dv = s.node_sliding_velocities()[i];
+                let f = s.node_forces()[i] / (300.0 * 0.01 / nodes as f64);
+                loop_pts.push((dv, f, i));
+            }
+        }
+    }
+    let (w, h) = (1400u32, 1700u32);
+    let root = BitMapBackend::new(out, (w, h)).into_drawing_area();
+    root.fill(&WHITE).map_err(err)?;
+    let root = root
+        .titled(
+            "Paper B, Fig. 6: cello open C, v_b 0.15 m/s, beta 0.07, 300 N/m, 60 nodes over 1 cm",
+            ("sans-serif", 24),
+        )
+        .map_err(err)?;
+    let panels = root.split_evenly((4, 2));
+    let t_end = t[shown - 1];
+    let line = |area: &DrawingArea<BitMapBackend, plotters::coord::Shift>,
+                title: &str,
+                unit: &str,
+                y: &[f64],
+                color: RGBColor|
+     -> Result<(), String> {
+        let (lo, hi) = range(y.iter().copied());
+        let mut chart = ChartBuilder::on(area)
+            .margin(10)
+            .x_label_area_size(35)
+            .y_label_area_size(60)
+            .caption(title, ("sans-serif", 18))
+            .build_cartesian_2d(0.0..t_end, lo..hi)
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc("time (ms)")
+            .y_desc(unit)
+            .draw()
+            .map_err(err)?;
+        chart
+            .draw_series(LineSeries::new(
+                t.iter().copied().zip(y.iter().copied()),
+                &color,
+            ))
+            .map_err(err)?;
+        Ok(())
+    };
+    line(
+        &panels[0],
+        "String horizontal velocity (middle node)",
+        "m/s",
+        &vs,
+        BLUE,
+    )?;
+    line(&panels[1], "Friction force (whole bow)", "N", &ff, RED)?;
+    line(
+        &panels[2],
+        "Hair relative velocity (middle node)",
+        "m/s",
+        &vh,
+        GREEN,
+    )?;
+    line(
+        &panels[3],
+        "Effective bow force (whole bow)",
+        "N",
+        &fnn,
+        BLACK,
+    )?;
+    let cols = slip_map.len();
+    let map = |area: &DrawingArea<BitMapBackend, plotters::coord::Shift>,
+               title: &str,
+               colour: &dyn Fn(usize, usize) -> RGBColor|
+     -> Result<(), String> {
+        let mut chart = ChartBuilder::on(area)
+            .margin(10)
+            .x_label_area_size(35)
+            .y_label_area_size(60)
+            .caption(title, ("sans-serif", 18))
+            .build_cartesian_2d(0.0..t_end, 0.0..nodes as f64)
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc("time (ms)")
+            .y_desc("node (bridge side at 0)")
+            .disable_mesh()
+            .draw()
+            .map_err(err)?;
+        let dt = t_end / cols as f64;
+        chart
+            .draw_series((0..cols).flat_map(|c| {
+                (0..nodes).map(move |i| {
+                    Rectangle::new(
+                        [
+                            (c as f64 * dt, i as f64),
+                            ((c + 1) as f64 * dt, (i + 1) as f64),
+                        ],
+                        colour(c, i).filled(),
+                    )
+                })
+            }))
+            .map_err(err)?;
+        Ok(())
+    };
+    map(
+        &panels[4],
+        "Friction map (slip: white, stick: black)",
+        &|c, i| {
+            if slip_map[c][i] {
+                WHITE
+            } else {
+                BLACK
+            }
+        },
+    )?;
+    let tmax = temp_map.iter().flatten().cloned().fold(1e-9, f64::max);
+    map(
+        &panels[5],
+        &format!("Temperature (0 to {tmax:.1} K above ambient)"),
+        &|c, i| {
+            let u = (temp_map[c][i] / tmax).clamp(0.0, 1.0);
+            RGBColor(
+                (255.0 * u) as u8,
+                (80.0 * u) as u8,
+                (255.0 * (1.0 - u)) as u8,
+            )
+        },
+    )?;
+    // Friction against sliding velocity, nut-side half (darker: towards the bow middle).
+    let (xlo, xhi) = range(loop_pts.iter().map(|p| p.0));
+    let (ylo, yhi) = range(loop_pts.iter().map(|p| p.1));
+    let mut chart = ChartBuilder::on(&panels[6])
+        .margin(10)
+        .x_label_area_size(35)
+        .y_label_area_size(60)
+        .caption(
+            "Friction coefficient against sliding velocity (nut-side half)",
+            ("sans-serif", 18),
+        )
+        .build_cartesian_2d(xlo..xhi, ylo..yhi)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("sliding velocity v_s - (v_b + v_h) (m/s)")
+        .y_desc("F / F_b")
+        .draw()
+        .map_err(err)?;
+    chart
+        .draw_series(loop_pts.iter().map(|(x, y, i)| {
+            let shade = (200.0 * (*i - nodes / 2) as f64 / (nodes / 2) as f64) as u8;
+            Circle::new((*x, *y), 1, RGBColor(shade, shade, shade).filled())
+        }))
+        .map_err(err)?;
+    // Temperature profile across the grid at the end.
+    let grid = s.temperature_grid().to_vec();
+    let (lo, hi) = range(grid.iter().copied());
+    let mut chart = ChartBuilder::on(&panels[7])
+        .margin(10)
+        .x_label_area_size(35)
+        .y_label_area_size(60)
+        .caption(
+            "Temperature across the grid (bow plus 2 mm margins), last sample",
+            ("sans-serif", 18),
+        )
+        .build_cartesian_2d(0.0..grid.len() as f64, lo.min(0.0)..hi)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("grid point")
+        .y_desc("K")
+        .draw()
+        .map_err(err)?;
+    chart
+        .draw_series(LineSeries::new(
+            grid.iter().enumerate().map(|(i, v)| (i as f64, *v)),
             &RED,
         ))
         .map_err(err)?;

@@ -73,7 +73,7 @@ enum Command {
         fit: Option<PathBuf>,
     },
     /// Print real-time ratios (run a release build): `friction` times 10 s of cello D at
-    /// 48 kHz with each friction law.
+    /// 48 kHz with each friction law; `table1` times paper B's thermal bow per node count.
     Bench { what: String },
     /// Fit a passive modal bridge admittance to measured data (CSV in, JSON out).
     FitBridge {
@@ -194,7 +194,10 @@ fn main() -> ExitCode {
         }),
         Command::Bench { what } => report(match what.as_str() {
             "friction" => colophony::bench::friction_table(),
-            other => Err(format!("unknown bench '{other}': choose friction")),
+            "table1" => colophony::bench::table1(),
+            other => Err(format!(
+                "unknown bench '{other}': choose friction or table1"
+            )),
         }),
         Command::FitBridge { input, modes, out } => {
             report(colophony::admittance_fit::run_cli(&input, modes, &out))

@@ -517,64 +517,71 @@ impl ThermalString {
         let d_y = m_y / dt + 0.5 * c_y + 0.25 * k_y * dt;
         let e_y = m_y / dt - 0.5 * c_y - 0.25 * k_y * dt;
 
+        // Consecutive nodes sit at consecutive positions: step the ring indices instead of
+        // taking a modulo per node (right-going index falls, left-going rises with x).
+        let mut ir = at(self.bow_start);
+        let mut il = at(m - 1 - self.bow_start);
+        let inv_d_y = 1.0 / d_y;
+        let inv_y_load = 1.0 / (half_y + 0.5 * inv_d_y);
+        let inv_x_load = 1.0 / (half_y + a);
+        let v_b = bow.velocity_m_per_s;
+        let bow_off = self.margin_nodes;
+        let nodes = &mut self.nodes;
         for i in 0..n_b {
-            let x = self.bow_start + i;
-            let (ir, il) = (at(x), at(m - 1 - x));
-            if !on {
-                self.nodes.force[i] = 0.0;
-                self.nodes.fy[i] = 0.0;
-                self.nodes.slipping[i] = false;
-                self.nodes.v_delta[i] = 0.0;
-                // The hair relaxes off the string.
-                self.nodes.hair_x[i] = 0.0;
-                self.nodes.hair_v[i] = 0.0;
-                self.nodes.y[i] = 0.0;
-                self.nodes.vy[i] = 0.0;
-                continue;
-            }
-            // Vertical junction: the string and the hair mass move together.
-            let vp_y = self.right[1][ir] + self.left[1][il];
-            let rhs = -0.5 * self.nodes.fy[i] + e_y * self.nodes.vy[i] - k_y * self.nodes.y[i];
-            let fy = (rhs / d_y - vp_y) / (half_y + 0.5 / d_y);
-            let vy = vp_y + fy * half_y;
-            self.nodes.y[i] += 0.5 * dt * (vy + self.nodes.vy[i]);
-            self.nodes.vy[i] = vy;
-            self.nodes.fy[i] = fy;
-            self.right[1][ir] += fy * half_y;
-            self.left[1][il] += fy * half_y;
-            let f_n = (f_b + fy).max(0.0);
+            if on {
+                // Vertical junction: the string and the hair mass move together.
+                let vp_y = self.right[1][ir] + self.left[1][il];
+                let rhs = -0.5 * nodes.fy[i] + e_y * nodes.vy[i] - k_y * nodes.y[i];
+                let fy = (rhs * inv_d_y - vp_y) * inv_y_load;
+                let vy = vp_y + fy * half_y;
+                nodes.y[i] += 0.5 * dt * (vy + nodes.vy[i]);
+                nodes.vy[i] = vy;
+                nodes.fy[i] = fy;
+                self.right[1][ir] += fy * half_y;
+                self.left[1][il] += fy * half_y;
+                let f_n = (f_b + fy).max(0.0);
 
-            // Horizontal: Friedlander with the hair's compliance.
-            let vp = self.right[0][ir] + self.left[0][il];
-            let b = -a * k_h * (self.nodes.hair_x[i] + 0.5 * dt * self.nodes.hair_v[i]);
-            let mu = self.thermal.mu(self.temperature[self.margin_nodes + i]);
-            let f_stick = (bow.velocity_m_per_s + b - vp) / (half_y + a);
-            let limit = mu * f_n;
-            let (force, slipping) = if f_stick.abs() <= limit {
-                (f_stick, false)
+                // Horizontal: Friedlander with the hair's compliance.
+                let vp = self.right[0][ir] + self.left[0][il];
+                let b = -a * k_h * (nodes.hair_x[i] + 0.5 * dt * nodes.hair_v[i]);
+                let mu = self.thermal.mu(self.temperature[bow_off + i]);
+                let f_stick = (v_b + b - vp) * inv_x_load;
+                let limit = mu * f_n;
+                let slipping = f_stick.abs() > limit;
+                let force = if slipping {
+                    f_stick.signum() * limit
+                } else {
+                    f_stick
+                };
+                let v_s = vp + force * half_y;
+                let v_h = -a * force + b;
+                nodes.hair_x[i] += 0.5 * dt * (v_h + nodes.hair_v[i]);
+                nodes.hair_v[i] = v_h;
+                nodes.force[i] = force;
+                nodes.slipping[i] = slipping;
+                nodes.v_delta[i] = if slipping { v_s - (v_b + v_h) } else { 0.0 };
+                self.right[0][ir] += force * half_y;
+                self.left[0][il] += force * half_y;
+                frame.friction_force_n += force;
+                frame.normal_force_n += f_n;
+                frame.slipping_nodes += slipping as usize;
+                if i == mid {
+                    frame.string_velocity_m_per_s = v_s;
+                    frame.hair_velocity_m_per_s = v_h;
+                }
             } else {
-                (f_stick.signum() * limit, true)
-            };
-            let v_s = vp + force * half_y;
-            let v_h = -a * force + b;
-            self.nodes.hair_x[i] += 0.5 * dt * (v_h + self.nodes.hair_v[i]);
-            self.nodes.hair_v[i] = v_h;
-            self.nodes.force[i] = force;
-            self.nodes.slipping[i] = slipping;
-            self.nodes.v_delta[i] = if slipping {
-                v_s - (bow.velocity_m_per_s + v_h)
-            } else {
-                0.0
-            };
-            self.right[0][ir] += force * half_y;
-            self.left[0][il] += force * half_y;
-            frame.friction_force_n += force;
-            frame.normal_force_n += f_n;
-            frame.slipping_nodes += slipping as usize;
-            if i == mid {
-                frame.string_velocity_m_per_s = v_s;
-                frame.hair_velocity_m_per_s = v_h;
+                nodes.force[i] = 0.0;
+                nodes.fy[i] = 0.0;
+                nodes.slipping[i] = false;
+                nodes.v_delta[i] = 0.0;
+                // The hair relaxes off the string.
+                nodes.hair_x[i] = 0.0;
+                nodes.hair_v[i] = 0.0;
+                nodes.y[i] = 0.0;
+                nodes.vy[i] = 0.0;
             }
+            ir = if ir == 0 { cap - 1 } else { ir - 1 };
+            il = if il + 1 == cap { 0 } else { il + 1 };
         }
         if !on {
             let x = self.bow_start + mid;
@@ -602,29 +609,36 @@ impl ThermalString {
         frame
     }
 
-    /// Eq. (1) by FTCS with the sub-steps the stability bound asks for.
+    /// Eq. (1) by FTCS with the sub-steps the stability bound asks for: diffusion over
+    /// the whole grid (branch-free interior), then the friction source and convective loss
+    /// on the bow's nodes.
     fn update_temperature(&mut self, dt: f64, dx: f64) {
         let p = self.thermal;
         let h = dt / self.substeps as f64;
         let r = p.diffusivity_m2_per_s * h / (dx * dx);
         let n = self.temperature.len();
+        let heat = h * p.c_h_kelvin_m_per_j / dx;
+        let cool = h * p.c_c_per_m;
+        let off = self.margin_nodes;
         for _ in 0..self.substeps {
-            for j in 0..n {
-                let left = if j == 0 { 0.0 } else { self.temperature[j - 1] };
-                let right = if j + 1 == n {
-                    0.0
-                } else {
-                    self.temperature[j + 1]
-                };
-                let here = self.temperature[j];
-                let mut next = here + r * (left - 2.0 * here + right);
-                if j >= self.margin_nodes && j < self.margin_nodes + self.nodes_count {
-                    let i = j - self.margin_nodes;
-                    let v = self.nodes.v_delta[i].abs();
-                    let f_len = self.nodes.force[i].abs() / dx;
-                    next += h * (p.c_h_kelvin_m_per_j * f_len * v - p.c_c_per_m * here * v);
+            let t = &self.temperature;
+            let next = &mut self.temperature_next;
+            if n == 1 {
+                next[0] = t[0] * (1.0 - 2.0 * r);
+            } else {
+                next[0] = t[0] + r * (t[1] - 2.0 * t[0]);
+                for j in 1..n - 1 {
+                    next[j] = t[j] + r * (t[j - 1] - 2.0 * t[j] + t[j + 1]);
                 }
-                self.temperature_next[j] = flush_tiny(next);
+                next[n - 1] = t[n - 1] + r * (t[n - 2] - 2.0 * t[n - 1]);
+            }
+            for i in 0..self.nodes_count {
+                let v = self.nodes.v_delta[i].abs();
+                let j = off + i;
+                next[j] += heat * self.nodes.force[i].abs() * v - cool * t[j] * v;
+            }
+            for x in next.iter_mut() {
+                *x = flush_tiny(*x);
             }
             std::mem::swap(&mut self.temperature, &mut self.temperature_next);
         }
