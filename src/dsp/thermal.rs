@@ -228,7 +228,11 @@ struct Nodes {
     fy: Vec<f64>,
     force: Vec<f64>,
     v_delta: Vec<f64>,
+    normal: Vec<f64>,
     slipping: Vec<bool>,
+    /// Incoming horizontal and vertical velocity per node (gathered each sample).
+    vp: Vec<f64>,
+    vp_y: Vec<f64>,
 }
 
 /// A string with a finite-width thermal bow (see the module doc).
@@ -374,7 +378,10 @@ impl ThermalString {
                 fy: zeros(nodes),
                 force: zeros(nodes),
                 v_delta: zeros(nodes),
+                normal: zeros(nodes),
                 slipping: vec![false; nodes],
+                vp: zeros(nodes),
+                vp_y: zeros(nodes),
             },
             temperature: zeros(grid),
             temperature_next: zeros(grid),
@@ -519,69 +526,98 @@ impl ThermalString {
 
         // Consecutive nodes sit at consecutive positions: step the ring indices instead of
         // taking a modulo per node (right-going index falls, left-going rises with x).
-        let mut ir = at(self.bow_start);
-        let mut il = at(m - 1 - self.bow_start);
-        let inv_d_y = 1.0 / d_y;
-        let inv_y_load = 1.0 / (half_y + 0.5 * inv_d_y);
-        let inv_x_load = 1.0 / (half_y + a);
-        let v_b = bow.velocity_m_per_s;
-        let bow_off = self.margin_nodes;
+        let step_r = |i: usize| if i == 0 { cap - 1 } else { i - 1 };
+        let step_l = |i: usize| if i + 1 == cap { 0 } else { i + 1 };
+        let (ir0, il0) = (at(self.bow_start), at(m - 1 - self.bow_start));
         let nodes = &mut self.nodes;
-        for i in 0..n_b {
-            if on {
-                // Vertical junction: the string and the hair mass move together.
-                let vp_y = self.right[1][ir] + self.left[1][il];
-                let rhs = -0.5 * nodes.fy[i] + e_y * nodes.vy[i] - k_y * nodes.y[i];
-                let fy = (rhs * inv_d_y - vp_y) * inv_y_load;
-                let vy = vp_y + fy * half_y;
-                nodes.y[i] += 0.5 * dt * (vy + nodes.vy[i]);
-                nodes.vy[i] = vy;
-                nodes.fy[i] = fy;
-                self.right[1][ir] += fy * half_y;
-                self.left[1][il] += fy * half_y;
-                let f_n = (f_b + fy).max(0.0);
-
-                // Horizontal: Friedlander with the hair's compliance.
-                let vp = self.right[0][ir] + self.left[0][il];
-                let b = -a * k_h * (nodes.hair_x[i] + 0.5 * dt * nodes.hair_v[i]);
-                let mu = self.thermal.mu(self.temperature[bow_off + i]);
-                let f_stick = (v_b + b - vp) * inv_x_load;
-                let limit = mu * f_n;
-                let slipping = f_stick.abs() > limit;
-                let force = if slipping {
-                    f_stick.signum() * limit
-                } else {
-                    f_stick
-                };
-                let v_s = vp + force * half_y;
-                let v_h = -a * force + b;
-                nodes.hair_x[i] += 0.5 * dt * (v_h + nodes.hair_v[i]);
-                nodes.hair_v[i] = v_h;
-                nodes.force[i] = force;
-                nodes.slipping[i] = slipping;
-                nodes.v_delta[i] = if slipping { v_s - (v_b + v_h) } else { 0.0 };
-                self.right[0][ir] += force * half_y;
-                self.left[0][il] += force * half_y;
-                frame.friction_force_n += force;
-                frame.normal_force_n += f_n;
-                frame.slipping_nodes += slipping as usize;
-                if i == mid {
-                    frame.string_velocity_m_per_s = v_s;
-                    frame.hair_velocity_m_per_s = v_h;
-                }
-            } else {
-                nodes.force[i] = 0.0;
-                nodes.fy[i] = 0.0;
-                nodes.slipping[i] = false;
-                nodes.v_delta[i] = 0.0;
-                // The hair relaxes off the string.
-                nodes.hair_x[i] = 0.0;
-                nodes.hair_v[i] = 0.0;
-                nodes.y[i] = 0.0;
-                nodes.vy[i] = 0.0;
+        if !on {
+            for v in [
+                &mut nodes.force,
+                &mut nodes.fy,
+                &mut nodes.v_delta,
+                &mut nodes.hair_x,
+                &mut nodes.hair_v,
+                &mut nodes.y,
+                &mut nodes.vy,
+            ] {
+                v.fill(0.0);
             }
-            ir = if ir == 0 { cap - 1 } else { ir - 1 };
-            il = if il + 1 == cap { 0 } else { il + 1 };
+            nodes.slipping.fill(false);
+        } else {
+            // Gather the incoming waves, solve every node (independent within a sample,
+            // branch-free so it vectorises), scatter the outgoing waves.
+            let (mut ir, mut il) = (ir0, il0);
+            for i in 0..n_b {
+                nodes.vp[i] = self.right[0][ir] + self.left[0][il];
+                nodes.vp_y[i] = self.right[1][ir] + self.left[1][il];
+                ir = step_r(ir);
+                il = step_l(il);
+            }
+            let inv_d_y = 1.0 / d_y;
+            let inv_y_load = 1.0 / (half_y + 0.5 * inv_d_y);
+            let inv_x_load = 1.0 / (half_y + a);
+            let v_b = bow.velocity_m_per_s;
+            let th = self.thermal;
+            let temps = &self.temperature[self.margin_nodes..self.margin_nodes + n_b];
+            let mu_slope = (th.mu_hot - th.mu_cold) / (th.t_hot_kelvin - th.t_cold_kelvin);
+            let (mu_lo, mu_hi) = (th.mu_hot.min(th.mu_cold), th.mu_hot.max(th.mu_cold));
+            // Equal-length slices: the bounds checks go and the loop vectorises.
+            let fy_s = &mut nodes.fy[..n_b];
+            let vy_s = &mut nodes.vy[..n_b];
+            let y_s = &mut nodes.y[..n_b];
+            let vp_y = &nodes.vp_y[..n_b];
+            let vp = &nodes.vp[..n_b];
+            let hx = &mut nodes.hair_x[..n_b];
+            let hv = &mut nodes.hair_v[..n_b];
+            let force_s = &mut nodes.force[..n_b];
+            let normal_s = &mut nodes.normal[..n_b];
+            let slip_s = &mut nodes.slipping[..n_b];
+            let vd_s = &mut nodes.v_delta[..n_b];
+            for i in 0..n_b {
+                // Vertical junction: the string and the hair mass move together.
+                let rhs = -0.5 * fy_s[i] + e_y * vy_s[i] - k_y * y_s[i];
+                let fy = (rhs * inv_d_y - vp_y[i]) * inv_y_load;
+                let vy = vp_y[i] + fy * half_y;
+                y_s[i] += 0.5 * dt * (vy + vy_s[i]);
+                vy_s[i] = vy;
+                fy_s[i] = fy;
+                let f_n = (f_b + fy).max(0.0);
+                // Horizontal: Friedlander with the hair's compliance; the clamp is the
+                // stick/slip decision (slip exactly when |F_stick| > mu F_N). mu(T) is
+                // ThermalParams::mu written out with min/max.
+                let b = -a * k_h * (hx[i] + 0.5 * dt * hv[i]);
+                let mu = (th.mu_cold + mu_slope * (temps[i] - th.t_cold_kelvin))
+                    .max(mu_lo)
+                    .min(mu_hi);
+                let limit = mu * f_n;
+                let f_stick = (v_b + b - vp[i]) * inv_x_load;
+                let force = f_stick.max(-limit).min(limit);
+                let slipping = f_stick.abs() > limit;
+                let v_s = vp[i] + force * half_y;
+                let v_h = -a * force + b;
+                hx[i] += 0.5 * dt * (v_h + hv[i]);
+                hv[i] = v_h;
+                force_s[i] = force;
+                normal_s[i] = f_n;
+                slip_s[i] = slipping;
+                vd_s[i] = if slipping { v_s - (v_b + v_h) } else { 0.0 };
+            }
+            let (mut ir, mut il) = (ir0, il0);
+            for i in 0..n_b {
+                let dv = nodes.force[i] * half_y;
+                let dv_y = nodes.fy[i] * half_y;
+                self.right[0][ir] += dv;
+                self.left[0][il] += dv;
+                self.right[1][ir] += dv_y;
+                self.left[1][il] += dv_y;
+                ir = step_r(ir);
+                il = step_l(il);
+            }
+            frame.friction_force_n = nodes.force.iter().sum();
+            frame.normal_force_n = nodes.normal.iter().sum();
+            frame.slipping_nodes = nodes.slipping.iter().filter(|s| **s).count();
+            frame.string_velocity_m_per_s = nodes.vp[mid] + nodes.force[mid] * half_y;
+            frame.hair_velocity_m_per_s = nodes.hair_v[mid];
         }
         if !on {
             let x = self.bow_start + mid;
