@@ -166,8 +166,8 @@ fn presets_and_friction_laws_render_and_unknown_names_fail_cleanly() {
 }
 
 #[test]
-fn paper_a_figures_are_written_as_png() {
-    for name in ["serafin-fig7", "serafin-modal"] {
+fn paper_figures_are_written_as_png() {
+    for name in ["serafin-fig7", "serafin-modal", "maestre-fig6"] {
         let out = scratch(&format!("{name}.png"));
         let run = colophony(&["figure", name, "--out", out.to_str().unwrap()]);
         assert!(
