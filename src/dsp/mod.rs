@@ -7,6 +7,7 @@ pub mod filters;
 pub mod friction;
 pub mod instrument;
 pub mod modal;
+pub mod resample;
 pub mod rubbed;
 pub mod thermal;
 pub mod waveguide;
