@@ -52,9 +52,16 @@ enum Command {
         /// 2 friction force (N).
         #[arg(long)]
         probe: bool,
-        /// Friction law: hyperbolic, static (Stribeck), lugre or elasto-plastic.
+        /// Friction law: hyperbolic, static (Stribeck), lugre, elasto-plastic, or thermal
+        /// (paper B's finite-width bow; see --nodes and --bow-width).
         #[arg(long, default_value = "hyperbolic", value_parser = parse_friction)]
-        friction: FrictionModel,
+        friction: FrictionArg,
+        /// Thermal bow: hair nodes across the bow.
+        #[arg(long, default_value_t = 10)]
+        nodes: usize,
+        /// Thermal bow: width of the hair ribbon, m (the force is spread over it).
+        #[arg(long, default_value_t = 0.01)]
+        bow_width: f64,
         /// Rub a modal object instead of bowing a string: paper-modal, door-hinge, chalk,
         /// wine-glass or brake-squeal (the other bow settings are then the preset's).
         #[arg(long, value_parser = parse_preset)]
@@ -106,9 +113,20 @@ fn report(result: Result<String, String>) -> ExitCode {
     }
 }
 
-fn parse_friction(s: &str) -> Result<FrictionModel, String> {
-    FrictionModel::from_name(s).ok_or_else(|| {
-        format!("unknown friction model '{s}': choose hyperbolic, static, lugre or elasto-plastic")
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum FrictionArg {
+    Point(FrictionModel),
+    Thermal,
+}
+
+fn parse_friction(s: &str) -> Result<FrictionArg, String> {
+    if s == "thermal" {
+        return Ok(FrictionArg::Thermal);
+    }
+    FrictionModel::from_name(s).map(FrictionArg::Point).ok_or_else(|| {
+        format!(
+            "unknown friction model '{s}': choose hyperbolic, static, lugre, elasto-plastic or thermal"
+        )
     })
 }
 
@@ -132,9 +150,21 @@ fn main() -> ExitCode {
             release,
             probe,
             friction,
+            nodes,
+            bow_width,
             preset,
         } => {
+            let thermal = friction == FrictionArg::Thermal;
+            let friction = match friction {
+                FrictionArg::Point(model) => model,
+                FrictionArg::Thermal => FrictionModel::Hyperbolic,
+            };
             if let Some(preset) = preset {
+                if thermal {
+                    return report(Err(
+                        "the thermal bow plays strings, not the rubbed presets".into()
+                    ));
+                }
                 return report(
                     colophony::render::render_rubbed(
                         preset,
@@ -162,7 +192,12 @@ fn main() -> ExitCode {
                 ..RenderSettings::default()
             };
             let started = std::time::Instant::now();
-            match render(&settings).and_then(|r| write_wav(&out, &r, probe)) {
+            let rendered = if thermal {
+                colophony::render::render_thermal(&settings, nodes, bow_width)
+            } else {
+                render(&settings)
+            };
+            match rendered.and_then(|r| write_wav(&out, &r, probe)) {
                 Ok(()) => {
                     let took = started.elapsed().as_secs_f64();
                     println!(

@@ -173,6 +173,107 @@ pub fn render(settings: &RenderSettings) -> Result<Rendered, RenderError> {
     Ok(out)
 }
 
+/// Paper B's finite-width thermal bow on the string that plays `settings.note` (stopped
+/// to its pitch: the vibrating length shortens), at its internal rate, resampled to the
+/// output rate. The bow force in N is spread over `width_m` (force per length
+/// `F / w`). The probe's channel 1 is the string velocity at the bow's middle node and
+/// channel 2 the total friction force, both resampled.
+pub fn render_thermal(
+    settings: &RenderSettings,
+    nodes: usize,
+    width_m: f64,
+) -> Result<Rendered, RenderError> {
+    use crate::dsp::resample::Resampler;
+    use crate::dsp::thermal::{
+        HairParams, ThermalBowControl, ThermalParams, ThermalString, ThermalStringSpec,
+    };
+    check(settings)?;
+    let kind = settings.instrument;
+    let index = kind
+        .string_for_note(settings.note)
+        .expect("check() accepted the note");
+    let open = kind.strings()[index];
+    let f0 = crate::dsp::instrument::midi_to_hz(settings.note as f64);
+    let spec = ThermalStringSpec {
+        f0_hz: f0,
+        z0_kg_per_s: open.z0_kg_per_s,
+        length_m: kind.string_length_m() * open.open_hz / f0,
+        ..ThermalStringSpec::cello_c()
+    };
+    let mut string = ThermalString::new(
+        spec,
+        nodes,
+        width_m,
+        ThermalParams::default(),
+        HairParams::default(),
+    )
+    .map_err(RenderError::BadSetting)?;
+    let fs = settings.sample_rate_hz;
+    let mut resampler =
+        Resampler::new(string.internal_rate_hz(), fs).map_err(RenderError::BadSetting)?;
+    let frames = (settings.seconds * fs).round() as usize;
+    let release = settings.release_s.map(|s| (s * fs).round() as usize);
+    let mut out = Rendered {
+        sample_rate_hz: fs,
+        audio: Vec::with_capacity(frames),
+        bow_point_velocity_m_per_s: Vec::with_capacity(frames),
+        friction_force_n: Vec::with_capacity(frames),
+        newton: SolverStats::default(),
+    };
+    // Three signals through three resamplers would triple the cost; the probe channels
+    // share the audio's resampler by running the string once per block into buffers.
+    let mut probe_resamplers = [resampler.clone(), resampler.clone()];
+    let bow = settings.bow;
+    let scale = 0.1 / spec.z0_kg_per_s;
+    let block = 256;
+    let mut internal: Vec<(f64, f64, f64)> = Vec::new();
+    let mut buf = [vec![0.0; block], vec![0.0; block], vec![0.0; block]];
+    let mut done = 0;
+    while done < frames {
+        let n = block.min(frames - done);
+        let lifted = release.is_some_and(|r| done >= r);
+        let control = ThermalBowControl {
+            velocity_m_per_s: bow.velocity_m_per_s,
+            force_per_m: if lifted { 0.0 } else { bow.force_n / width_m },
+            position_beta: bow.position_beta,
+        };
+        internal.clear();
+        resampler.process(
+            || {
+                let f = string.tick(control);
+                internal.push((
+                    f.bridge_force_n,
+                    f.string_velocity_m_per_s,
+                    f.friction_force_n,
+                ));
+                f.bridge_force_n * scale
+            },
+            &mut buf[0][..n],
+        );
+        for (c, r) in probe_resamplers.iter_mut().enumerate() {
+            let mut pos = 0;
+            let source = &internal;
+            r.process(
+                || {
+                    // Pulls follow exactly the same schedule as the audio's.
+                    let v = source
+                        .get(pos)
+                        .map_or(0.0, |s| if c == 0 { s.1 } else { s.2 });
+                    pos += 1;
+                    v
+                },
+                &mut buf[c + 1][..n],
+            );
+        }
+        out.audio.extend_from_slice(&buf[0][..n]);
+        out.bow_point_velocity_m_per_s
+            .extend_from_slice(&buf[1][..n]);
+        out.friction_force_n.extend_from_slice(&buf[2][..n]);
+        done += n;
+    }
+    Ok(out)
+}
+
 /// Rubs one of the modal presets for `seconds` with the given friction law. The probe
 /// channels hold the resonator velocity at the contact and the friction force.
 pub fn render_rubbed(

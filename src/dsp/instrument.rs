@@ -119,6 +119,16 @@ impl InstrumentKind {
     }
 
     /// The string a note goes to, if the instrument can play it.
+    /// Vibrating length of the open strings, m (PARAMETERS.md §1.4: violin 0.32,
+    /// viola 0.38, cello 0.69).
+    pub fn string_length_m(self) -> f64 {
+        match self {
+            Self::Violin => 0.32,
+            Self::Viola => 0.38,
+            Self::Cello => 0.69,
+        }
+    }
+
     pub fn string_for_note(self, note: u8) -> Option<usize> {
         let open = self.open_notes();
         if note < open[0] || note > open[STRINGS - 1] + MAX_STOP_SEMITONES {
