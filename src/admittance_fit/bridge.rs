@@ -1,0 +1,289 @@
+//! The modal bridge admittance: the mode type, its response, and the JSON file format
+//! (`{"modes": [{"freq_hz", "bandwidth_hz", "gain"}]}`) with a validating loader.
+
+use nalgebra::Complex;
+use serde::{Deserialize, Serialize};
+use std::f64::consts::TAU;
+use std::path::Path;
+
+/// A complex admittance value (s/kg).
+pub type C64 = Complex<f64>;
+
+/// One mode of the bridge's driving-point admittance,
+/// `gain * s / (s^2 + 2 pi bandwidth_hz s + (2 pi freq_hz)^2)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BridgeMode {
+    /// Undamped natural frequency (Hz).
+    pub freq_hz: f64,
+    /// Half-power bandwidth (Hz); the pole pair is `-pi b +- j sqrt((2 pi f)^2 - (pi b)^2)`.
+    pub bandwidth_hz: f64,
+    /// Symmetric positive semidefinite gain (1/kg = s/kg times rad/s), rows and columns
+    /// (horizontal, vertical). A 1x1 file loads as `[[g, 0], [0, 0]]`.
+    pub gain: [[f64; 2]; 2],
+}
+
+/// A bridge: its modes, as loaded by [`load_bridge`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct BridgeModes {
+    pub modes: Vec<BridgeMode>,
+}
+
+/// The response of one mode per unit gain at `freq_hz`:
+/// `s / (s^2 + 2 pi b s + (2 pi f)^2)` at `s = j 2 pi freq_hz`, in seconds (times a gain in
+/// 1/kg gives s/kg).
+pub fn mode_response(mode_freq_hz: f64, bandwidth_hz: f64, freq_hz: f64) -> C64 {
+    let w = TAU * freq_hz;
+    let w0 = TAU * mode_freq_hz;
+    let beta = TAU * bandwidth_hz;
+    C64::new(0.0, w) / C64::new(w0 * w0 - w * w, w * beta)
+}
+
+impl BridgeMode {
+    /// `s / (s^2 + 2 pi b s + (2 pi f)^2)` at `s = j 2 pi freq_hz`.
+    pub fn response(&self, freq_hz: f64) -> C64 {
+        mode_response(self.freq_hz, self.bandwidth_hz, freq_hz)
+    }
+}
+
+impl BridgeModes {
+    /// The 2x2 admittance matrix Y(j 2 pi freq_hz) in s/kg, (horizontal, vertical).
+    pub fn admittance_s_per_kg(&self, freq_hz: f64) -> [[C64; 2]; 2] {
+        let mut y = [[C64::new(0.0, 0.0); 2]; 2];
+        for mode in &self.modes {
+            let h = mode.response(freq_hz);
+            for (row, gain_row) in y.iter_mut().zip(&mode.gain) {
+                for (yij, gij) in row.iter_mut().zip(gain_row) {
+                    *yij += h * *gij;
+                }
+            }
+        }
+        y
+    }
+}
+
+/// Eigenvalues (ascending) of the symmetric 2x2 matrix `[[a, b], [b, c]]`.
+pub fn symmetric_eigenvalues(a: f64, b: f64, c: f64) -> [f64; 2] {
+    let mean = 0.5 * (a + c);
+    let radius = (0.5 * (a - c)).hypot(b);
+    [mean - radius, mean + radius]
+}
+
+/// The nearest (Frobenius) positive semidefinite matrix to `[[a, b], [b, c]]`: negative
+/// eigenvalues set to zero.
+pub(crate) fn nearest_psd(a: f64, b: f64, c: f64) -> [[f64; 2]; 2] {
+    let [lo, hi] = symmetric_eigenvalues(a, b, c);
+    if lo >= 0.0 {
+        return [[a, b], [b, c]];
+    }
+    if hi <= 0.0 {
+        return [[0.0; 2]; 2];
+    }
+    // Rank one: hi * v v^T, v the unit eigenvector of hi.
+    let (vx, vy) = if b != 0.0 {
+        (b, hi - a)
+    } else if a >= c {
+        (1.0, 0.0)
+    } else {
+        (0.0, 1.0)
+    };
+    let n2 = vx * vx + vy * vy;
+    let g12 = hi * vx * vy / n2;
+    [[hi * vx * vx / n2, g12], [g12, hi * vy * vy / n2]]
+}
+
+#[derive(Serialize, Deserialize)]
+struct BridgeFile {
+    modes: Vec<ModeFile>,
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ModeFile {
+    freq_hz: f64,
+    bandwidth_hz: f64,
+    gain: Vec<Vec<f64>>,
+}
+
+/// Relative tolerance for symmetry and for negative eigenvalues of a gain: rounding only.
+const PSD_TOLERANCE: f64 = 1e-12;
+
+/// Reads and validates a bridge JSON file (1x1 or 2x2 gains). Every frequency and
+/// bandwidth must be finite and positive (a stable, causal pole pair), every gain square,
+/// symmetric and positive semidefinite (to a relative 1e-12), all of one size.
+pub fn load_bridge(path: &Path) -> Result<BridgeModes, String> {
+    load_bridge_ports(path).map(|(modes, _)| modes)
+}
+
+/// [`load_bridge`], also telling whether the file holds 1x1 (`1`) or 2x2 (`2`) gains.
+pub fn load_bridge_ports(path: &Path) -> Result<(BridgeModes, usize), String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    parse_bridge(&text).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// [`load_bridge_ports`] on JSON text.
+pub fn parse_bridge(text: &str) -> Result<(BridgeModes, usize), String> {
+    let file: BridgeFile =
+        serde_json::from_str(text).map_err(|e| format!("not a bridge JSON file: {e}"))?;
+    if file.modes.is_empty() {
+        return Err("the bridge has no modes".into());
+    }
+    let mut ports = 0;
+    let mut modes = Vec::with_capacity(file.modes.len());
+    for (i, m) in file.modes.iter().enumerate() {
+        let n = i + 1;
+        if !(m.freq_hz.is_finite() && m.freq_hz > 0.0) {
+            return Err(format!(
+                "mode {n}: freq_hz must be finite and positive, found {}",
+                m.freq_hz
+            ));
+        }
+        if !(m.bandwidth_hz.is_finite() && m.bandwidth_hz > 0.0) {
+            return Err(format!(
+                "mode {n}: bandwidth_hz must be finite and positive (a stable pole), found {}",
+                m.bandwidth_hz
+            ));
+        }
+        let size = m.gain.len();
+        if !(size == 1 || size == 2) || m.gain.iter().any(|row| row.len() != size) {
+            return Err(format!("mode {n}: gain must be a 1x1 or a 2x2 matrix"));
+        }
+        if ports == 0 {
+            ports = size;
+        } else if size != ports {
+            return Err(format!(
+                "mode {n}: gain is {size}x{size} but earlier modes' are {ports}x{ports}"
+            ));
+        }
+        if m.gain.iter().flatten().any(|g| !g.is_finite()) {
+            return Err(format!("mode {n}: gain has a non-finite entry"));
+        }
+        let gain = if size == 1 {
+            [[m.gain[0][0], 0.0], [0.0, 0.0]]
+        } else {
+            [[m.gain[0][0], m.gain[0][1]], [m.gain[1][0], m.gain[1][1]]]
+        };
+        let scale = gain.iter().flatten().fold(0.0f64, |s, g| s.max(g.abs()));
+        if (gain[0][1] - gain[1][0]).abs() > PSD_TOLERANCE * scale {
+            return Err(format!(
+                "mode {n}: gain is not symmetric ({} vs {})",
+                gain[0][1], gain[1][0]
+            ));
+        }
+        let [lowest, _] = symmetric_eigenvalues(gain[0][0], gain[0][1], gain[1][1]);
+        if lowest < -PSD_TOLERANCE * scale {
+            return Err(format!(
+                "mode {n}: gain is not positive semidefinite (eigenvalue {lowest:e}), so the \
+                 bridge would not be passive"
+            ));
+        }
+        modes.push(BridgeMode {
+            freq_hz: m.freq_hz,
+            bandwidth_hz: m.bandwidth_hz,
+            gain,
+        });
+    }
+    Ok((BridgeModes { modes }, ports))
+}
+
+/// The bridge as JSON text in the file format; `ports` 1 writes `"gain": [[g11]]`.
+pub fn bridge_json(bridge: &BridgeModes, ports: usize) -> String {
+    // One mode a line: readable, and a refit shows as a clean diff.
+    let lines: Vec<String> = bridge
+        .modes
+        .iter()
+        .map(|m| {
+            let mode = ModeFile {
+                freq_hz: m.freq_hz,
+                bandwidth_hz: m.bandwidth_hz,
+                gain: if ports == 1 {
+                    vec![vec![m.gain[0][0]]]
+                } else {
+                    m.gain.iter().map(|row| row.to_vec()).collect()
+                },
+            };
+            serde_json::to_string(&mode).expect("finite plain data serialises")
+        })
+        .collect();
+    format!(
+        "{{\n  \"modes\": [\n    {}\n  ]\n}}\n",
+        lines.join(",\n    ")
+    )
+}
+
+/// Writes the bridge JSON to `path` through a temporary file renamed at the end, so a
+/// failure never leaves a partial file.
+pub fn write_bridge(path: &Path, bridge: &BridgeModes, ports: usize) -> Result<(), String> {
+    write_atomically(path, bridge_json(bridge, ports).as_bytes())
+}
+
+/// Writes `bytes` to a temporary file beside `path`, then renames it to `path`.
+pub(crate) fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), String> {
+    let name = path
+        .file_name()
+        .ok_or_else(|| format!("{}: not a file path", path.display()))?;
+    let mut tmp_name = std::ffi::OsString::from(".");
+    tmp_name.push(name);
+    tmp_name.push(format!(".tmp{}", std::process::id()));
+    let tmp = path.with_file_name(tmp_name);
+    let result = std::fs::write(&tmp, bytes).and_then(|()| std::fs::rename(&tmp, path));
+    result.map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        format!("{}: {e}", path.display())
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn admittance_loader_reads_both_sizes_and_round_trips() {
+        let two = BridgeModes {
+            modes: vec![BridgeMode {
+                freq_hz: 200.0,
+                bandwidth_hz: 8.0,
+                gain: [[2.0, -0.5], [-0.5, 1.0]],
+            }],
+        };
+        assert_eq!(parse_bridge(&bridge_json(&two, 2)).unwrap(), (two, 2));
+        let one = r#"{"modes": [{"freq_hz": 100, "bandwidth_hz": 5, "gain": [[3]]}]}"#;
+        let (bridge, ports) = parse_bridge(one).unwrap();
+        assert_eq!(ports, 1);
+        assert_eq!(bridge.modes[0].gain, [[3.0, 0.0], [0.0, 0.0]]);
+    }
+
+    #[test]
+    fn admittance_loader_refuses_unstable_asymmetric_or_active_modes() {
+        let with = |f: &str, b: &str, g: &str| {
+            parse_bridge(&format!(
+                r#"{{"modes": [{{"freq_hz": {f}, "bandwidth_hz": {b}, "gain": {g}}}]}}"#
+            ))
+        };
+        assert!(with("100", "5", "[[1, 0], [0, 1]]").is_ok());
+        assert!(with("-100", "5", "[[1]]").unwrap_err().contains("freq_hz"));
+        assert!(with("100", "0", "[[1]]").unwrap_err().contains("stable"));
+        assert!(with("100", "5", "[[-1]]")
+            .unwrap_err()
+            .contains("semidefinite"));
+        assert!(with("100", "5", "[[1, 2], [2, 1]]")
+            .unwrap_err()
+            .contains("semidefinite"));
+        assert!(with("100", "5", "[[1, 0.5], [0.4, 1]]")
+            .unwrap_err()
+            .contains("symmetric"));
+        assert!(with("100", "5", "[[1, 0]]").unwrap_err().contains("2x2"));
+        assert!(parse_bridge(r#"{"modes": []}"#)
+            .unwrap_err()
+            .contains("no modes"));
+        assert!(parse_bridge("[1, 2]").unwrap_err().contains("not a bridge"));
+    }
+
+    #[test]
+    fn admittance_nearest_psd_keeps_psd_and_clips_the_rest() {
+        assert_eq!(nearest_psd(2.0, 0.5, 1.0), [[2.0, 0.5], [0.5, 1.0]]);
+        let g = nearest_psd(1.0, 2.0, 1.0);
+        let [lo, hi] = symmetric_eigenvalues(g[0][0], g[0][1], g[1][1]);
+        assert!(lo.abs() < 1e-12 && (hi - 3.0).abs() < 1e-12, "{lo} {hi}");
+        assert_eq!(nearest_psd(-1.0, 0.0, -2.0), [[0.0; 2]; 2]);
+    }
+}
