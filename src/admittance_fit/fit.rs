@@ -284,7 +284,8 @@ impl Spectrum {
             .iter()
             .flatten()
             .fold(0.0f64, |m, y| m.max(y.norm()));
-        if !(largest > 0.0) {
+        // Finite data (the CSV reader refuses anything else), so only zero is left.
+        if largest == 0.0 {
             return Err("the admittance is zero at every frequency".into());
         }
         let floor = WEIGHT_FLOOR * largest;
@@ -553,15 +554,12 @@ impl Spectrum {
             })
             .collect();
         let entries = self.targets.len();
-        let grams: Vec<DMatrix<f64>> = (0..entries)
+        let (grams, projections): (Vec<DMatrix<f64>>, Vec<DVector<f64>>) = (0..entries)
             .map(|e| {
-                let a = self.design(&basis, e);
-                a.transpose() * a
+                let a_t = self.design(&basis, e).transpose();
+                (&a_t * a_t.transpose(), a_t * &self.targets[e])
             })
-            .collect();
-        let projections: Vec<DVector<f64>> = (0..entries)
-            .map(|e| self.design(&basis, e).transpose() * &self.targets[e])
-            .collect();
+            .unzip();
         let total: f64 = self.targets.iter().map(|y| y.norm_squared()).sum();
         // One scale per mode (shared by its entries, so the cone is unchanged) makes the
         // columns of unit size; dividing by the data energy makes the cost of order one.
