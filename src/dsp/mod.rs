@@ -3,6 +3,7 @@
 //! ([`body`]), the instrument that wires them to notes and a bow ([`instrument`]).
 
 pub mod body;
+pub mod bridge;
 pub mod filters;
 pub mod friction;
 pub mod instrument;

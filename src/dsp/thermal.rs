@@ -314,6 +314,28 @@ impl ThermalString {
         thermal: ThermalParams,
         hair: HairParams,
     ) -> Result<Self, String> {
+        let c = 2.0 * spec.length_m * spec.f0_hz;
+        Self::at_rate(
+            spec,
+            nodes,
+            width_m,
+            c * nodes as f64 / width_m,
+            thermal,
+            hair,
+        )
+    }
+
+    /// The string run at a given internal rate (several strings coupled at one bridge share
+    /// one rate, set by the bowed string): the node spacing is then `c / fs`, so the bow
+    /// spans `N_B c / fs`, which is `width_m` only on the string that set the rate.
+    pub fn at_rate(
+        spec: ThermalStringSpec,
+        nodes: usize,
+        width_m: f64,
+        internal_rate_hz: f64,
+        thermal: ThermalParams,
+        hair: HairParams,
+    ) -> Result<Self, String> {
         thermal.validate()?;
         check_psd("nut", spec.nut_admittance)?;
         check_psd("bridge", spec.bridge_admittance)?;
@@ -326,9 +348,12 @@ impl ThermalString {
         if !(spec.f0_hz > 0.0 && spec.z0_kg_per_s > 0.0 && spec.length_m > 0.0 && spec.q1 > 0.0) {
             return Err("string frequency, impedance, length and Q must be positive".into());
         }
-        let dx = width_m / nodes as f64;
+        if !(internal_rate_hz.is_finite() && internal_rate_hz > 0.0) {
+            return Err(format!("invalid internal rate {internal_rate_hz}"));
+        }
         let c = 2.0 * spec.length_m * spec.f0_hz;
-        let fs = c / dx;
+        let fs = internal_rate_hz;
+        let dx = c / fs;
         let w1 = 2.0 * PI * spec.f0_hz / fs;
         let w2 = (20.0 * w1).min(0.4 * PI);
         // Per round trip: the fundamental decays at Q1, twenty times the frequency at Q1/2.
@@ -495,9 +520,16 @@ impl ThermalString {
         self.temperature.fill(0.0);
     }
 
-    /// One sample at the internal rate. A bow force of zero lifts the bow (no contact in
-    /// either plane).
+    /// One sample at the internal rate with the string's own (2x2 admittance) bridge. A bow
+    /// force of zero lifts the bow (no contact in either plane).
     pub fn tick(&mut self, bow: ThermalBowControl) -> ThermalFrame {
+        let mut frame = self.tick_contact(bow);
+        self.terminate_alone(&mut frame);
+        frame
+    }
+
+    /// The bow contact and thermal update of one sample (no terminations).
+    pub fn tick_contact(&mut self, bow: ThermalBowControl) -> ThermalFrame {
         let cap = self.m + 1;
         let m = self.m;
         let t = self.t;
@@ -625,24 +657,55 @@ impl ThermalString {
         }
         self.update_temperature(dt, dx);
 
-        // Terminations.
-        let mut at_bridge = [0.0; 2];
+        frame
+    }
+
+    fn terminate_alone(&mut self, frame: &mut ThermalFrame) {
+        let z = self.spec.z0_kg_per_s;
+        // Terminations: the string's own bridge reflection.
+        let at_bridge = self.arriving_at_bridge();
+        let rb = self.bridge_reflection;
+        let outgoing = [
+            rb[0][0] * at_bridge[0] + rb[0][1] * at_bridge[1],
+            rb[1][0] * at_bridge[0] + rb[1][1] * at_bridge[1],
+        ];
+        self.finish_sample(outgoing);
+        // Force on the bridge: incoming minus outgoing waves times Z, horizontal.
+        frame.bridge_force_n = z * (at_bridge[0] - outgoing[0]);
+    }
+
+    /// The `[h, v]` velocity waves arriving at the bridge this sample (after the loss
+    /// filter). Call once per sample, after [`ThermalString::tick_contact`] and before
+    /// [`ThermalString::finish_sample`]; the bridge model answers with the outgoing waves.
+    pub fn arriving_at_bridge(&mut self) -> [f64; 2] {
+        let cap = self.m + 1;
+        let i = (self.t + cap - (self.m - 1)) % cap;
+        [
+            self.loss[0].tick(self.left[0][i]),
+            self.loss[1].tick(self.left[1][i]),
+        ]
+    }
+
+    /// Ends the sample: writes the waves leaving the bridge, reflects at the nut, and
+    /// advances time.
+    pub fn finish_sample(&mut self, leaving_bridge: [f64; 2]) {
+        let cap = self.m + 1;
+        let i = (self.t + cap - (self.m - 1)) % cap;
         let mut at_nut = [0.0; 2];
         for p in 0..2 {
-            at_bridge[p] = self.loss[p].tick(self.left[p][at(m - 1)]);
-            at_nut[p] = self.fraction[p].tick(self.right[p][at(m - 1)]);
+            at_nut[p] = self.fraction[p].tick(self.right[p][i]);
         }
-        let rb = self.bridge_reflection;
         let rn = self.nut_reflection;
-        let next = (t + 1) % cap;
+        let next = (self.t + 1) % cap;
         for p in 0..2 {
-            self.right[p][next] = flush_tiny(rb[p][0] * at_bridge[0] + rb[p][1] * at_bridge[1]);
+            self.right[p][next] = flush_tiny(leaving_bridge[p]);
             self.left[p][next] = flush_tiny(rn[p][0] * at_nut[0] + rn[p][1] * at_nut[1]);
         }
-        // Force on the bridge: incoming plus outgoing waves, horizontal.
-        frame.bridge_force_n = z * (at_bridge[0] - self.right[0][next]);
         self.t = next;
-        frame
+    }
+
+    pub fn z0_kg_per_s(&self) -> f64 {
+        self.spec.z0_kg_per_s
     }
 
     /// Eq. (1) by FTCS with the sub-steps the stability bound asks for: diffusion over
