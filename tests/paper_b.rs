@@ -284,3 +284,64 @@ fn the_thermal_bow_renders_at_the_host_rate_in_tune_and_bounded() {
         assert!(free_cents.abs() < 2.0);
     }
 }
+
+#[test]
+fn bowing_one_string_makes_the_open_strings_ring_through_the_bridge() {
+    use colophony::dsp::bridge::generic_cello_bridge;
+    use colophony::dsp::thermal::ThermalQuartet;
+    // Cello C, G, D, A (Z0 from PARAMETERS.md §1.4 and §1.7), all 0.69 m.
+    let specs: Vec<ThermalStringSpec> = [
+        (65.41, 1.88),
+        (98.0, 0.833),
+        (146.83, 0.506),
+        (220.0, 0.504),
+    ]
+    .into_iter()
+    .map(|(f0_hz, z0_kg_per_s)| ThermalStringSpec {
+        f0_hz,
+        z0_kg_per_s,
+        ..ThermalStringSpec::cello_c()
+    })
+    .collect();
+    let run = |bridge: &[colophony::dsp::bridge::BridgeMode]| {
+        let mut q = ThermalQuartet::new(
+            &specs,
+            0,
+            6,
+            0.01,
+            bridge,
+            ThermalParams::default(),
+            HairParams::default(),
+        )
+        .unwrap();
+        let fs = q.internal_rate_hz();
+        let lifted = ThermalBowControl {
+            force_per_m: 0.0,
+            ..FIG6_BOW
+        };
+        let bowed = ThermalBowControl {
+            position_beta: 0.1,
+            ..FIG6_BOW
+        };
+        let mut bows = [lifted; 4];
+        bows[0] = bowed;
+        for _ in 0..(0.5 * fs) as usize {
+            q.tick(&bows, 0);
+        }
+        let energies: Vec<f64> = (0..4).map(|i| q.string(i).energy_j()).collect();
+        energies
+    };
+    let coupled = run(&generic_cello_bridge());
+    // A bridge without modes is rigid: no coupling.
+    let rigid = run(&[]);
+    println!("string energies after 0.5 s bowing C, generic bridge: {coupled:?}; rigid bridge: {rigid:?}");
+    for i in 1..4 {
+        // The open strings pick up energy through the bridge (at least 1e-6 of the bowed
+        // string's), and none at all on a rigid bridge.
+        assert!(coupled[i] > 1e-6 * coupled[0], "string {i}: {coupled:?}");
+        assert_eq!(rigid[i], 0.0);
+    }
+    // G's second partial (196 Hz) sits on C's third (196.2 Hz): G rings more than A, whose
+    // partials do not line up with C's (220 / 65.41 = 3.36).
+    assert!(coupled[1] > coupled[3], "{coupled:?}");
+}

@@ -62,7 +62,11 @@ impl Resampler {
                 if u >= HALF_WIDTH as f64 {
                     return 0.0;
                 }
-                let sinc = if u == 0.0 { 1.0 } else { (PI * u).sin() / (PI * u) };
+                let sinc = if u == 0.0 {
+                    1.0
+                } else {
+                    (PI * u).sin() / (PI * u)
+                };
                 let r = u / HALF_WIDTH as f64;
                 sinc * bessel_i0(KAISER_BETA * (1.0 - r * r).sqrt()) / i0b
             })
@@ -119,7 +123,8 @@ impl Resampler {
             let last = (centre + self.half_in).floor() as u64;
             let mut acc = 0.0;
             for k in first..=last {
-                acc += self.history[(k as usize) & mask] * self.kernel(self.g * (centre - k as f64));
+                acc +=
+                    self.history[(k as usize) & mask] * self.kernel(self.g * (centre - k as f64));
             }
             *y = super::filters::flush_tiny(acc * self.g);
             self.produced += 1;

@@ -765,3 +765,85 @@ mod tests {
         assert_eq!(reflection(1.0, [[0.0; 2]; 2]), [[-1.0, 0.0], [0.0, -1.0]]);
     }
 }
+
+/// Four strings (both polarisations) meeting at one modal bridge, all at the internal rate
+/// of the string the bow plays (paper B §5): bowing one string makes the others ring.
+#[derive(Debug, Clone)]
+pub struct ThermalQuartet {
+    strings: Vec<ThermalString>,
+    bridge: super::bridge::ModalBridge,
+    arriving: Vec<[f64; 2]>,
+    leaving: Vec<[f64; 2]>,
+    impedances: Vec<f64>,
+}
+
+/// One sample of the quartet.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct QuartetFrame {
+    /// Total force of the strings on the bridge `[h, v]`, N (the body's drive).
+    pub bridge_force_n: [f64; 2],
+    /// Bridge velocity `[h, v]`, m/s.
+    pub bridge_velocity_m_per_s: [f64; 2],
+    /// The bowed string's contact signals.
+    pub bowed: ThermalFrame,
+}
+
+impl ThermalQuartet {
+    /// `specs` are the four strings; `bowed` the one whose bow width sets the rate.
+    pub fn new(
+        specs: &[ThermalStringSpec],
+        bowed: usize,
+        nodes: usize,
+        width_m: f64,
+        bridge: &[super::bridge::BridgeMode],
+        thermal: ThermalParams,
+        hair: HairParams,
+    ) -> Result<Self, String> {
+        let lead = specs.get(bowed).ok_or("no such string")?;
+        let fs = 2.0 * lead.length_m * lead.f0_hz * nodes as f64 / width_m;
+        let strings = specs
+            .iter()
+            .map(|spec| ThermalString::at_rate(*spec, nodes, width_m, fs, thermal, hair))
+            .collect::<Result<Vec<_>, _>>()?;
+        let impedances = specs.iter().map(|s| s.z0_kg_per_s).collect();
+        Ok(Self {
+            bridge: super::bridge::ModalBridge::new(bridge, fs)?,
+            arriving: vec![[0.0; 2]; specs.len()],
+            leaving: vec![[0.0; 2]; specs.len()],
+            impedances,
+            strings,
+        })
+    }
+
+    pub fn internal_rate_hz(&self) -> f64 {
+        self.strings[0].internal_rate_hz()
+    }
+
+    pub fn string(&self, i: usize) -> &ThermalString {
+        &self.strings[i]
+    }
+
+    /// One sample; `bows[i]` is string `i`'s bow (zero force: not bowed).
+    pub fn tick(&mut self, bows: &[ThermalBowControl], report: usize) -> QuartetFrame {
+        let mut frame = QuartetFrame::default();
+        for (i, (string, bow)) in self.strings.iter_mut().zip(bows).enumerate() {
+            let f = string.tick_contact(*bow);
+            if i == report {
+                frame.bowed = f;
+            }
+            self.arriving[i] = string.arriving_at_bridge();
+        }
+        let (v, force) = super::bridge::solve_junction(
+            &mut self.bridge,
+            &self.arriving,
+            &self.impedances,
+            &mut self.leaving,
+        );
+        for (string, leaving) in self.strings.iter_mut().zip(&self.leaving) {
+            string.finish_sample(*leaving);
+        }
+        frame.bridge_force_n = force;
+        frame.bridge_velocity_m_per_s = v;
+        frame
+    }
+}
