@@ -287,7 +287,7 @@ fn the_thermal_bow_renders_at_the_host_rate_in_tune_and_bounded() {
 
 #[test]
 fn bowing_one_string_makes_the_open_strings_ring_through_the_bridge() {
-    use colophony::dsp::bridge::generic_cello_bridge;
+    use colophony::admittance_fit::shipped_cello_bridge;
     use colophony::dsp::thermal::ThermalQuartet;
     // Cello C, G, D, A (Z0 from PARAMETERS.md §1.4 and §1.7), all 0.69 m.
     let specs: Vec<ThermalStringSpec> = [
@@ -331,7 +331,8 @@ fn bowing_one_string_makes_the_open_strings_ring_through_the_bridge() {
         let energies: Vec<f64> = (0..4).map(|i| q.string(i).energy_j()).collect();
         energies
     };
-    let coupled = run(&generic_cello_bridge());
+    // The shipped generic cello bridge (assets/bridges/cello-generic.json).
+    let coupled = run(&shipped_cello_bridge().modes);
     // A bridge without modes is rigid: no coupling.
     let rigid = run(&[]);
     println!("string energies after 0.5 s bowing C, generic bridge: {coupled:?}; rigid bridge: {rigid:?}");

@@ -10,17 +10,9 @@ use std::path::Path;
 pub type C64 = Complex<f64>;
 
 /// One mode of the bridge's driving-point admittance,
-/// `gain * s / (s^2 + 2 pi bandwidth_hz s + (2 pi freq_hz)^2)`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct BridgeMode {
-    /// Undamped natural frequency (Hz).
-    pub freq_hz: f64,
-    /// Half-power bandwidth (Hz); the pole pair is `-pi b +- j sqrt((2 pi f)^2 - (pi b)^2)`.
-    pub bandwidth_hz: f64,
-    /// Symmetric positive semidefinite gain (1/kg = s/kg times rad/s), rows and columns
-    /// (horizontal, vertical). A 1x1 file loads as `[[g, 0], [0, 0]]`.
-    pub gain: [[f64; 2]; 2],
-}
+/// `gain * s / (s^2 + 2 pi bandwidth_hz s + (2 pi freq_hz)^2)`: the DSP core's type, which
+/// the physical bridge ([`crate::dsp::bridge::ModalBridge`]) runs.
+pub use crate::dsp::bridge::BridgeMode;
 
 /// A bridge: its modes, as loaded by [`load_bridge`].
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -286,4 +278,19 @@ mod tests {
         assert!(lo.abs() < 1e-12 && (hi - 3.0).abs() < 1e-12, "{lo} {hi}");
         assert_eq!(nearest_psd(-1.0, 0.0, -2.0), [[0.0; 2]; 2]);
     }
+}
+
+/// The shipped generic (designed, not measured) cello bridge, `assets/bridges/cello-generic.json`,
+/// embedded in the binary and validated.
+pub fn shipped_cello_bridge() -> BridgeModes {
+    parse_bridge(include_str!("../../assets/bridges/cello-generic.json"))
+        .expect("the shipped cello bridge is valid")
+        .0
+}
+
+/// The shipped generic violin bridge, `assets/bridges/violin-generic.json`.
+pub fn shipped_violin_bridge() -> BridgeModes {
+    parse_bridge(include_str!("../../assets/bridges/violin-generic.json"))
+        .expect("the shipped violin bridge is valid")
+        .0
 }

@@ -67,33 +67,6 @@ impl BridgeMode {
     }
 }
 
-/// A generic passive cello bridge used until measured data are loaded: a few body and
-/// bridge-hill modes (A0 ~100 Hz, main wood modes ~180-220 Hz, bridge hill ~2 kHz) with
-/// gains of the order of measured cello admittances (1e-2..1e-1 s/kg at the peaks).
-/// Labelled generic: designed, not measured.
-pub fn generic_cello_bridge() -> Vec<BridgeMode> {
-    // Peak admittances (s/kg) per mode, [[hh, hv], [hv, vv]], turned into G = peak 2 pi b.
-    let mode = |f: f64, q: f64, hh: f64, hv: f64, vv: f64| {
-        let b = f / q;
-        let g = 2.0 * PI * b;
-        BridgeMode {
-            freq_hz: f,
-            bandwidth_hz: b,
-            gain: [[hh * g, hv * g], [hv * g, vv * g]],
-        }
-    };
-    vec![
-        mode(102.0, 25.0, 0.02, 0.006, 0.03),
-        mode(185.0, 30.0, 0.03, -0.008, 0.02),
-        mode(220.0, 30.0, 0.025, 0.005, 0.04),
-        mode(410.0, 25.0, 0.02, 0.004, 0.015),
-        mode(560.0, 20.0, 0.015, -0.003, 0.02),
-        mode(1100.0, 15.0, 0.02, 0.005, 0.01),
-        mode(2000.0, 8.0, 0.04, 0.01, 0.02),
-        mode(3200.0, 8.0, 0.02, 0.005, 0.015),
-    ]
-}
-
 #[derive(Debug, Clone, Copy, Default)]
 struct Section {
     a1: f64,
@@ -254,6 +227,30 @@ pub fn solve_junction(
 mod tests {
     use super::*;
 
+    /// A few hand-made modes for the unit tests (the shipped bridges are data in assets/).
+    fn generic_cello_bridge() -> Vec<BridgeMode> {
+        // Peak admittances (s/kg) per mode, [[hh, hv], [hv, vv]], turned into G = peak 2 pi b.
+        let mode = |f: f64, q: f64, hh: f64, hv: f64, vv: f64| {
+            let b = f / q;
+            let g = 2.0 * PI * b;
+            BridgeMode {
+                freq_hz: f,
+                bandwidth_hz: b,
+                gain: [[hh * g, hv * g], [hv * g, vv * g]],
+            }
+        };
+        vec![
+            mode(102.0, 25.0, 0.02, 0.006, 0.03),
+            mode(185.0, 30.0, 0.03, -0.008, 0.02),
+            mode(220.0, 30.0, 0.025, 0.005, 0.04),
+            mode(410.0, 25.0, 0.02, 0.004, 0.015),
+            mode(560.0, 20.0, 0.015, -0.003, 0.02),
+            mode(1100.0, 15.0, 0.02, 0.005, 0.01),
+            mode(2000.0, 8.0, 0.04, 0.01, 0.02),
+            mode(3200.0, 8.0, 0.02, 0.005, 0.015),
+        ]
+    }
+
     #[test]
     fn the_generic_bridge_is_passive_on_a_dense_grid() {
         let bridge = ModalBridge::new(&generic_cello_bridge(), 48_000.0).unwrap();
@@ -280,8 +277,14 @@ mod tests {
                 let expected = mode.gain[0][0] / (2.0 * PI * mode.bandwidth_hz);
                 // Pre-warped bilinear: the peak is real and exact at f_m. 1e-7: rounding, from
                 // the cancellation in 1 - e^-2jw at w ~ 1e-3 rad.
-                assert!((y[0][0].0 / expected - 1.0).abs() < 1e-7, "{fs} Hz, {mode:?}: {y:?}");
-                assert!(y[0][0].1.abs() < 1e-7 * expected, "{fs} Hz, {mode:?}: {y:?}");
+                assert!(
+                    (y[0][0].0 / expected - 1.0).abs() < 1e-7,
+                    "{fs} Hz, {mode:?}: {y:?}"
+                );
+                assert!(
+                    y[0][0].1.abs() < 1e-7 * expected,
+                    "{fs} Hz, {mode:?}: {y:?}"
+                );
             }
         }
     }
