@@ -259,6 +259,10 @@ pub struct ThermalString {
     temperature_next: Vec<f64>,
     margin_nodes: usize,
     substeps: usize,
+    /// Whether the hair touched the string last sample (its state needs clearing on lift).
+    contact_active: bool,
+    /// Whether any grid point is above ambient (else the FTCS update is skipped).
+    thermal_active: bool,
     loss: [OnePoleLoss; 2],
     /// Thiran fractional delay at the nut, per polarisation (tuning).
     fraction: [Allpass1; 2],
@@ -412,6 +416,8 @@ impl ThermalString {
             temperature_next: zeros(grid),
             margin_nodes,
             substeps,
+            contact_active: true,
+            thermal_active: true,
             loss: [loss, loss],
             fraction: [fraction, fraction],
             nut_reflection: reflection(spec.z0_kg_per_s, spec.nut_admittance),
@@ -563,19 +569,26 @@ impl ThermalString {
         let (ir0, il0) = (at(self.bow_start), at(m - 1 - self.bow_start));
         let nodes = &mut self.nodes;
         if !on {
-            for v in [
-                &mut nodes.force,
-                &mut nodes.fy,
-                &mut nodes.v_delta,
-                &mut nodes.hair_x,
-                &mut nodes.hair_v,
-                &mut nodes.y,
-                &mut nodes.vy,
-            ] {
-                v.fill(0.0);
+            if !self.contact_active {
+                // Already lifted and cleared: nothing to do (an unbowed string costs only
+                // its waves).
+            } else {
+                for v in [
+                    &mut nodes.force,
+                    &mut nodes.fy,
+                    &mut nodes.v_delta,
+                    &mut nodes.hair_x,
+                    &mut nodes.hair_v,
+                    &mut nodes.y,
+                    &mut nodes.vy,
+                ] {
+                    v.fill(0.0);
+                }
+                nodes.slipping.fill(false);
+                self.contact_active = false;
             }
-            nodes.slipping.fill(false);
         } else {
+            self.contact_active = true;
             // Gather the incoming waves, solve every node (independent within a sample,
             // branch-free so it vectorises), scatter the outgoing waves.
             let (mut ir, mut il) = (ir0, il0);
@@ -655,7 +668,16 @@ impl ThermalString {
             let x = self.bow_start + mid;
             frame.string_velocity_m_per_s = self.right[0][at(x)] + self.left[0][at(m - 1 - x)];
         }
-        self.update_temperature(dt, dx);
+        // The grid idles once the bow is off and the contact has cooled to nothing.
+        if on || self.thermal_active {
+            self.update_temperature(dt, dx);
+            if !on {
+                self.thermal_active = self.temperature.iter().any(|t| *t != 0.0);
+            }
+        }
+        if on {
+            self.thermal_active = true;
+        }
 
         frame
     }
