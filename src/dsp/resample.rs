@@ -94,17 +94,6 @@ impl Resampler {
         self.produced = 0;
     }
 
-    #[inline]
-    fn kernel(&self, u: f64) -> f64 {
-        let x = u.abs() * TABLE_STEPS as f64;
-        let i = x as usize;
-        if i >= HALF_WIDTH * TABLE_STEPS {
-            return 0.0;
-        }
-        let f = x - i as f64;
-        self.table[i] + f * (self.table[i + 1] - self.table[i])
-    }
-
     /// Fills `out`, pulling input samples from `input` as needed. The output is delayed by
     /// [`Self::latency_samples`].
     pub fn process(&mut self, mut input: impl FnMut() -> f64, out: &mut [f64]) {
@@ -121,10 +110,22 @@ impl Resampler {
             let centre = p + self.half_in;
             let first = (centre - self.half_in).ceil().max(0.0) as u64;
             let last = (centre + self.half_in).floor() as u64;
+            // The kernel argument steps by -g per tap: walk the table with a running
+            // position instead of converting each tap's argument afresh.
+            let steps = TABLE_STEPS as f64;
+            let mut x = self.g * (centre - first as f64) * steps;
+            let dx = self.g * steps;
+            let table_end = (HALF_WIDTH * TABLE_STEPS) as f64;
             let mut acc = 0.0;
             for k in first..=last {
-                acc +=
-                    self.history[(k as usize) & mask] * self.kernel(self.g * (centre - k as f64));
+                let ax = x.abs();
+                if ax < table_end {
+                    let i = ax as usize;
+                    let f = ax - i as f64;
+                    let h = self.table[i] + f * (self.table[i + 1] - self.table[i]);
+                    acc += self.history[(k as usize) & mask] * h;
+                }
+                x -= dx;
             }
             *y = super::filters::flush_tiny(acc * self.g);
             self.produced += 1;

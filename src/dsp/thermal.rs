@@ -637,15 +637,16 @@ impl ThermalString {
                 let limit = mu * f_n;
                 let f_stick = (v_b + b - vp[i]) * inv_x_load;
                 let force = f_stick.max(-limit).min(limit);
-                let slipping = f_stick.abs() > limit;
-                let v_s = vp[i] + force * half_y;
                 let v_h = -a * force + b;
                 hx[i] += 0.5 * dt * (v_h + hv[i]);
                 hv[i] = v_h;
                 force_s[i] = force;
                 normal_s[i] = f_n;
-                slip_s[i] = slipping;
-                vd_s[i] = if slipping { v_s - (v_b + v_h) } else { 0.0 };
+                // v_s - (v_b + v_h) = (F - F_stick)(1 / 2Z + a): exactly 0 while sticking.
+                vd_s[i] = (force - f_stick) * (half_y + a);
+            }
+            for (slip, vd) in slip_s.iter_mut().zip(vd_s.iter()) {
+                *slip = *vd != 0.0;
             }
             let (mut ir, mut il) = (ir0, il0);
             for i in 0..n_b {
