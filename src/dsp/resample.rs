@@ -4,7 +4,9 @@
 //! A windowed-sinc interpolator evaluated at arbitrary (irrational) ratios: output sample
 //! `n` sits at input position `p = n fs_in / fs_out`; it is
 //! `y(n) = sum_k x(k) g h(g (p - k))` with `g = fc / fs_in * 2`, `h` a Kaiser-windowed sinc
-//! (beta 9, half-width [`HALF_WIDTH`] zero crossings of the cut-off) and the cut-off `fc`
+//! (beta 8, half-width [`HALF_WIDTH`] zero crossings of the cut-off; 10 rather than 16
+//! halves the cost, about 400 -> 250 taps per output sample from 541.6 kHz, for aliases
+//! at -73 dB instead of -94 dB) and the cut-off `fc`
 //! 0.45 of the lower of the two rates (its -6 dB point; flat to 0.8 of it). The kernel is tabulated ([`TABLE_STEPS`] points per
 //! zero crossing, linearly interpolated). It pulls input on demand, so the model runs
 //! exactly as many internal samples as the output needs. No allocation after `new`.
@@ -13,10 +15,10 @@
 use std::f64::consts::PI;
 
 /// Zero crossings of the kernel on each side.
-pub const HALF_WIDTH: usize = 16;
+pub const HALF_WIDTH: usize = 10;
 /// Table points per zero crossing.
 pub const TABLE_STEPS: usize = 256;
-const KAISER_BETA: f64 = 9.0;
+const KAISER_BETA: f64 = 8.0;
 
 fn bessel_i0(x: f64) -> f64 {
     let (mut sum, mut term, mut k) = (1.0, 1.0, 1.0);
@@ -158,19 +160,19 @@ mod tests {
         let fs_in = 541_595.0;
         let fs_out = 48_000.0;
         // Pass band to 0.8 of the cut-off (17.3 kHz at 48 kHz): the cut-off itself is the
-        // kernel's -6 dB point and 32 zero crossings leave a transition of about +-2.5 kHz.
+        // kernel's -6 dB point and 20 zero crossings leave a transition of about +-4 kHz.
         for f in [100.0, 1000.0, 10_000.0, 17_000.0] {
             let gain_db = 20.0 * tone_through(fs_in, fs_out, f).log10();
             println!("{f} Hz: {gain_db:+.4} dB");
-            // 0.05 dB: Kaiser beta 9 ripple is far smaller; the RMS estimate over whole
+            // 0.05 dB: the Kaiser ripple is far smaller; the RMS estimate over whole
             // and partial periods adds a little.
             assert!(gain_db.abs() < 0.05, "{f} Hz: {gain_db} dB");
         }
         for f in [27_000.0, 30_000.0, 50_000.0, 100_000.0] {
             let alias_db = 20.0 * tone_through(fs_in, fs_out, f).log10();
             println!("{f} Hz (would alias): {alias_db:.1} dB");
-            // Kaiser beta 9 gives about -90 dB stop-band attenuation; 27 kHz sits just
-            // past the transition band (21.6-26.4 kHz).
+            // The design target: aliases of a full-scale tone at or below -70 dB. 27 kHz sits
+            // at the edge of the transition band (21.6 kHz +- about 5 kHz).
             assert!(alias_db < -70.0, "{f} Hz leaks at {alias_db} dB");
         }
     }
