@@ -167,3 +167,108 @@ pub fn table1() -> Result<String, String> {
     }
     Ok(lines.join("\n"))
 }
+
+/// `colophony bench scenes`: the cost of common scenes with and without skipping what does
+/// not sound (sleeping strings), and the error skipping introduces against computing
+/// everything, from one run. Cello, defaults, 4 s at 48 kHz, blocks of 256.
+pub fn scenes() -> Result<String, String> {
+    use crate::dsp::instrument::Instrument;
+    let fs = 48_000.0;
+    let seconds = 4.0;
+    let frames = (seconds * fs) as usize;
+    let s = |t: f64| (t * fs) as usize;
+    type Score = Vec<(usize, bool, u8)>;
+    let on = |t: usize, n: u8| (t, true, n);
+    let off = |t: usize, n: u8| (t, false, n);
+    let scenes: Vec<(&str, Score)> = vec![
+        ("silence", vec![]),
+        ("one string bowed", vec![on(0, 50)]),
+        ("one string decaying", vec![on(0, 50), off(s(0.5), 50)]),
+        ("double stop", vec![on(0, 50), on(0, 57)]),
+        (
+            "four-string chord ringing",
+            vec![
+                on(0, 36),
+                on(0, 43),
+                on(0, 50),
+                on(0, 57),
+                off(s(0.3), 36),
+                off(s(0.3), 43),
+                off(s(0.3), 50),
+                off(s(0.3), 57),
+            ],
+        ),
+        (
+            "short phrase",
+            vec![
+                on(0, 50),
+                off(s(0.5), 50),
+                on(s(0.5), 52),
+                off(s(1.0), 52),
+                on(s(1.0), 57),
+                off(s(1.6), 57),
+                on(s(1.6), 62),
+                off(s(2.2), 62),
+            ],
+        ),
+    ];
+    let render = |score: &Score, skipping: bool| -> Vec<f64> {
+        let mut inst = Instrument::new(InstrumentKind::Cello, fs);
+        inst.set_skipping(skipping);
+        let bow = BowControl::default();
+        let mut out = Vec::with_capacity(frames);
+        let mut next = 0;
+        for i in 0..frames {
+            if i % 256 == 0 {
+                inst.update_sleep();
+            }
+            while next < score.len() && score[next].0 == i {
+                let (_, down, note) = score[next];
+                if down {
+                    inst.note_on(note);
+                } else {
+                    inst.note_off(note);
+                }
+                next += 1;
+            }
+            out.push(inst.tick(bow).audio);
+        }
+        out
+    };
+    let mut lines = vec![
+        format!("Cello, {seconds} s at 48 kHz, best of three; cost in % of one core."),
+        String::new(),
+        "| scene | computing everything (%) | skipping (%) | saving | largest difference (dB below peak) |".to_string(),
+        "|---|---|---|---|---|".to_string(),
+    ];
+    let mut costs = Vec::new();
+    for (name, score) in &scenes {
+        let mut full = Vec::new();
+        let mut skipped = Vec::new();
+        let full_s = best_of_three(|| full = render(score, false));
+        let skip_s = best_of_three(|| skipped = render(score, true));
+        let peak = full.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let diff = full
+            .iter()
+            .zip(&skipped)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        let db = if diff == 0.0 {
+            "identical".to_string()
+        } else {
+            format!("{:.0}", 20.0 * (diff / peak.max(1e-30)).log10())
+        };
+        lines.push(format!(
+            "| {name} | {:.3} | {:.3} | {:.1}x | {db} |",
+            100.0 * full_s / seconds,
+            100.0 * skip_s / seconds,
+            full_s / skip_s
+        ));
+        costs.push(skip_s);
+    }
+    lines.push(String::new());
+    lines.push(format!(
+        "Silence costs {:.1} % of one bowed string.",
+        100.0 * costs[0] / costs[1]
+    ));
+    Ok(lines.join("\n"))
+}

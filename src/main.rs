@@ -230,8 +230,9 @@ fn main() -> ExitCode {
         Command::Bench { what } => report(match what.as_str() {
             "friction" => colophony::bench::friction_table(),
             "table1" => colophony::bench::table1(),
+            "scenes" => colophony::bench::scenes(),
             other => Err(format!(
-                "unknown bench '{other}': choose friction or table1"
+                "unknown bench '{other}': choose friction, table1 or scenes"
             )),
         }),
         Command::FitBridge { input, modes, out } => {

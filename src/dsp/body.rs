@@ -55,4 +55,11 @@ impl BodyModes {
     pub fn reset(&mut self) {
         self.filters.iter_mut().for_each(Bandpass::reset);
     }
+
+    /// Whether every mode has rung out below `level` (state magnitude, N-scale).
+    pub fn is_quiet(&self, level: f64) -> bool {
+        self.filters[..self.count]
+            .iter()
+            .all(|f| f.state_magnitude() < level)
+    }
 }

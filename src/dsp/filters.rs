@@ -132,6 +132,11 @@ pub struct Bandpass {
 }
 
 impl Bandpass {
+    /// Largest state magnitude (to tell when the filter has rung out).
+    pub fn state_magnitude(&self) -> f64 {
+        self.s1.abs().max(self.s2.abs())
+    }
+
     pub fn new(freq_hz: f64, q: f64, sample_rate_hz: f64) -> Self {
         let w0 = 2.0 * PI * freq_hz / sample_rate_hz;
         let alpha = w0.sin() / (2.0 * q);

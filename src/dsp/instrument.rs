@@ -199,6 +199,10 @@ pub struct Instrument {
     probed: usize,
     ramp_step: f64,
     output_scale: f64,
+    /// Whether quiet lifted strings sleep (the default; off only to measure the saving).
+    skipping: bool,
+    /// No string awake and the body rung out: a sample costs nothing.
+    body_asleep: bool,
 }
 
 impl Instrument {
@@ -229,6 +233,8 @@ impl Instrument {
             probed: 0,
             ramp_step: 1.0 / (BOW_RAMP_S * sample_rate_hz),
             output_scale: kind.output_scale_per_n(),
+            skipping: true,
+            body_asleep: true,
         }
     }
 
@@ -332,6 +338,15 @@ impl Instrument {
     /// Puts lifted strings whose energy fell below [`SLEEP_ENERGY_J`] to sleep. Called once
     /// per block by the plugin and the renderer (it walks the delay lines).
     pub fn update_sleep(&mut self) {
+        if !self.skipping {
+            return;
+        }
+        // The body sleeps too once no string is awake and its modes have rung out
+        // (state below 1e-12 N: output below -200 dB of a bowed note).
+        self.body_asleep = self.voices.iter().all(|v| !v.awake) && self.body.is_quiet(1e-12);
+        if self.body_asleep {
+            self.body.reset();
+        }
         for voice in &mut self.voices {
             if voice.awake
                 && !voice.bowed
@@ -349,8 +364,13 @@ impl Instrument {
     pub fn tick(&mut self, bow: BowControl) -> Frame {
         let mut bridge = 0.0;
         let mut frame = Frame::default();
+        let skipping = self.skipping;
+        if skipping && self.body_asleep && self.voices.iter().all(|v| !v.awake) {
+            return Frame::default();
+        }
+        self.body_asleep = false;
         for (i, voice) in self.voices.iter_mut().enumerate() {
-            if !voice.awake {
+            if !voice.awake && skipping {
                 continue;
             }
             let target = if voice.bowed { 1.0 } else { 0.0 };
@@ -381,6 +401,17 @@ impl Instrument {
             frame = Frame::default();
         }
         frame
+    }
+
+    /// Turns sleeping off (every string is computed every sample) or on. Off only serves
+    /// to measure what skipping saves and changes: `colophony bench scenes`.
+    pub fn set_skipping(&mut self, skipping: bool) {
+        self.skipping = skipping;
+    }
+
+    /// Strings computed on the next sample.
+    pub fn awake_strings(&self) -> usize {
+        self.voices.iter().filter(|v| v.awake).count()
     }
 
     /// Renders `out.len()` samples of audio with constant bow settings: a loop over
