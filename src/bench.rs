@@ -107,20 +107,7 @@ pub fn table1() -> Result<String, String> {
         force_per_m: 0.0,
         ..bowed
     };
-    // Cello C, G, D, A: Z0 from PARAMETERS.md §1.4 and §1.7, 0.69 m.
-    let specs: Vec<ThermalStringSpec> = [
-        (65.41, 1.88),
-        (98.0, 0.833),
-        (146.83, 0.506),
-        (220.0, 0.504),
-    ]
-    .into_iter()
-    .map(|(f0_hz, z0_kg_per_s)| ThermalStringSpec {
-        f0_hz,
-        z0_kg_per_s,
-        ..ThermalStringSpec::cello_c()
-    })
-    .collect();
+    let specs = ThermalStringSpec::cello_strings();
     let bridge = shipped_cello_bridge().modes;
     let audio_s = 1.0;
     let out_rate = 48_000.0;

@@ -21,7 +21,8 @@ use std::sync::Once;
 const WIDTH: u32 = 1400;
 const HEIGHT: u32 = 560;
 
-fn fonts() {
+/// Registers the bundled font for plotters (once per process).
+pub(crate) fn fonts() {
     static REGISTER: Once = Once::new();
     REGISTER.call_once(|| {
         // Only fails for invalid font data; the bundled font is valid.

@@ -90,6 +90,18 @@ pub struct Rendered {
     pub newton: SolverStats,
 }
 
+impl Rendered {
+    fn with_capacity(sample_rate_hz: f64, frames: usize) -> Self {
+        Self {
+            sample_rate_hz,
+            audio: Vec::with_capacity(frames),
+            bow_point_velocity_m_per_s: Vec::with_capacity(frames),
+            friction_force_n: Vec::with_capacity(frames),
+            newton: SolverStats::default(),
+        }
+    }
+}
+
 fn check(settings: &RenderSettings) -> Result<(), RenderError> {
     let bad = |s: String| Err(RenderError::BadSetting(s));
     let b = &settings.bow;
@@ -149,13 +161,7 @@ pub fn render(settings: &RenderSettings) -> Result<Rendered, RenderError> {
         .map_err(RenderError::BadSetting)?;
     instrument.set_friction_model(settings.friction);
     instrument.note_on(settings.note);
-    let mut out = Rendered {
-        sample_rate_hz: fs,
-        audio: Vec::with_capacity(frames),
-        bow_point_velocity_m_per_s: Vec::with_capacity(frames),
-        friction_force_n: Vec::with_capacity(frames),
-        newton: SolverStats::default(),
-    };
+    let mut out = Rendered::with_capacity(fs, frames);
     for i in 0..frames {
         if i % BLOCK == 0 {
             instrument.update_sleep();
@@ -213,13 +219,7 @@ pub fn render_thermal(
         Resampler::new(string.internal_rate_hz(), fs).map_err(RenderError::BadSetting)?;
     let frames = (settings.seconds * fs).round() as usize;
     let release = settings.release_s.map(|s| (s * fs).round() as usize);
-    let mut out = Rendered {
-        sample_rate_hz: fs,
-        audio: Vec::with_capacity(frames),
-        bow_point_velocity_m_per_s: Vec::with_capacity(frames),
-        friction_force_n: Vec::with_capacity(frames),
-        newton: SolverStats::default(),
-    };
+    let mut out = Rendered::with_capacity(fs, frames);
     // Three signals through three resamplers would triple the cost; the probe channels
     // share the audio's resampler by running the string once per block into buffers.
     let mut probe_resamplers = [resampler.clone(), resampler.clone()];
@@ -295,13 +295,7 @@ pub fn render_rubbed(
     let mut scene = RubbedScene::from_spec(preset.spec(), friction, sample_rate_hz)
         .map_err(RenderError::BadSetting)?;
     let frames = (seconds * sample_rate_hz).round() as usize;
-    let mut out = Rendered {
-        sample_rate_hz,
-        audio: Vec::with_capacity(frames),
-        bow_point_velocity_m_per_s: Vec::with_capacity(frames),
-        friction_force_n: Vec::with_capacity(frames),
-        newton: SolverStats::default(),
-    };
+    let mut out = Rendered::with_capacity(sample_rate_hz, frames);
     for _ in 0..frames {
         let frame = scene.tick();
         out.audio.push(frame.audio);

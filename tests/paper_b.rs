@@ -289,20 +289,7 @@ fn the_thermal_bow_renders_at_the_host_rate_in_tune_and_bounded() {
 fn bowing_one_string_makes_the_open_strings_ring_through_the_bridge() {
     use colophony::admittance_fit::shipped_cello_bridge;
     use colophony::dsp::thermal::ThermalQuartet;
-    // Cello C, G, D, A (Z0 from PARAMETERS.md §1.4 and §1.7), all 0.69 m.
-    let specs: Vec<ThermalStringSpec> = [
-        (65.41, 1.88),
-        (98.0, 0.833),
-        (146.83, 0.506),
-        (220.0, 0.504),
-    ]
-    .into_iter()
-    .map(|(f0_hz, z0_kg_per_s)| ThermalStringSpec {
-        f0_hz,
-        z0_kg_per_s,
-        ..ThermalStringSpec::cello_c()
-    })
-    .collect();
+    let specs = ThermalStringSpec::cello_strings();
     let run = |bridge: &[colophony::dsp::bridge::BridgeMode]| {
         let mut q = ThermalQuartet::new(
             &specs,

@@ -5,21 +5,7 @@ use super::bridge::{load_bridge_ports, BridgeModes};
 use super::data::{entry_position, read_admittance_csv, AdmittanceData};
 use super::fit::fit_errors;
 use plotters::prelude::*;
-use plotters::style::{register_font, FontStyle};
 use std::path::Path;
-use std::sync::Once;
-
-fn fonts() {
-    static REGISTER: Once = Once::new();
-    REGISTER.call_once(|| {
-        // Only fails for invalid font data; the bundled font is valid.
-        let _ = register_font(
-            "sans-serif",
-            FontStyle::Normal,
-            epaint_default_fonts::UBUNTU_LIGHT,
-        );
-    });
-}
 
 fn err(e: impl std::fmt::Display) -> String {
     e.to_string()
@@ -55,7 +41,7 @@ pub fn draw(
     title: &str,
     out: &Path,
 ) -> Result<(), String> {
-    fonts();
+    crate::figures::fonts();
     let ports = data.ports();
     let columns = data.entries.len();
     let (width, height) = (520 * columns as u32 + 60, 900u32);

@@ -177,6 +177,21 @@ pub struct ThermalStringSpec {
 }
 
 impl ThermalStringSpec {
+    /// The cello's four strings C, G, D, A (Z0 from PARAMETERS.md §1.4 and §1.7), 0.69 m.
+    pub fn cello_strings() -> [Self; 4] {
+        [
+            (65.41, 1.88),
+            (98.0, 0.833),
+            (146.83, 0.506),
+            (220.0, 0.504),
+        ]
+        .map(|(f0_hz, z0_kg_per_s)| Self {
+            f0_hz,
+            z0_kg_per_s,
+            ..Self::cello_c()
+        })
+    }
+
     /// Cello open C (PARAMETERS.md §1.7: Z0 ~ 1.85-1.91 kg/s, L 0.67-0.69 m).
     pub fn cello_c() -> Self {
         Self {
