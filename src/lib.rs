@@ -218,7 +218,7 @@ impl Plugin for Colophony {
                     bow.force_n / DEFAULT_BOW.force_n,
                 );
             }
-            let out = dsp::filters::flush_tiny(audio * gain) as f32;
+            let out = dsp::filters::safety_limit(dsp::filters::flush_tiny(audio * gain)) as f32;
             for s in channels.iter_mut() {
                 *s = out;
             }

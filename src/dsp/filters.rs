@@ -175,9 +175,45 @@ pub fn flush_tiny(x: f64) -> f64 {
     }
 }
 
+/// Output safety limiter: the identity up to `SAFETY_KNEE` of full scale, then a smooth
+/// (C1) curve that approaches but never exceeds 1. Only extreme bowing (several N at over
+/// 1 m/s near the bridge) reaches it; it keeps a host's output audible-sane.
+pub const SAFETY_KNEE: f64 = 0.9;
+
+#[inline]
+pub fn safety_limit(x: f64) -> f64 {
+    let a = x.abs();
+    if a <= SAFETY_KNEE {
+        x
+    } else {
+        let room = 1.0 - SAFETY_KNEE;
+        let over = (a - SAFETY_KNEE) / room;
+        x.signum() * (SAFETY_KNEE + room * over / (1.0 + over))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_safety_limiter_is_transparent_below_its_knee_and_never_reaches_full_scale() {
+        for x in [-0.9, -0.5, 0.0, 0.3, 0.9] {
+            assert_eq!(safety_limit(x), x);
+        }
+        let mut last = 0.0;
+        for k in 1..2000 {
+            let x = 0.9 + k as f64 * 0.05;
+            let y = safety_limit(x);
+            assert!(y > last && y < 1.0, "{x} -> {y}");
+            assert_eq!(safety_limit(-x), -y);
+            last = y;
+        }
+        // C1 at the knee: slope 1 on both sides.
+        let h = 1e-7;
+        let slope = (safety_limit(SAFETY_KNEE + h) - SAFETY_KNEE) / h;
+        assert!((slope - 1.0).abs() < 1e-5);
+    }
 
     #[test]
     fn thiran_coefficient_gives_the_requested_phase_delay() {
