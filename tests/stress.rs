@@ -3,8 +3,8 @@
 //! Fixed seeds (a SplitMix64 generator), so a failure replays exactly.
 //!
 //! The quick variant (CI) renders about 40 s of audio across the matrix; set
-//! `COLOPHONY_STRESS_SECONDS` (per case) for the long one, e.g. 30 for ~1 h of audio in
-//! total: `COLOPHONY_STRESS_SECONDS=30 cargo test --release --test stress -- --nocapture`.
+//! `COLOPHONY_STRESS_SECONDS` (per case) for the long one, e.g. 110 for ~1 h of audio in
+//! total: `COLOPHONY_STRESS_SECONDS=110 cargo test --release --test stress -- --nocapture`.
 
 use colophony::dsp::friction::FrictionModel;
 use colophony::dsp::instrument::{BowControl, Instrument, InstrumentKind};
