@@ -9,6 +9,7 @@ pub mod admittance_fit;
 pub mod analysis;
 pub mod bench;
 pub mod dsp;
+pub mod editor;
 pub mod figures;
 pub mod params;
 pub mod render;
