@@ -37,6 +37,10 @@ pub struct Colophony {
     resonator: Option<RubbedPreset>,
     /// Held notes, so a resonator switch can move them to the new resonator.
     held: [bool; 128],
+    /// The last note the strings took; the editor draws its Schelleng window.
+    last_note: Option<u8>,
+    /// Written once per block for the editor (one relaxed atomic store).
+    editor_link: Arc<editor::EditorLink>,
 }
 
 impl Default for Colophony {
@@ -48,6 +52,8 @@ impl Default for Colophony {
             rubbed: RubbedInstrument::new(48_000.0),
             resonator: None,
             held: [false; 128],
+            last_note: None,
+            editor_link: Arc::new(editor::EditorLink::default()),
             params,
         }
     }
@@ -60,6 +66,7 @@ impl Colophony {
             None => {
                 if self.instrument.note_on(note).is_some() {
                     self.held[note as usize & 127] = true;
+                    self.last_note = Some(note);
                 }
             }
             Some(_) => {
@@ -146,12 +153,19 @@ impl Plugin for Colophony {
     const MIDI_INPUT: MidiConfig = MidiConfig::MidiCCs;
     const SAMPLE_ACCURATE_AUTOMATION: bool = true;
 
-    type Editor = ();
+    type Editor = editor::ColophonyEditor;
     type SysExMessage = ();
     type BackgroundTask = ();
 
     fn params(&self) -> Arc<dyn Params> {
         self.params.clone()
+    }
+
+    fn editor(&mut self, _async_executor: AsyncExecutor<Self>) -> Option<Self::Editor> {
+        Some(editor::ColophonyEditor::new(
+            self.params.clone(),
+            self.editor_link.clone(),
+        ))
     }
 
     fn activate(
@@ -229,6 +243,7 @@ impl Plugin for Colophony {
             self.handle_event(event);
             next_event = context.next_event();
         }
+        self.editor_link.set_note(self.last_note);
         if self.instrument.is_sounding() || self.rubbed.is_sounding() {
             ProcessStatus::KeepAlive
         } else {

@@ -117,6 +117,9 @@ pub struct ColophonyParams {
     pub friction_model: EnumParam<FrictionChoice>,
     #[id = "resonator"]
     pub resonator: EnumParam<ResonatorChoice>,
+    /// The editor window's size, saved with the plugin state (not a parameter).
+    #[persist = "editor-state"]
+    pub editor_state: crate::editor::EditorState,
 }
 
 pub fn bow_velocity_range() -> FloatRange {
@@ -172,6 +175,7 @@ impl Default for ColophonyParams {
             .with_smoother(SmoothingStyle::Linear(10.0)),
             friction_model: EnumParam::new("Friction Model", FrictionChoice::Hyperbolic),
             resonator: EnumParam::new("Resonator", ResonatorChoice::Strings),
+            editor_state: Default::default(),
         }
     }
 }

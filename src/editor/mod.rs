@@ -1,4 +1,385 @@
 //! The plugin editor (nice-plug-egui): an XY pad for bow velocity and force with the
 //! Schelleng window behind it, the bow position and the model selectors.
+//!
+//! * [`mapping`]: the pad's pixel <-> parameter mapping and the Schelleng curves (pure).
+//! * [`pad`]: the pad widget and its begin/set/end gestures.
+//! * [`view`]: the editor's contents, drawn into any `egui::Ui` ([`EditorUi`]).
+//! * This file: the window glue. [`ColophonyEditor`] is the plugin's `Editor`;
+//!   [`EditorState`] is the window size saved with the plugin state
+//!   (`#[persist = "editor-state"]` in [`crate::params::ColophonyParams`]); [`EditorLink`]
+//!   carries what the audio thread tells the editor (the current note).
+//!
+//! **Why a wrapper around `EguiEditor`.** nice-plug-egui 0.6's `EguiEditorState` has no
+//! serde support and no way to set its size after creation, and `Plugin::editor` is called
+//! once when the plugin is created, before the host loads the saved state. So the window
+//! size lives in [`EditorState`] (persisted), every resize writes it, and
+//! [`ColophonyEditor`] rebuilds its `EguiEditor` from it whenever they differ while the
+//! window is closed (after a state load), before the host asks for the size or opens the
+//! window.
 
 pub mod mapping;
+pub mod pad;
+pub mod view;
+
+pub use view::EditorUi;
+
+use crate::params::ColophonyParams;
+use nice_plug::context::gui::GuiContext;
+use nice_plug::editor::dpi::{LogicalSize, NativeSize, Size};
+use nice_plug::editor::{Editor, HostMethods, ParentWindowHandle, ResizeHint, SpawnedEditor};
+use nice_plug::params::persist::PersistentField;
+use nice_plug::plugin::TrackInfo;
+use nice_plug_egui::baseview::{HandlerError, WindowSize};
+use nice_plug_egui::{
+    create_egui_editor, EguiEditor, EguiEditorHandle, EguiEditorState, EguiNiceSettings, Frame,
+    NiceEguiApp, RepaintNotifier,
+};
+use serde::{Deserialize, Serialize};
+use std::error::Error;
+use std::sync::atomic::{AtomicU64, AtomicU8, Ordering};
+use std::sync::{Arc, Mutex, MutexGuard};
+
+/// The editor window's size in logical points.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct EditorSize {
+    pub width: f32,
+    pub height: f32,
+}
+
+impl EditorSize {
+    pub const DEFAULT: Self = Self {
+        width: 820.0,
+        height: 540.0,
+    };
+    pub const MIN: Self = Self {
+        width: 640.0,
+        height: 430.0,
+    };
+    pub const MAX: Self = Self {
+        width: 4096.0,
+        height: 4096.0,
+    };
+
+    /// Clamped to [`Self::MIN`] .. [`Self::MAX`]; the default if not finite (a damaged state).
+    pub fn sanitized(self) -> Self {
+        if !(self.width.is_finite() && self.height.is_finite()) {
+            return Self::DEFAULT;
+        }
+        Self {
+            width: self.width.clamp(Self::MIN.width, Self::MAX.width),
+            height: self.height.clamp(Self::MIN.height, Self::MAX.height),
+        }
+    }
+}
+
+/// The persisted editor state: the window size, both halves in one atomic so a save never
+/// sees half a resize.
+#[derive(Debug)]
+pub struct EditorState {
+    bits: AtomicU64,
+}
+
+impl EditorState {
+    fn pack(size: EditorSize) -> u64 {
+        (size.width.to_bits() as u64) << 32 | size.height.to_bits() as u64
+    }
+
+    pub fn size(&self) -> EditorSize {
+        let bits = self.bits.load(Ordering::Acquire);
+        EditorSize {
+            width: f32::from_bits((bits >> 32) as u32),
+            height: f32::from_bits(bits as u32),
+        }
+    }
+
+    pub fn set_size(&self, size: EditorSize) {
+        self.bits
+            .store(Self::pack(size.sanitized()), Ordering::Release);
+    }
+}
+
+impl Default for EditorState {
+    fn default() -> Self {
+        Self {
+            bits: AtomicU64::new(Self::pack(EditorSize::DEFAULT)),
+        }
+    }
+}
+
+impl<'a> PersistentField<'a, EditorSize> for EditorState {
+    fn set(&self, new_value: EditorSize) {
+        self.set_size(new_value);
+    }
+
+    fn map<F, R>(&self, f: F) -> R
+    where
+        F: Fn(&EditorSize) -> R,
+    {
+        f(&self.size())
+    }
+}
+
+/// What the audio thread tells the editor, lock-free: written once per block.
+#[derive(Debug)]
+pub struct EditorLink {
+    note: AtomicU8,
+}
+
+impl EditorLink {
+    const NO_NOTE: u8 = u8::MAX;
+
+    /// Audio thread: the last note the strings took (`None` before any).
+    pub fn set_note(&self, note: Option<u8>) {
+        self.note
+            .store(note.unwrap_or(Self::NO_NOTE), Ordering::Relaxed);
+    }
+
+    pub fn note(&self) -> Option<u8> {
+        match self.note.load(Ordering::Relaxed) {
+            Self::NO_NOTE => None,
+            note => Some(note),
+        }
+    }
+}
+
+impl Default for EditorLink {
+    fn default() -> Self {
+        Self {
+            note: AtomicU8::new(Self::NO_NOTE),
+        }
+    }
+}
+
+/// The nice-plug-egui app: builds an [`EditorUi`] when the window opens, drops it (ending
+/// any open gesture) when it closes, and saves every resize in [`EditorState`].
+pub struct EditorApp {
+    params: Arc<ColophonyParams>,
+    link: Arc<EditorLink>,
+    ui: Option<EditorUi>,
+}
+
+impl NiceEguiApp for EditorApp {
+    fn build(
+        &mut self,
+        _egui_ctx: egui::Context,
+        nice_gui_ctx: GuiContext,
+        _frame: &mut Frame,
+    ) -> Result<(), HandlerError> {
+        self.ui = Some(EditorUi::new(
+            self.params.clone(),
+            self.link.clone(),
+            nice_gui_ctx,
+        ));
+        Ok(())
+    }
+
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut Frame) {
+        if let Some(editor) = &mut self.ui {
+            editor.ui(ui);
+        }
+    }
+
+    fn resized(&mut self, new_size: WindowSize) {
+        self.params.editor_state.set_size(EditorSize {
+            width: new_size.logical.width as f32,
+            height: new_size.logical.height as f32,
+        });
+    }
+
+    fn editor_closed(&mut self) {
+        self.ui = None;
+    }
+}
+
+impl Drop for EditorUi {
+    fn drop(&mut self) {
+        self.end_gestures();
+    }
+}
+
+struct Built {
+    state: Arc<EguiEditorState>,
+    editor: EguiEditor<EditorApp>,
+}
+
+impl Built {
+    fn size(&self) -> Option<EditorSize> {
+        match self.state.size() {
+            Size::Logical(l) => Some(EditorSize {
+                width: l.width as f32,
+                height: l.height as f32,
+            }),
+            Size::Physical(_) => None,
+        }
+    }
+}
+
+/// The plugin's editor: an `EguiEditor` rebuilt from the persisted size when needed.
+pub struct ColophonyEditor {
+    params: Arc<ColophonyParams>,
+    link: Arc<EditorLink>,
+    built: Mutex<Built>,
+}
+
+impl ColophonyEditor {
+    pub fn new(params: Arc<ColophonyParams>, link: Arc<EditorLink>) -> Self {
+        let built = Mutex::new(Self::build(&params, &link));
+        Self {
+            params,
+            link,
+            built,
+        }
+    }
+
+    fn build(params: &Arc<ColophonyParams>, link: &Arc<EditorLink>) -> Built {
+        let size = params.editor_state.size();
+        let state = EguiEditorState::from_size(
+            LogicalSize::new(size.width as f64, size.height as f64),
+            1.0,
+        );
+        let settings = EguiNiceSettings::new()
+            .with_tile("Colophony")
+            .with_resize_hint(ResizeHint::resizable().with_min_max_logical_size(
+                Some(LogicalSize::new(
+                    EditorSize::MIN.width,
+                    EditorSize::MIN.height,
+                )),
+                Some(LogicalSize::new(
+                    EditorSize::MAX.width,
+                    EditorSize::MAX.height,
+                )),
+            ));
+        let app = EditorApp {
+            params: params.clone(),
+            link: link.clone(),
+            ui: None,
+        };
+        let editor = create_egui_editor(state.clone(), RepaintNotifier::new(), settings, app)
+            .expect("create_egui_editor always returns an editor");
+        Built { state, editor }
+    }
+
+    /// The editor, rebuilt first if the persisted size changed while the window was closed.
+    fn current(&self) -> MutexGuard<'_, Built> {
+        let mut built = self
+            .built
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner());
+        if !built.state.is_open() && built.size() != Some(self.params.editor_state.size()) {
+            *built = Self::build(&self.params, &self.link);
+        }
+        built
+    }
+}
+
+impl Editor for ColophonyEditor {
+    type Handle = EguiEditorHandle;
+
+    fn spawn(
+        &self,
+        parent: Option<ParentWindowHandle>,
+        wait_for_parent: bool,
+        fallback_scale_factor: Option<f64>,
+        gui_context: GuiContext,
+        host: Option<HostMethods>,
+    ) -> Result<SpawnedEditor<Self::Handle>, Box<dyn Error>> {
+        self.current().editor.spawn(
+            parent,
+            wait_for_parent,
+            fallback_scale_factor,
+            gui_context,
+            host,
+        )
+    }
+
+    fn size(&self) -> NativeSize<u32> {
+        self.current().editor.size()
+    }
+
+    fn resize_hint(&self) -> ResizeHint {
+        self.current().editor.resize_hint()
+    }
+
+    fn track_info_updated(&self, info: TrackInfo) {
+        self.current().editor.track_info_updated(info);
+    }
+
+    unsafe fn assume_standalone_in_process(&self) {
+        // SAFETY: the caller upholds `Editor::assume_standalone_in_process`'s contract,
+        // which is the inner editor's.
+        unsafe { self.current().editor.assume_standalone_in_process() }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nice_plug::prelude::Params;
+
+    #[test]
+    fn editor_size_is_saved_and_restored_with_the_plugin_state() {
+        let saved = ColophonyParams::default();
+        saved.editor_state.set_size(EditorSize {
+            width: 1000.0,
+            height: 700.0,
+        });
+        let fields = saved.serialize_fields();
+        assert!(fields.contains_key("editor-state"), "{fields:?}");
+
+        let loaded = ColophonyParams::default();
+        assert_eq!(loaded.editor_state.size(), EditorSize::DEFAULT);
+        loaded.deserialize_fields(&fields);
+        assert_eq!(
+            loaded.editor_state.size(),
+            EditorSize {
+                width: 1000.0,
+                height: 700.0
+            }
+        );
+    }
+
+    #[test]
+    fn editor_size_is_kept_within_limits() {
+        let state = EditorState::default();
+        state.set_size(EditorSize {
+            width: 10.0,
+            height: 1e6,
+        });
+        assert_eq!(
+            state.size(),
+            EditorSize {
+                width: EditorSize::MIN.width,
+                height: EditorSize::MAX.height
+            }
+        );
+        state.set_size(EditorSize {
+            width: f32::NAN,
+            height: 500.0,
+        });
+        assert_eq!(state.size(), EditorSize::DEFAULT);
+    }
+
+    #[test]
+    fn editor_is_rebuilt_at_the_loaded_size() {
+        let params = Arc::new(ColophonyParams::default());
+        let editor = ColophonyEditor::new(params.clone(), Arc::new(EditorLink::default()));
+        assert_eq!(editor.current().size(), Some(EditorSize::DEFAULT));
+        let loaded = EditorSize {
+            width: 900.0,
+            height: 600.0,
+        };
+        params.editor_state.set_size(loaded);
+        assert_eq!(editor.current().size(), Some(loaded));
+        assert!(editor.resize_hint().can_resize);
+    }
+
+    #[test]
+    fn editor_link_carries_the_note() {
+        let link = EditorLink::default();
+        assert_eq!(link.note(), None);
+        link.set_note(Some(50));
+        assert_eq!(link.note(), Some(50));
+        link.set_note(None);
+        assert_eq!(link.note(), None);
+    }
+}

@@ -1,0 +1,282 @@
+//! The editor's contents, independent of the window: the selectors along the top, the XY
+//! pad with the Schelleng window, and the side panel with the bow sliders and the window's
+//! numbers. [`EditorUi::ui`] draws one frame into any `egui::Ui`, which is how the editor
+//! tests drive it without a window.
+
+use super::mapping::SchellengWindow;
+use super::pad::{format_force, format_velocity, XyPad, MAX_FORCE_COLOUR, MIN_FORCE_COLOUR};
+use super::{EditorLink, EditorSize};
+use crate::dsp::instrument::{midi_to_hz, InstrumentKind};
+use crate::params::{ColophonyParams, ResonatorChoice};
+use egui::{vec2, Color32, Layout, RichText, Ui};
+use nice_plug::context::gui::GuiContext;
+use nice_plug::prelude::{Enum, EnumParam, ParamSetter};
+use nice_plug_egui::resizable_window::ResizableWindow;
+use nice_plug_egui::widgets::ParamSlider;
+use std::sync::Arc;
+
+/// Width of the side panel, points.
+const SIDE_WIDTH: f32 = 250.0;
+
+/// One open editor's state: the parameters, the link to the audio thread, the host context
+/// the gestures go to, and the pad.
+pub struct EditorUi {
+    params: Arc<ColophonyParams>,
+    link: Arc<EditorLink>,
+    context: GuiContext,
+    pad: XyPad,
+}
+
+impl EditorUi {
+    pub fn new(params: Arc<ColophonyParams>, link: Arc<EditorLink>, context: GuiContext) -> Self {
+        Self {
+            params,
+            link,
+            context,
+            pad: XyPad::default(),
+        }
+    }
+
+    pub fn pad(&self) -> &XyPad {
+        &self.pad
+    }
+
+    /// Ends a pad gesture left open (the editor closing mid-drag).
+    pub fn end_gestures(&mut self) {
+        let setter = self.context.param_setter();
+        self.pad
+            .release(&setter, &self.params.bow_velocity, &self.params.bow_force);
+    }
+
+    /// The note the Schelleng window is drawn for: the last note the strings played, or
+    /// (before any) the instrument's third string open (cello and viola D, violin A).
+    pub fn window_note(&self, kind: InstrumentKind) -> u8 {
+        self.link
+            .note()
+            .filter(|&n| kind.string_for_note(n).is_some())
+            .unwrap_or(kind.open_notes()[2])
+    }
+
+    /// The Schelleng window for the current note and bow position, `None` while the bow
+    /// rubs a modal resonator instead of the strings.
+    pub fn window(&self) -> Option<SchellengWindow> {
+        if self.params.resonator.value() != ResonatorChoice::Strings {
+            return None;
+        }
+        let kind: InstrumentKind = self.params.instrument.value().into();
+        let beta = self.params.bow_position.value() as f64;
+        SchellengWindow::for_note(kind, self.window_note(kind), beta)
+    }
+
+    /// Draws one frame.
+    pub fn ui(&mut self, ui: &mut Ui) {
+        ResizableWindow::new("colophony-editor")
+            .min_size(vec2(EditorSize::MIN.width, EditorSize::MIN.height))
+            .show(ui, |ui| self.contents(ui));
+    }
+
+    fn contents(&mut self, ui: &mut Ui) {
+        let params = self.params.clone();
+        let context = self.context.clone();
+        let setter = context.param_setter();
+        ui.horizontal(|ui| {
+            ui.heading("Colophony");
+            ui.add_space(12.0);
+            enum_selector(ui, "Instrument", &params.instrument, &setter);
+            enum_selector(ui, "Friction model", &params.friction_model, &setter);
+            enum_selector(ui, "Resonator", &params.resonator, &setter);
+        });
+        ui.separator();
+
+        let window = self.window();
+        let available = ui.available_size();
+        ui.horizontal_top(|ui| {
+            let pad_size = vec2(
+                (available.x - SIDE_WIDTH - 12.0).max(200.0),
+                (available.y - 8.0).max(200.0),
+            );
+            let (outer, _) = ui.allocate_exact_size(pad_size, egui::Sense::hover());
+            let mut pad_ui = ui.new_child(egui::UiBuilder::new().max_rect(outer));
+            self.pad.show(
+                &mut pad_ui,
+                outer,
+                &setter,
+                &params.bow_velocity,
+                &params.bow_force,
+                window.as_ref(),
+            );
+            ui.add_space(8.0);
+            ui.allocate_ui_with_layout(
+                vec2(SIDE_WIDTH, pad_size.y),
+                Layout::top_down(egui::Align::Min),
+                |ui| {
+                    ui.set_width(SIDE_WIDTH);
+                    self.side_panel(ui, &setter, window.as_ref());
+                },
+            );
+        });
+    }
+
+    fn side_panel(&self, ui: &mut Ui, setter: &ParamSetter, window: Option<&SchellengWindow>) {
+        let p = &self.params;
+        ui.label(RichText::new("Bow").strong());
+        egui::Grid::new("bow-sliders")
+            .num_columns(2)
+            .spacing(vec2(8.0, 6.0))
+            .show(ui, |ui| {
+                ui.label("Velocity");
+                ui.add(ParamSlider::for_param(&p.bow_velocity, setter).with_width(120.0));
+                ui.end_row();
+                ui.label("Force");
+                ui.add(ParamSlider::for_param(&p.bow_force, setter).with_width(120.0));
+                ui.end_row();
+                ui.label("Position");
+                ui.add(ParamSlider::for_param(&p.bow_position, setter).with_width(120.0));
+                ui.end_row();
+                ui.label("Output gain");
+                ui.add(ParamSlider::for_param(&p.gain, setter).with_width(120.0));
+                ui.end_row();
+            });
+        ui.add_space(6.0);
+        ui.separator();
+        ui.label(RichText::new("Schelleng window").strong());
+        let Some(w) = window else {
+            ui.label(format!(
+                "Not shown: the bow rubs the {} resonator, not a string.",
+                ResonatorChoice::variants()[p.resonator.value().to_index()].to_lowercase()
+            ));
+            return;
+        };
+        let kind: InstrumentKind = p.instrument.value().into();
+        let note = self.window_note(kind);
+        let string = kind.string_for_note(note).unwrap_or(0);
+        let open = kind.open_notes()[string];
+        let heard = if self.link.note().is_some() {
+            "last note"
+        } else {
+            "no note yet"
+        };
+        let v = p.bow_velocity.value();
+        let f = p.bow_force.value();
+        let (f_min, f_max) = (w.min_force_n(v as f64), w.max_force_n(v as f64));
+        egui::Grid::new("schelleng-numbers")
+            .num_columns(2)
+            .spacing(vec2(8.0, 3.0))
+            .show(ui, |ui| {
+                ui.label("Note");
+                ui.label(format!(
+                    "{} ({heard}), {:.1} Hz",
+                    note_name(note),
+                    midi_to_hz(note as f64)
+                ));
+                ui.end_row();
+                ui.label("String");
+                ui.label(format!("{} string", pitch_class(open)));
+                ui.end_row();
+                ui.label("Z0");
+                ui.label(format!("{:.3} kg/s", w.z0_kg_per_s));
+                ui.end_row();
+                ui.label("Bridge R");
+                ui.label(format!("{:.0} kg/s (2 Q1 Z0 / pi)", w.bridge_r_kg_per_s));
+                ui.end_row();
+                ui.label("mu_s, mu_d");
+                ui.label(format!("{:.2}, {:.2}", w.mu_s, w.mu_d));
+                ui.end_row();
+                ui.label("At");
+                ui.label(format!("{}, beta {:.3}", format_velocity(v), w.beta));
+                ui.end_row();
+                ui.label(RichText::new("F_max").color(MAX_FORCE_COLOUR));
+                ui.label(format!("{f_max:.3} N"));
+                ui.end_row();
+                ui.label(RichText::new("F_min").color(MIN_FORCE_COLOUR));
+                ui.label(format!("{f_min:.4} N"));
+                ui.end_row();
+                ui.label("Bow");
+                ui.label(format_force(f));
+                ui.end_row();
+            });
+        let (text, colour) = predicted_regime(v as f64, f as f64, f_min, f_max);
+        ui.label(RichText::new(format!("Predicted: {text}")).color(colour));
+    }
+}
+
+/// Where the bow sits relative to the window, as Schelleng's diagram names the regions.
+fn predicted_regime(v: f64, f: f64, f_min: f64, f_max: f64) -> (&'static str, Color32) {
+    if f <= 0.0 {
+        ("silent (bow lifted)", Color32::GRAY)
+    } else if v == 0.0 {
+        ("silent (bow at rest)", Color32::GRAY)
+    } else if f > f_max {
+        ("raucous (above F_max)", MAX_FORCE_COLOUR)
+    } else if f < f_min {
+        ("multiple slips (below F_min)", MIN_FORCE_COLOUR)
+    } else {
+        ("Helmholtz motion", Color32::from_rgb(120, 210, 120))
+    }
+}
+
+/// A labelled drop-down for an enum parameter; a choice is one begin/set/end gesture.
+fn enum_selector<T: Enum + PartialEq + Copy + 'static>(
+    ui: &mut Ui,
+    label: &str,
+    param: &EnumParam<T>,
+    setter: &ParamSetter,
+) {
+    let current = param.value().to_index();
+    let names = T::variants();
+    let mut selected = current;
+    let label_id = ui.label(label).id;
+    egui::ComboBox::from_id_salt(label)
+        .selected_text(names[current])
+        .show_ui(ui, |ui| {
+            for (index, name) in names.iter().enumerate() {
+                ui.selectable_value(&mut selected, index, *name);
+            }
+        })
+        .response
+        .labelled_by(label_id);
+    if selected != current {
+        setter.begin_set_parameter(param);
+        setter.set_parameter(param, T::from_index(selected));
+        setter.end_set_parameter(param);
+    }
+}
+
+const PITCH_CLASSES: [&str; 12] = [
+    "C", "C#", "D", "D#", "E", "F", "F#", "G", "G#", "A", "A#", "B",
+];
+
+fn pitch_class(note: u8) -> &'static str {
+    PITCH_CLASSES[note as usize % 12]
+}
+
+/// Scientific pitch name (MIDI 60 = C4).
+pub fn note_name(note: u8) -> String {
+    format!("{}{}", pitch_class(note), note as i32 / 12 - 1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn note_names_are_scientific_pitch() {
+        assert_eq!(note_name(60), "C4");
+        assert_eq!(note_name(50), "D3");
+        assert_eq!(note_name(36), "C2");
+        assert_eq!(note_name(69), "A4");
+    }
+
+    #[test]
+    fn predicted_regime_follows_the_window() {
+        let (lo, hi) = (0.04, 5.0);
+        assert!(predicted_regime(0.1, 1.0, lo, hi)
+            .0
+            .starts_with("Helmholtz"));
+        assert!(predicted_regime(0.1, 6.0, lo, hi).0.starts_with("raucous"));
+        assert!(predicted_regime(0.1, 0.01, lo, hi)
+            .0
+            .starts_with("multiple"));
+        assert!(predicted_regime(0.1, 0.0, lo, hi).0.starts_with("silent"));
+    }
+}
