@@ -1,0 +1,319 @@
+//! The editor driven headless by egui_kittest: the real [`EditorUi`] with the real
+//! nice-plug `ParamSetter`, whose host side (`GuiContextInner`) is a recorder that logs every
+//! begin/set/end call and applies the values to the parameters as a host would.
+
+use colophony::editor::mapping::PadMapping;
+use colophony::editor::pad::{pad_value_text, PAD_LABEL};
+use colophony::editor::{EditorLink, EditorUi};
+use colophony::params::{ColophonyParams, InstrumentChoice};
+use egui::{pos2, vec2, Pos2, Rect};
+use egui_kittest::kittest::Queryable;
+use egui_kittest::Harness;
+use nice_plug::context::gui::GuiContext;
+use nice_plug::prelude::{GuiContextInner, Param, ParamPtr, PluginApi, PluginState};
+use std::sync::{Arc, Mutex};
+
+#[derive(Debug, Clone, PartialEq)]
+enum Call {
+    Begin(String),
+    Set(String, f32),
+    End(String),
+}
+
+/// The host side of the `ParamSetter`: logs the calls and applies each value at once.
+#[derive(Default)]
+struct Recorder {
+    calls: Mutex<Vec<Call>>,
+}
+
+impl Recorder {
+    fn calls(&self) -> Vec<Call> {
+        self.calls.lock().unwrap().clone()
+    }
+}
+
+fn name(param: ParamPtr) -> String {
+    // SAFETY: every pointer the editor passes points into the test's live parameters.
+    unsafe { param.name() }.to_owned()
+}
+
+impl GuiContextInner for Recorder {
+    fn plugin_api(&self) -> PluginApi {
+        PluginApi::Clap
+    }
+
+    unsafe fn raw_begin_set_parameter(&self, param: ParamPtr) {
+        self.calls.lock().unwrap().push(Call::Begin(name(param)));
+    }
+
+    unsafe fn raw_set_parameter_normalized(&self, param: ParamPtr, normalized: f32) {
+        self.calls
+            .lock()
+            .unwrap()
+            .push(Call::Set(name(param), normalized));
+        // SAFETY: as above; the test thread is the only one touching the parameters.
+        unsafe { param._internal_set_normalized_value(normalized) };
+    }
+
+    unsafe fn raw_end_set_parameter(&self, param: ParamPtr) {
+        self.calls.lock().unwrap().push(Call::End(name(param)));
+    }
+
+    fn get_state(&self) -> PluginState {
+        unimplemented!("the editor does not read the state")
+    }
+
+    fn set_state(&self, _state: PluginState) {}
+
+    fn request_restart(&self) {}
+}
+
+struct Fixture {
+    params: Arc<ColophonyParams>,
+    recorder: Arc<Recorder>,
+    link: Arc<EditorLink>,
+    editor: EditorUi,
+}
+
+fn fixture() -> Fixture {
+    let params = Arc::new(ColophonyParams::default());
+    let recorder = Arc::new(Recorder::default());
+    let link = Arc::new(EditorLink::default());
+    let editor = EditorUi::new(
+        params.clone(),
+        link.clone(),
+        GuiContext::new(recorder.clone()),
+    );
+    Fixture {
+        params,
+        recorder,
+        link,
+        editor,
+    }
+}
+
+fn harness(editor: &mut EditorUi) -> Harness<'_> {
+    let mut harness = Harness::builder()
+        .with_size(vec2(820.0, 540.0))
+        .build_ui(move |ui| editor.ui(ui));
+    harness.run();
+    harness
+}
+
+fn pad_rect(harness: &Harness<'_>) -> Rect {
+    harness.get_by_label(PAD_LABEL).rect()
+}
+
+fn pad_value(harness: &Harness<'_>) -> String {
+    harness
+        .get_by_label(PAD_LABEL)
+        .value()
+        .expect("the pad reports its values")
+}
+
+/// Presses at `from`, moves in `steps` frames to `to`, releases there.
+fn drag(harness: &mut Harness<'_>, from: Pos2, to: Pos2, steps: usize) {
+    harness.hover_at(from);
+    harness.step();
+    harness.drag_at(from);
+    harness.step();
+    for k in 1..=steps {
+        harness.hover_at(from.lerp(to, k as f32 / steps as f32));
+        harness.step();
+    }
+    harness.drop_at(to);
+    harness.run();
+}
+
+/// Indices of the calls for `param` of each kind.
+fn positions(calls: &[Call], param: &str) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
+    let (mut begins, mut sets, mut ends) = (vec![], vec![], vec![]);
+    for (i, call) in calls.iter().enumerate() {
+        match call {
+            Call::Begin(p) if p == param => begins.push(i),
+            Call::Set(p, _) if p == param => sets.push(i),
+            Call::End(p) if p == param => ends.push(i),
+            _ => {}
+        }
+    }
+    (begins, sets, ends)
+}
+
+/// One gesture for `param`: one begin, then at least one set, then one end.
+fn assert_one_gesture(calls: &[Call], param: &str) -> usize {
+    let (begins, sets, ends) = positions(calls, param);
+    assert_eq!(begins.len(), 1, "{param}: one begin in {calls:?}");
+    assert_eq!(ends.len(), 1, "{param}: one end in {calls:?}");
+    assert!(!sets.is_empty(), "{param}: no set in {calls:?}");
+    assert!(
+        begins[0] < sets[0] && *sets.last().unwrap() < ends[0],
+        "{param}: begin before set before end, got {calls:?}"
+    );
+    sets.len()
+}
+
+#[test]
+fn dragging_the_pad_sets_velocity_and_force_within_one_gesture_each() {
+    let mut f = fixture();
+    let (start, end, rect);
+    {
+        let mut h = harness(&mut f.editor);
+        rect = pad_rect(&h);
+        start = rect.center();
+        end = pos2(
+            rect.left() + 0.85 * rect.width(),
+            rect.top() + 0.2 * rect.height(),
+        );
+        drag(&mut h, start, end, 12);
+    }
+    let calls = f.recorder.calls();
+    let velocity_sets = assert_one_gesture(&calls, "Bow Velocity");
+    let force_sets = assert_one_gesture(&calls, "Bow Force");
+    assert!(velocity_sets >= 5 && force_sets >= 5, "{calls:?}");
+    // Nothing else was touched.
+    assert!(calls.iter().all(|c| match c {
+        Call::Begin(p) | Call::Set(p, _) | Call::End(p) => p == "Bow Velocity" || p == "Bow Force",
+    }));
+
+    // Both parameters are where the mapping puts the release point.
+    let (v, force) = PadMapping::default().pos_to_values(rect, end);
+    let p = &f.params;
+    assert!(
+        (p.bow_velocity.value() - v).abs() < 1e-3,
+        "velocity {} expected {v}",
+        p.bow_velocity.value()
+    );
+    assert!(
+        (p.bow_force.value() / force - 1.0).abs() < 1e-3,
+        "force {} expected {force}",
+        p.bow_force.value()
+    );
+    // Up and to the right of the default (0.1 m/s, 1 N).
+    assert!(p.bow_velocity.value() > 0.9 && p.bow_force.value() > 1.5);
+}
+
+#[test]
+fn dragging_to_the_bottom_edge_lifts_the_bow_and_left_reverses_it() {
+    let mut f = fixture();
+    {
+        let mut h = harness(&mut f.editor);
+        let rect = pad_rect(&h);
+        let end = pos2(rect.left() + 0.1 * rect.width(), rect.bottom() + 20.0);
+        drag(&mut h, rect.center(), end, 8);
+    }
+    assert_one_gesture(&f.recorder.calls(), "Bow Velocity");
+    assert_one_gesture(&f.recorder.calls(), "Bow Force");
+    assert_eq!(f.params.bow_force.value(), 0.0);
+    assert!(f.params.bow_velocity.value() < -1.0);
+}
+
+#[test]
+fn a_click_on_the_pad_is_one_complete_gesture() {
+    let mut f = fixture();
+    {
+        let mut h = harness(&mut f.editor);
+        let rect = pad_rect(&h);
+        let at = pos2(
+            rect.left() + 0.25 * rect.width(),
+            rect.top() + 0.5 * rect.height(),
+        );
+        h.get_by_label(PAD_LABEL).hover();
+        h.run();
+        h.hover_at(at);
+        h.step();
+        h.drag_at(at);
+        h.drop_at(at);
+        h.run();
+    }
+    let calls = f.recorder.calls();
+    assert_eq!(assert_one_gesture(&calls, "Bow Velocity"), 1, "{calls:?}");
+    assert_eq!(assert_one_gesture(&calls, "Bow Force"), 1, "{calls:?}");
+    assert!((f.params.bow_velocity.value() + 0.75).abs() < 0.01);
+}
+
+#[test]
+fn closing_the_editor_mid_drag_ends_the_gesture() {
+    let mut f = fixture();
+    {
+        let mut h = harness(&mut f.editor);
+        let rect = pad_rect(&h);
+        h.hover_at(rect.center());
+        h.step();
+        h.drag_at(rect.center());
+        h.step();
+        h.hover_at(rect.center() + vec2(40.0, -30.0));
+        h.step();
+    }
+    assert!(f.editor.pad().is_dragging());
+    let before = f.recorder.calls();
+    assert!(!before.iter().any(|c| matches!(c, Call::End(_))));
+    drop(f.editor);
+    let calls = f.recorder.calls();
+    assert_one_gesture(&calls, "Bow Velocity");
+    assert_one_gesture(&calls, "Bow Force");
+}
+
+#[test]
+fn the_pad_follows_host_automation_when_not_dragged() {
+    let mut f = fixture();
+    let params = f.params.clone();
+    let mut h = harness(&mut f.editor);
+    assert_eq!(pad_value(&h), pad_value_text(0.1, 1.0));
+    // The host moves both parameters (automation playback).
+    unsafe {
+        params
+            .bow_velocity
+            .as_ptr()
+            ._internal_set_normalized_value(params.bow_velocity.preview_normalized(-0.4));
+        params
+            .bow_force
+            .as_ptr()
+            ._internal_set_normalized_value(params.bow_force.preview_normalized(2.5));
+    }
+    h.run();
+    assert_eq!(pad_value(&h), pad_value_text(-0.4, 2.5));
+    drop(h);
+    assert!(f.recorder.calls().is_empty(), "the editor sent nothing");
+}
+
+#[test]
+fn choosing_an_instrument_is_one_gesture() {
+    let mut f = fixture();
+    {
+        let mut h = harness(&mut f.editor);
+        let combo = h.get_by_role_and_label(egui::Role::ComboBox, "Instrument");
+        assert_eq!(combo.value().as_deref(), Some("Cello"));
+        combo.click();
+        h.run();
+        h.get_by_label("Violin").click();
+        h.run();
+    }
+    let calls = f.recorder.calls();
+    assert_eq!(assert_one_gesture(&calls, "Instrument"), 1, "{calls:?}");
+    assert_eq!(f.params.instrument.value(), InstrumentChoice::Violin);
+}
+
+/// Whether some label shows exactly `text`.
+fn assert_shows(harness: &Harness<'_>, text: &str) {
+    assert!(
+        harness.query_all_by_value(text).next().is_some(),
+        "no label shows {text:?}"
+    );
+}
+
+#[test]
+fn the_schelleng_numbers_follow_the_note_the_audio_thread_reports() {
+    let mut f = fixture();
+    let link = f.link.clone();
+    let mut h = harness(&mut f.editor);
+    // No note yet: cello D (Z0 0.506 kg/s); F_max at 0.1 m/s and beta 0.1 is 5.06 N.
+    assert_shows(&h, "0.506 kg/s");
+    assert_shows(&h, "5.060 N");
+    assert_shows(&h, "D3 (no note yet), 146.8 Hz");
+    // The strings took G2 (the G string, Z0 0.833 kg/s).
+    link.set_note(Some(43));
+    h.run();
+    assert_shows(&h, "0.833 kg/s");
+    assert_shows(&h, "G2 (last note), 98.0 Hz");
+    assert_shows(&h, "G string");
+}
