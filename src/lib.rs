@@ -181,6 +181,7 @@ impl Plugin for Colophony {
         self.rubbed = RubbedInstrument::new(fs);
         self.resonator = None;
         self.held = [false; 128];
+        self.editor_link.scope.set_sample_rate(fs as f32);
         true
     }
 
@@ -209,6 +210,8 @@ impl Plugin for Colophony {
         self.apply_resonator(p.resonator.value().preset());
         self.instrument.update_sleep();
         self.rubbed.update_sleep();
+        // The editor's live views are fed only while an editor shows them.
+        let live = self.editor_link.is_listening();
         let mut next_event = context.next_event();
         for (sample, mut channels) in buffer.iter_samples().enumerate() {
             while let Some(event) = next_event {
@@ -226,7 +229,13 @@ impl Plugin for Colophony {
             };
             let gain = util::db_to_gain(p.gain.smoothed.next()) as f64;
             // Both sources tick while they sound: the one just switched away from rings on.
-            let mut audio = self.instrument.tick(bow).audio;
+            let frame = self.instrument.tick(bow);
+            if live {
+                self.editor_link
+                    .scope
+                    .push(editor::live::ContactSample::new(&frame, &bow));
+            }
+            let mut audio = frame.audio;
             if self.rubbed.is_sounding() {
                 audio += self.rubbed.tick(
                     bow.velocity_m_per_s / DEFAULT_BOW.velocity_m_per_s,

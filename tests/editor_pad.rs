@@ -2,6 +2,7 @@
 //! nice-plug `ParamSetter`, whose host side (`GuiContextInner`) is a recorder that logs every
 //! begin/set/end call and applies the values to the parameters as a host would.
 
+use colophony::editor::live::ContactSample;
 use colophony::editor::mapping::PadMapping;
 use colophony::editor::pad::{pad_value_text, PAD_LABEL};
 use colophony::editor::{EditorLink, EditorUi};
@@ -316,4 +317,38 @@ fn the_schelleng_numbers_follow_the_note_the_audio_thread_reports() {
     assert_shows(&h, "0.833 kg/s");
     assert_shows(&h, "G2 (last note), 98.0 Hz");
     assert_shows(&h, "G string");
+}
+
+#[test]
+fn live_views_are_fed_only_while_an_open_editor_shows_them() {
+    let mut f = fixture();
+    let link = f.link.clone();
+    assert!(
+        !link.is_listening(),
+        "nothing is fed before the editor opens"
+    );
+    {
+        let mut h = harness(&mut f.editor);
+        assert!(link.is_listening());
+        // Samples arriving from the audio thread are drawn without any input.
+        for i in 0..4000 {
+            let phase = (i % 327) as f32 / 327.0;
+            link.scope.push(ContactSample {
+                string_velocity: if phase < 0.9 { 0.1 } else { -0.9 },
+                relative_velocity: if phase < 0.9 { 0.0 } else { -1.0 },
+                mu: if phase < 0.9 { 0.3 } else { 0.2 },
+            });
+        }
+        h.run();
+        let live = h.get_by_role_and_label(egui::Role::CheckBox, "Live views");
+        live.click();
+        h.run();
+        assert!(!link.is_listening(), "hidden live views are not fed");
+        h.get_by_role_and_label(egui::Role::CheckBox, "Live views")
+            .click();
+        h.run();
+        assert!(link.is_listening());
+    }
+    drop(f.editor);
+    assert!(!link.is_listening(), "a closed editor is not fed");
 }

@@ -4,10 +4,11 @@
 //! * [`mapping`]: the pad's pixel <-> parameter mapping and the Schelleng curves (pure).
 //! * [`pad`]: the pad widget and its begin/set/end gestures.
 //! * [`view`]: the editor's contents, drawn into any `egui::Ui` ([`EditorUi`]).
+//! * [`live`]: the live views and the wait-free ring that feeds them from the audio thread.
 //! * This file: the window glue. [`ColophonyEditor`] is the plugin's `Editor`;
 //!   [`EditorState`] is the window size saved with the plugin state
 //!   (`#[persist = "editor-state"]` in [`crate::params::ColophonyParams`]); [`EditorLink`]
-//!   carries what the audio thread tells the editor (the current note).
+//!   carries what the audio thread tells the editor (the current note, the live samples).
 //!
 //! **Why a wrapper around `EguiEditor`.** nice-plug-egui 0.6's `EguiEditorState` has no
 //! serde support and no way to set its size after creation, and `Plugin::editor` is called
@@ -17,6 +18,7 @@
 //! window is closed (after a state load), before the host asks for the size or opens the
 //! window.
 
+pub mod live;
 pub mod mapping;
 pub mod pad;
 pub mod view;
@@ -36,7 +38,7 @@ use nice_plug_egui::{
 };
 use serde::{Deserialize, Serialize};
 use std::error::Error;
-use std::sync::atomic::{AtomicU64, AtomicU8, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicU8, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 
 /// The editor window's size in logical points.
@@ -48,8 +50,8 @@ pub struct EditorSize {
 
 impl EditorSize {
     pub const DEFAULT: Self = Self {
-        width: 820.0,
-        height: 540.0,
+        width: 860.0,
+        height: 640.0,
     };
     pub const MIN: Self = Self {
         width: 640.0,
@@ -119,10 +121,14 @@ impl<'a> PersistentField<'a, EditorSize> for EditorState {
     }
 }
 
-/// What the audio thread tells the editor, lock-free: written once per block.
+/// What the audio thread tells the editor, lock-free: the note once per block, and the
+/// live samples only while an editor showing them is open.
 #[derive(Debug)]
 pub struct EditorLink {
     note: AtomicU8,
+    listening: AtomicBool,
+    /// The probed string's contact, one sample per audio sample while listening.
+    pub scope: live::Scope,
 }
 
 impl EditorLink {
@@ -140,12 +146,24 @@ impl EditorLink {
             note => Some(note),
         }
     }
+
+    /// Editor: whether it shows the live views (false when it closes).
+    pub fn set_listening(&self, on: bool) {
+        self.listening.store(on, Ordering::Relaxed);
+    }
+
+    /// Audio thread, once per block: whether to feed [`Self::scope`].
+    pub fn is_listening(&self) -> bool {
+        self.listening.load(Ordering::Relaxed)
+    }
 }
 
 impl Default for EditorLink {
     fn default() -> Self {
         Self {
             note: AtomicU8::new(Self::NO_NOTE),
+            listening: AtomicBool::new(false),
+            scope: live::Scope::default(),
         }
     }
 }
@@ -194,6 +212,7 @@ impl NiceEguiApp for EditorApp {
 impl Drop for EditorUi {
     fn drop(&mut self) {
         self.end_gestures();
+        self.stop_listening();
     }
 }
 

@@ -3,6 +3,7 @@
 //! numbers. [`EditorUi::ui`] draws one frame into any `egui::Ui`, which is how the editor
 //! tests drive it without a window.
 
+use super::live::{paint_friction_loop, paint_velocity_trace, ContactSample, SCOPE_LEN};
 use super::mapping::SchellengWindow;
 use super::pad::{format_force, format_velocity, XyPad, MAX_FORCE_COLOUR, MIN_FORCE_COLOUR};
 use super::{EditorLink, EditorSize};
@@ -14,9 +15,16 @@ use nice_plug::prelude::{Enum, EnumParam, ParamSetter};
 use nice_plug_egui::resizable_window::ResizableWindow;
 use nice_plug_egui::widgets::ParamSlider;
 use std::sync::Arc;
+use std::time::Duration;
 
 /// Width of the side panel, points.
 const SIDE_WIDTH: f32 = 250.0;
+/// Height of the live views' row, points.
+const LIVE_HEIGHT: f32 = 170.0;
+/// Periods of the current note the velocity trace shows.
+const TRACE_PERIODS: f32 = 3.0;
+/// How often the live views look for new samples.
+const LIVE_REFRESH: Duration = Duration::from_millis(33);
 
 /// One open editor's state: the parameters, the link to the audio thread, the host context
 /// the gestures go to, and the pad.
@@ -25,6 +33,10 @@ pub struct EditorUi {
     link: Arc<EditorLink>,
     context: GuiContext,
     pad: XyPad,
+    /// Whether the live views are shown (and fed).
+    pub live: bool,
+    /// The live samples copied out of the scope, reused every frame.
+    samples: Vec<ContactSample>,
 }
 
 impl EditorUi {
@@ -34,11 +46,18 @@ impl EditorUi {
             link,
             context,
             pad: XyPad::default(),
+            live: true,
+            samples: Vec::with_capacity(SCOPE_LEN),
         }
     }
 
     pub fn pad(&self) -> &XyPad {
         &self.pad
+    }
+
+    /// Stops the audio thread feeding the live views (the editor closing).
+    pub fn stop_listening(&self) {
+        self.link.set_listening(false);
     }
 
     /// Ends a pad gesture left open (the editor closing mid-drag).
@@ -70,6 +89,7 @@ impl EditorUi {
 
     /// Draws one frame.
     pub fn ui(&mut self, ui: &mut Ui) {
+        self.link.set_listening(self.live);
         ResizableWindow::new("colophony-editor")
             .min_size(vec2(EditorSize::MIN.width, EditorSize::MIN.height))
             .show(ui, |ui| self.contents(ui));
@@ -85,15 +105,17 @@ impl EditorUi {
             enum_selector(ui, "Instrument", &params.instrument, &setter);
             enum_selector(ui, "Friction model", &params.friction_model, &setter);
             enum_selector(ui, "Resonator", &params.resonator, &setter);
+            ui.checkbox(&mut self.live, "Live views");
         });
         ui.separator();
 
         let window = self.window();
         let available = ui.available_size();
+        let live_height = if self.live { LIVE_HEIGHT } else { 0.0 };
         ui.horizontal_top(|ui| {
             let pad_size = vec2(
                 (available.x - SIDE_WIDTH - 12.0).max(200.0),
-                (available.y - 8.0).max(200.0),
+                (available.y - live_height - 8.0).max(200.0),
             );
             let (outer, _) = ui.allocate_exact_size(pad_size, egui::Sense::hover());
             let mut pad_ui = ui.new_child(egui::UiBuilder::new().max_rect(outer));
@@ -115,6 +137,50 @@ impl EditorUi {
                 },
             );
         });
+        if self.live {
+            self.live_views(ui, vec2(available.x, LIVE_HEIGHT - 8.0));
+        }
+    }
+
+    /// The velocity trace and the friction loop side by side.
+    fn live_views(&mut self, ui: &mut Ui, size: egui::Vec2) {
+        let scope = &self.link.scope;
+        let kind: InstrumentKind = self.params.instrument.value().into();
+        let f0 = midi_to_hz(self.window_note(kind) as f64) as f32;
+        let sample_rate = scope.sample_rate();
+        let wanted = (TRACE_PERIODS * sample_rate / f0).ceil() as usize;
+        scope.copy_latest(wanted, &mut self.samples);
+        ui.ctx().request_repaint_after(LIVE_REFRESH);
+
+        let (rect, _) = ui.allocate_exact_size(size, egui::Sense::hover());
+        let margin_left = 52.0;
+        let gap = 16.0;
+        let width = (rect.width() - 2.0 * margin_left - gap) / 2.0;
+        let plot = |i: f32| {
+            let left = rect.left() + margin_left + i * (width + margin_left + gap);
+            egui::Rect::from_min_size(
+                egui::pos2(left, rect.top() + 4.0),
+                vec2(width, rect.height() - 22.0),
+            )
+        };
+        if self.samples.is_empty() {
+            ui.painter().text(
+                rect.center(),
+                egui::Align2::CENTER_CENTER,
+                "Live views: waiting for audio (play a note)",
+                egui::FontId::proportional(13.0),
+                ui.visuals().weak_text_color(),
+            );
+            return;
+        }
+        paint_velocity_trace(
+            ui,
+            plot(0.0),
+            &self.samples,
+            sample_rate,
+            self.params.bow_velocity.value(),
+        );
+        paint_friction_loop(ui, plot(1.0), &self.samples);
     }
 
     fn side_panel(&self, ui: &mut Ui, setter: &ParamSetter, window: Option<&SchellengWindow>) {
