@@ -205,21 +205,16 @@ impl XyPad {
             text_colour,
         );
 
-        // Force grid: decades labelled, 2 and 5 faint.
-        let mut decade = m.force_log_min;
-        while decade <= m.force_max * 1.0001 {
-            let y = m.force_to_y(rect, decade);
-            painter.hline(rect.x_range(), y, Stroke::new(1.0, grid));
-            painter.text(
-                pos2(rect.left() - 4.0, y),
-                Align2::RIGHT_CENTER,
-                format!("{decade} N"),
-                small.clone(),
-                text_colour,
-            );
+        // Force grid: decades labelled, 2 and 5 faint. The log floor shares the bottom
+        // edge with 0 N, which is the label there.
+        for exponent in -4..=3 {
+            let decade = 10f32.powi(exponent);
+            if decade > m.force_max * 1.0001 {
+                break;
+            }
             for sub in [2.0, 5.0] {
                 let fs = decade * sub;
-                if fs < m.force_max {
+                if fs > m.force_log_min && fs < m.force_max {
                     let ys = m.force_to_y(rect, fs);
                     painter.hline(
                         rect.x_range(),
@@ -228,7 +223,18 @@ impl XyPad {
                     );
                 }
             }
-            decade *= 10.0;
+            if decade <= m.force_log_min * 1.0001 {
+                continue;
+            }
+            let y = m.force_to_y(rect, decade);
+            painter.hline(rect.x_range(), y, Stroke::new(1.0, grid));
+            painter.text(
+                pos2(rect.left() - 4.0, y),
+                Align2::RIGHT_CENTER,
+                format!("{} N", format_decade(exponent)),
+                small.clone(),
+                text_colour,
+            );
         }
         painter.text(
             pos2(rect.left() - 4.0, rect.bottom()),
@@ -338,6 +344,15 @@ impl XyPad {
     }
 }
 
+/// `10^exponent` written out (0.1, 1, 10), without binary rounding noise.
+fn format_decade(exponent: i32) -> String {
+    if exponent >= 0 {
+        format!("{}", 10u32.pow(exponent as u32))
+    } else {
+        format!("0.{}1", "0".repeat((-exponent - 1) as usize))
+    }
+}
+
 /// The pad's value as text: velocity and force with their units.
 pub fn pad_value_text(v: f32, f: f32) -> String {
     format!("{}   {}", format_velocity(v), format_force(f))
@@ -352,5 +367,18 @@ pub fn format_force(f: f32) -> String {
         format!("F {f:.4} N")
     } else {
         format!("F {f:.3} N")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn decade_labels_have_no_rounding_noise() {
+        assert_eq!(format_decade(-2), "0.01");
+        assert_eq!(format_decade(-1), "0.1");
+        assert_eq!(format_decade(0), "1");
+        assert_eq!(format_decade(1), "10");
     }
 }

@@ -18,7 +18,7 @@ use std::sync::Arc;
 use std::time::Duration;
 
 /// Width of the side panel, points.
-const SIDE_WIDTH: f32 = 250.0;
+const SIDE_WIDTH: f32 = 290.0;
 /// Height of the live views' row, points.
 const LIVE_HEIGHT: f32 = 170.0;
 /// Periods of the current note the velocity trace shows.
@@ -92,7 +92,11 @@ impl EditorUi {
         self.link.set_listening(self.live);
         ResizableWindow::new("colophony-editor")
             .min_size(vec2(EditorSize::MIN.width, EditorSize::MIN.height))
-            .show(ui, |ui| self.contents(ui));
+            .show(ui, |ui| {
+                egui::Frame::new()
+                    .inner_margin(egui::Margin::symmetric(8, 6))
+                    .show(ui, |ui| self.contents(ui));
+            });
     }
 
     fn contents(&mut self, ui: &mut Ui) {
@@ -155,7 +159,8 @@ impl EditorUi {
         let (rect, _) = ui.allocate_exact_size(size, egui::Sense::hover());
         let margin_left = 52.0;
         let gap = 16.0;
-        let width = (rect.width() - 2.0 * margin_left - gap) / 2.0;
+        let margin_right = 8.0;
+        let width = (rect.width() - 2.0 * margin_left - gap - margin_right) / 2.0;
         let plot = |i: f32| {
             let left = rect.left() + margin_left + i * (width + margin_left + gap);
             egui::Rect::from_min_size(
@@ -191,16 +196,16 @@ impl EditorUi {
             .spacing(vec2(8.0, 6.0))
             .show(ui, |ui| {
                 ui.label("Velocity");
-                ui.add(ParamSlider::for_param(&p.bow_velocity, setter).with_width(120.0));
+                ui.add(ParamSlider::for_param(&p.bow_velocity, setter).with_width(100.0));
                 ui.end_row();
                 ui.label("Force");
-                ui.add(ParamSlider::for_param(&p.bow_force, setter).with_width(120.0));
+                ui.add(ParamSlider::for_param(&p.bow_force, setter).with_width(100.0));
                 ui.end_row();
                 ui.label("Position");
-                ui.add(ParamSlider::for_param(&p.bow_position, setter).with_width(120.0));
+                ui.add(ParamSlider::for_param(&p.bow_position, setter).with_width(100.0));
                 ui.end_row();
                 ui.label("Output gain");
-                ui.add(ParamSlider::for_param(&p.gain, setter).with_width(120.0));
+                ui.add(ParamSlider::for_param(&p.gain, setter).with_width(100.0));
                 ui.end_row();
             });
         ui.add_space(6.0);
