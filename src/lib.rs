@@ -14,9 +14,9 @@ pub mod figures;
 pub mod params;
 pub mod render;
 
-use dsp::friction::FrictionModel;
 use dsp::instrument::{BowControl, Instrument, InstrumentKind, PITCH_BEND_SEMITONES};
 use dsp::rubbed::{RubbedInstrument, RubbedPreset};
+use dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
 
 /// The bow settings at which a rubbed preset plays at its own velocity and force.
 const DEFAULT_BOW: BowControl = BowControl {
@@ -29,13 +29,24 @@ use nice_plug::prelude::*;
 use params::ColophonyParams;
 use std::sync::Arc;
 
+/// What the notes play: the waveguide strings with one of paper A's laws, paper B's
+/// thermal instrument of one kind (index into [`InstrumentKind::ALL`]), or a rubbed object.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Source {
+    Strings,
+    Thermal(usize),
+    Rubbed(RubbedPreset),
+}
+
 pub struct Colophony {
     params: Arc<ColophonyParams>,
     instrument: Instrument,
+    /// Paper B's instrument, one per kind (violin, viola, cello), allocated in `activate`:
+    /// switching kind or model lets the one switched away from ring on.
+    thermal: Vec<ThermalInstrument>,
     rubbed: RubbedInstrument,
-    /// The rubbed preset in use, `None` while the strings are bowed.
-    resonator: Option<RubbedPreset>,
-    /// Held notes, so a resonator switch can move them to the new resonator.
+    source: Source,
+    /// Held notes, so a source switch can move them to the new source.
     held: [bool; 128],
     /// The last note the strings took; the editor draws its Schelleng window.
     last_note: Option<u8>,
@@ -49,8 +60,9 @@ impl Default for Colophony {
         let kind: InstrumentKind = params.instrument.value().into();
         Self {
             instrument: Instrument::new(kind, 48_000.0),
+            thermal: Vec::new(),
             rubbed: RubbedInstrument::new(48_000.0),
-            resonator: None,
+            source: Source::Strings,
             held: [false; 128],
             last_note: None,
             editor_link: Arc::new(editor::EditorLink::default()),
@@ -61,15 +73,23 @@ impl Default for Colophony {
 
 impl Colophony {
     fn note_on(&mut self, note: u8) {
-        match self.resonator {
+        match self.source {
             // Notes the instrument cannot play are ignored.
-            None => {
+            Source::Strings => {
                 if self.instrument.note_on(note).is_some() {
                     self.held[note as usize & 127] = true;
                     self.last_note = Some(note);
                 }
             }
-            Some(_) => {
+            Source::Thermal(k) => {
+                if let Some(engine) = self.thermal.get_mut(k) {
+                    if engine.note_on(note).is_some() {
+                        self.held[note as usize & 127] = true;
+                        self.last_note = Some(note);
+                    }
+                }
+            }
+            Source::Rubbed(_) => {
                 if !self.held[note as usize & 127] {
                     self.held[note as usize & 127] = true;
                     self.rubbed.note_on();
@@ -80,37 +100,64 @@ impl Colophony {
 
     fn note_off(&mut self, note: u8) {
         let was_held = std::mem::replace(&mut self.held[note as usize & 127], false);
-        match self.resonator {
-            None => self.instrument.note_off(note),
-            Some(_) if was_held => self.rubbed.note_off(),
-            Some(_) => {}
+        match self.source {
+            Source::Strings => self.instrument.note_off(note),
+            Source::Thermal(k) => {
+                if let Some(engine) = self.thermal.get_mut(k) {
+                    engine.note_off(note);
+                }
+            }
+            Source::Rubbed(_) if was_held => self.rubbed.note_off(),
+            Source::Rubbed(_) => {}
         }
     }
 
     fn all_notes_off(&mut self) {
         self.held = [false; 128];
         self.instrument.all_notes_off();
+        for engine in &mut self.thermal {
+            engine.all_notes_off();
+        }
         self.rubbed.all_notes_off();
     }
 
-    /// Applies the block's resonator choice: held notes move to the new resonator (its
-    /// bow lands over the usual ramp) and the old one rings on, so there is no click.
-    fn apply_resonator(&mut self, choice: Option<RubbedPreset>) {
-        if choice == self.resonator {
+    /// The source the parameters ask for.
+    fn wanted_source(&self) -> Source {
+        let p = &self.params;
+        match (p.resonator.value().preset(), p.friction_model.value().point_law()) {
+            (Some(preset), _) => Source::Rubbed(preset),
+            (None, Some(_)) => Source::Strings,
+            (None, None) => {
+                let kind: InstrumentKind = p.instrument.value().into();
+                let k = InstrumentKind::ALL.iter().position(|x| *x == kind);
+                Source::Thermal(k.unwrap_or(0))
+            }
+        }
+    }
+
+    /// Applies the block's source: held notes move to the new source (its bow lands over
+    /// the usual ramp) and the old one rings on, so there is no click.
+    fn apply_source(&mut self, choice: Source) {
+        if choice == self.source {
             return;
         }
         let held = self.held;
-        self.instrument.all_notes_off();
-        self.rubbed.all_notes_off();
-        self.held = [false; 128];
-        self.resonator = choice;
-        if let Some(preset) = choice {
+        self.all_notes_off();
+        self.source = choice;
+        if let Source::Rubbed(preset) = choice {
             self.rubbed.set_preset(preset);
         }
         for (note, down) in held.iter().enumerate() {
             if *down {
                 self.note_on(note as u8);
             }
+        }
+    }
+
+    fn thermal_settings(&self) -> ThermalSettings {
+        ThermalSettings {
+            nodes: self.params.bow_nodes.value().max(1) as usize,
+            width_m: self.params.bow_width_mm.value() as f64 * 1e-3,
         }
     }
 
@@ -128,9 +175,13 @@ impl Colophony {
                 key: Key::Wildcard, ..
             }
             | NoteEvent::Choke { .. } => self.all_notes_off(),
-            NoteEvent::MidiPitchBend { value, .. } => self
-                .instrument
-                .set_pitch_bend((value as f64 - 0.5) * 2.0 * PITCH_BEND_SEMITONES),
+            NoteEvent::MidiPitchBend { value, .. } => {
+                let semitones = (value as f64 - 0.5) * 2.0 * PITCH_BEND_SEMITONES;
+                self.instrument.set_pitch_bend(semitones);
+                for engine in &mut self.thermal {
+                    engine.set_pitch_bend(semitones);
+                }
+            }
             _ => {}
         }
     }
@@ -178,8 +229,26 @@ impl Plugin for Colophony {
         let kind: InstrumentKind = self.params.instrument.value().into();
         let fs = buffer_config.sample_rate as f64;
         self.instrument = Instrument::new(kind, fs);
+        let settings = self.thermal_settings();
+        self.thermal.clear();
+        for kind in InstrumentKind::ALL {
+            let bridge = match kind {
+                InstrumentKind::Cello => admittance_fit::shipped_cello_bridge(),
+                // The viola borrows the violin's generic bridge (no viola data shipped).
+                InstrumentKind::Violin | InstrumentKind::Viola => {
+                    admittance_fit::shipped_violin_bridge()
+                }
+            };
+            match ThermalInstrument::new(kind, &bridge.modes, fs, settings) {
+                Ok(engine) => self.thermal.push(engine),
+                Err(e) => {
+                    nice_log!("cannot build the thermal {}: {e}", kind.name());
+                    return false;
+                }
+            }
+        }
         self.rubbed = RubbedInstrument::new(fs);
-        self.resonator = None;
+        self.source = Source::Strings;
         self.held = [false; 128];
         self.editor_link.scope.set_sample_rate(fs as f32);
         true
@@ -187,6 +256,9 @@ impl Plugin for Colophony {
 
     fn reset(&mut self) {
         self.instrument.reset();
+        for engine in &mut self.thermal {
+            engine.reset();
+        }
         self.rubbed.reset();
         self.held = [false; 128];
         let p = &self.params;
@@ -204,11 +276,20 @@ impl Plugin for Colophony {
     ) -> ProcessStatus {
         let p = &self.params;
         self.instrument.set_kind(p.instrument.value().into());
-        let friction: FrictionModel = p.friction_model.value().into();
-        self.instrument.set_friction_model(friction);
-        self.rubbed.set_friction_model(friction);
-        self.apply_resonator(p.resonator.value().preset());
+        // The rubbed objects keep the last point law while the thermal model is chosen.
+        if let Some(friction) = p.friction_model.value().point_law() {
+            self.instrument.set_friction_model(friction);
+            self.rubbed.set_friction_model(friction);
+        }
+        let settings = self.thermal_settings();
+        for engine in &mut self.thermal {
+            engine.set_settings(settings);
+        }
+        self.apply_source(self.wanted_source());
         self.instrument.update_sleep();
+        for engine in &mut self.thermal {
+            engine.update_sleep();
+        }
         self.rubbed.update_sleep();
         // The editor's live views are fed only while an editor shows them.
         let live = self.editor_link.is_listening();
@@ -228,8 +309,18 @@ impl Plugin for Colophony {
                 position_beta: p.bow_position.smoothed.next() as f64,
             };
             let gain = util::db_to_gain(p.gain.smoothed.next()) as f64;
-            // Both sources tick while they sound: the one just switched away from rings on.
-            let frame = self.instrument.tick(bow);
+            // Every source ticks while it sounds: the one just switched away from rings on.
+            let mut frame = self.instrument.tick(bow);
+            for (k, engine) in self.thermal.iter_mut().enumerate() {
+                if engine.is_sounding() {
+                    let f = engine.tick(bow);
+                    frame.audio += f.audio;
+                    if self.source == Source::Thermal(k) {
+                        frame.bow_point_velocity_m_per_s = f.bow_point_velocity_m_per_s;
+                        frame.friction_force_n = f.friction_force_n;
+                    }
+                }
+            }
             if live {
                 self.editor_link
                     .scope
@@ -253,7 +344,10 @@ impl Plugin for Colophony {
             next_event = context.next_event();
         }
         self.editor_link.set_note(self.last_note);
-        if self.instrument.is_sounding() || self.rubbed.is_sounding() {
+        if self.instrument.is_sounding()
+            || self.rubbed.is_sounding()
+            || self.thermal.iter().any(|e| e.is_sounding())
+        {
             ProcessStatus::KeepAlive
         } else {
             ProcessStatus::Normal

@@ -7,8 +7,10 @@
 //! | `bow_position` | Bow Position | beta | 0.02 .. 0.5 | 0.1 |
 //! | `instrument` | Instrument | - | violin, viola, cello | cello |
 //! | `gain` | Output Gain | dB | -40 .. 12 | 0 |
-//! | `friction_model` | Friction Model | - | hyperbolic, static (Stribeck), LuGre, elasto-plastic | hyperbolic |
+//! | `friction_model` | Friction Model | - | hyperbolic, static (Stribeck), LuGre, elasto-plastic, thermal (paper B) | hyperbolic |
 //! | `resonator` | Resonator | - | strings, paper A modal, door hinge, chalk, wine glass, brake squeal | strings |
+//! | `bow_nodes` | Bow Nodes | nodes on the lowest string (thermal model) | 1 .. 60 | 10 |
+//! | `bow_width` | Bow Width | mm of hair in contact (thermal model) | 5 .. 20 | 10 |
 
 use crate::dsp::friction::FrictionModel;
 use crate::dsp::instrument::InstrumentKind;
@@ -39,7 +41,8 @@ impl From<InstrumentChoice> for InstrumentKind {
     }
 }
 
-/// The friction law at the bow (paper A; paper B's thermal law joins later).
+/// The friction law at the bow: paper A's laws on the waveguide strings, or paper B's
+/// finite-width thermal bow on its own four-string instrument.
 #[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
 pub enum FrictionChoice {
     #[id = "hyperbolic"]
@@ -53,15 +56,20 @@ pub enum FrictionChoice {
     #[id = "elasto-plastic"]
     #[name = "Elasto-plastic"]
     ElastoPlastic,
+    #[id = "thermal"]
+    #[name = "Thermal (paper B)"]
+    Thermal,
 }
 
-impl From<FrictionChoice> for FrictionModel {
-    fn from(choice: FrictionChoice) -> Self {
-        match choice {
-            FrictionChoice::Hyperbolic => FrictionModel::Hyperbolic,
-            FrictionChoice::Static => FrictionModel::Stribeck,
-            FrictionChoice::LuGre => FrictionModel::LuGre,
-            FrictionChoice::ElastoPlastic => FrictionModel::ElastoPlastic,
+impl FrictionChoice {
+    /// Paper A's law on the waveguide strings, or `None` for paper B's thermal bow.
+    pub fn point_law(self) -> Option<FrictionModel> {
+        match self {
+            FrictionChoice::Hyperbolic => Some(FrictionModel::Hyperbolic),
+            FrictionChoice::Static => Some(FrictionModel::Stribeck),
+            FrictionChoice::LuGre => Some(FrictionModel::LuGre),
+            FrictionChoice::ElastoPlastic => Some(FrictionModel::ElastoPlastic),
+            FrictionChoice::Thermal => None,
         }
     }
 }
@@ -117,6 +125,10 @@ pub struct ColophonyParams {
     pub friction_model: EnumParam<FrictionChoice>,
     #[id = "resonator"]
     pub resonator: EnumParam<ResonatorChoice>,
+    #[id = "bow_nodes"]
+    pub bow_nodes: IntParam,
+    #[id = "bow_width"]
+    pub bow_width_mm: FloatParam,
     /// The editor window's size, saved with the plugin state (not a parameter).
     #[persist = "editor-state"]
     pub editor_state: crate::editor::EditorState,
@@ -134,6 +146,20 @@ pub fn bow_force_range() -> FloatRange {
         min: 0.0,
         max: 10.0,
         factor: FloatRange::skew_factor(-2.0),
+    }
+}
+
+pub fn bow_nodes_range() -> IntRange {
+    IntRange::Linear {
+        min: 1,
+        max: crate::dsp::thermal_instrument::MAX_NODES as i32,
+    }
+}
+
+pub fn bow_width_mm_range() -> FloatRange {
+    FloatRange::Linear {
+        min: (crate::dsp::thermal_instrument::MIN_WIDTH_M * 1e3) as f32,
+        max: (crate::dsp::thermal_instrument::MAX_WIDTH_M * 1e3) as f32,
     }
 }
 
@@ -175,6 +201,13 @@ impl Default for ColophonyParams {
             .with_smoother(SmoothingStyle::Linear(10.0)),
             friction_model: EnumParam::new("Friction Model", FrictionChoice::Hyperbolic),
             resonator: EnumParam::new("Resonator", ResonatorChoice::Strings),
+            // Discrete: a change rebuilds the thermal grid (after a 10 ms fade), so neither
+            // is smoothed.
+            bow_nodes: IntParam::new("Bow Nodes", 10, bow_nodes_range()),
+            bow_width_mm: FloatParam::new("Bow Width", 10.0, bow_width_mm_range())
+                .with_unit(" mm")
+                .with_step_size(0.5)
+                .with_value_to_string(formatters::v2s_f32_rounded(1)),
             editor_state: Default::default(),
         }
     }

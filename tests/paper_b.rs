@@ -288,34 +288,25 @@ fn the_thermal_bow_renders_at_the_host_rate_in_tune_and_bounded() {
 #[test]
 fn bowing_one_string_makes_the_open_strings_ring_through_the_bridge() {
     use colophony::admittance_fit::shipped_cello_bridge;
-    use colophony::dsp::thermal::ThermalQuartet;
-    let specs = ThermalStringSpec::cello_strings();
+    use colophony::dsp::instrument::{BowControl, InstrumentKind};
+    use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
     let run = |bridge: &[colophony::dsp::bridge::BridgeMode]| {
-        let mut q = ThermalQuartet::new(
-            &specs,
-            0,
-            6,
-            0.01,
-            bridge,
-            ThermalParams::default(),
-            HairParams::default(),
-        )
-        .unwrap();
-        let fs = q.internal_rate_hz();
-        let lifted = ThermalBowControl {
-            force_per_m: 0.0,
-            ..FIG6_BOW
+        let settings = ThermalSettings {
+            nodes: 6,
+            width_m: 0.01,
         };
-        let bowed = ThermalBowControl {
+        let mut cello =
+            ThermalInstrument::new(InstrumentKind::Cello, bridge, 48_000.0, settings).unwrap();
+        // Paper B's Figure 6 bow at beta 0.1 (Helmholtz motion): 300 N/m over 1 cm.
+        let bow = BowControl {
+            velocity_m_per_s: FIG6_BOW.velocity_m_per_s,
+            force_n: FIG6_BOW.force_per_m * 0.01,
             position_beta: 0.1,
-            ..FIG6_BOW
         };
-        let mut bows = [lifted; 4];
-        bows[0] = bowed;
-        for _ in 0..(0.5 * fs) as usize {
-            q.tick(&bows, 0);
-        }
-        let energies: Vec<f64> = (0..4).map(|i| q.string(i).energy_j()).collect();
+        assert_eq!(cello.note_on(36), Some(0));
+        let mut out = vec![0.0; 24_000];
+        cello.process(bow, &mut out);
+        let energies: Vec<f64> = (0..4).map(|i| cello.string(i).energy_j()).collect();
         energies
     };
     // The shipped generic cello bridge (assets/bridges/cello-generic.json).

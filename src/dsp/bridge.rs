@@ -80,6 +80,8 @@ struct Section {
 /// `Y(z)` at one sample rate (see the module doc).
 #[derive(Debug, Clone)]
 pub struct ModalBridge {
+    /// The continuous-time modes, validated (kept to rebuild the sections at a new rate).
+    modes: Vec<BridgeMode>,
     sections: Vec<Section>,
     r0: [[f64; 2]; 2],
     sample_rate_hz: f64,
@@ -87,10 +89,32 @@ pub struct ModalBridge {
 
 impl ModalBridge {
     pub fn new(modes: &[BridgeMode], sample_rate_hz: f64) -> Result<Self, String> {
-        let mut sections = Vec::with_capacity(modes.len());
-        let mut r0 = [[0.0; 2]; 2];
         for mode in modes {
             mode.validate()?;
+        }
+        if !(sample_rate_hz.is_finite() && sample_rate_hz > 0.0) {
+            return Err(format!("invalid bridge sample rate {sample_rate_hz}"));
+        }
+        let mut bridge = Self {
+            modes: modes.to_vec(),
+            sections: Vec::with_capacity(modes.len()),
+            r0: [[0.0; 2]; 2],
+            sample_rate_hz,
+        };
+        bridge.set_sample_rate(sample_rate_hz);
+        Ok(bridge)
+    }
+
+    /// Maps the modes to `sample_rate_hz` (dropping those at or above Nyquist) and clears
+    /// the state. Never allocates. A rate that is not finite and positive is ignored.
+    pub fn set_sample_rate(&mut self, sample_rate_hz: f64) {
+        if !(sample_rate_hz.is_finite() && sample_rate_hz > 0.0) {
+            return;
+        }
+        self.sample_rate_hz = sample_rate_hz;
+        self.sections.clear();
+        let mut r0 = [[0.0; 2]; 2];
+        for mode in &self.modes {
             if mode.freq_hz >= 0.5 * sample_rate_hz {
                 continue;
             }
@@ -105,18 +129,21 @@ impl ModalBridge {
                     r0[i][j] += gain[i][j];
                 }
             }
-            sections.push(Section {
+            self.sections.push(Section {
                 a1: 2.0 * (w * w - k * k) / d,
                 a2: (k * k - bw * k + w * w) / d,
                 gain,
                 ..Section::default()
             });
         }
-        Ok(Self {
-            sections,
-            r0,
-            sample_rate_hz,
-        })
+        self.r0 = r0;
+    }
+
+    /// Whether every section's state is below `threshold` (m/s): the bridge has rung out.
+    pub fn is_quiet(&self, threshold: f64) -> bool {
+        self.sections
+            .iter()
+            .all(|s| s.z1.iter().chain(&s.z2).all(|z| z.abs() < threshold))
     }
 
     pub fn mode_count(&self) -> usize {

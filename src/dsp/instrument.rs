@@ -112,7 +112,7 @@ impl InstrumentKind {
 
     /// Output scale: bridge force to a sample value, so that a default note of any
     /// instrument peaks near -12 dBFS.
-    fn output_scale_per_n(self) -> f64 {
+    pub fn output_scale_per_n(self) -> f64 {
         let mean_z0: f64 =
             self.strings().iter().map(|s| s.z0_kg_per_s).sum::<f64>() / STRINGS as f64;
         0.1 / mean_z0

@@ -42,20 +42,27 @@ pub struct Resampler {
     /// Output samples produced so far.
     produced: u64,
     half_in: f64,
+    output_rate_hz: f64,
 }
 
 impl Resampler {
     pub fn new(input_rate_hz: f64, output_rate_hz: f64) -> Result<Self, String> {
-        if !(input_rate_hz.is_finite() && output_rate_hz.is_finite())
-            || input_rate_hz <= 0.0
-            || output_rate_hz <= 0.0
+        Self::with_capacity(input_rate_hz, output_rate_hz, input_rate_hz)
+    }
+
+    /// A resampler whose input rate may later change, without allocating, to any rate up
+    /// to `max_input_rate_hz` ([`Resampler::set_input_rate`]).
+    pub fn with_capacity(
+        input_rate_hz: f64,
+        output_rate_hz: f64,
+        max_input_rate_hz: f64,
+    ) -> Result<Self, String> {
+        let valid = |r: f64| r.is_finite() && r > 0.0;
+        if !(valid(input_rate_hz) && valid(output_rate_hz) && valid(max_input_rate_hz))
+            || input_rate_hz > max_input_rate_hz
         {
             return Err(format!("invalid rates {input_rate_hz} -> {output_rate_hz}"));
         }
-        let ratio = input_rate_hz / output_rate_hz;
-        let cutoff = 0.45 * input_rate_hz.min(output_rate_hz);
-        let g = 2.0 * cutoff / input_rate_hz;
-        let half_in = HALF_WIDTH as f64 / g;
         let n = HALF_WIDTH * TABLE_STEPS;
         let i0b = bessel_i0(KAISER_BETA);
         let table = (0..=n + 1)
@@ -73,16 +80,46 @@ impl Resampler {
                 sinc * bessel_i0(KAISER_BETA * (1.0 - r * r).sqrt()) / i0b
             })
             .collect();
-        let len = (2.0 * half_in).ceil() as usize + 4;
-        Ok(Self {
-            ratio,
-            g,
+        // The kernel spans the most input samples at the highest input rate.
+        let (_, _, widest) = Self::geometry(max_input_rate_hz, output_rate_hz);
+        let len = (2.0 * widest).ceil() as usize + 4;
+        let mut r = Self {
+            ratio: 1.0,
+            g: 1.0,
             table,
             history: vec![0.0; len.next_power_of_two()],
             pulled: 0,
             produced: 0,
-            half_in,
-        })
+            half_in: 1.0,
+            output_rate_hz,
+        };
+        r.set_input_rate(input_rate_hz)?;
+        Ok(r)
+    }
+
+    /// Ratio, kernel scale and half-width in input samples for these rates.
+    fn geometry(input_rate_hz: f64, output_rate_hz: f64) -> (f64, f64, f64) {
+        let ratio = input_rate_hz / output_rate_hz;
+        let cutoff = 0.45 * input_rate_hz.min(output_rate_hz);
+        let g = 2.0 * cutoff / input_rate_hz;
+        (ratio, g, HALF_WIDTH as f64 / g)
+    }
+
+    /// Changes the input rate and clears the history. Never allocates; refuses a rate whose
+    /// kernel would not fit the history allocated by [`Resampler::with_capacity`].
+    pub fn set_input_rate(&mut self, input_rate_hz: f64) -> Result<(), &'static str> {
+        if !(input_rate_hz.is_finite() && input_rate_hz > 0.0) {
+            return Err("invalid input rate");
+        }
+        let (ratio, g, half_in) = Self::geometry(input_rate_hz, self.output_rate_hz);
+        if (2.0 * half_in).ceil() as usize + 4 > self.history.len() {
+            return Err("input rate beyond the resampler's capacity");
+        }
+        self.ratio = ratio;
+        self.g = g;
+        self.half_in = half_in;
+        self.reset();
+        Ok(())
     }
 
     /// Output delay in output samples (the kernel's half-width).

@@ -250,12 +250,96 @@ struct Nodes {
     vp_y: Vec<f64>,
 }
 
+impl Nodes {
+    fn with_capacity(n: usize) -> Self {
+        let v = || Vec::with_capacity(n);
+        Self {
+            hair_x: v(),
+            hair_v: v(),
+            vy: v(),
+            y: v(),
+            fy: v(),
+            force: v(),
+            v_delta: v(),
+            normal: v(),
+            slipping: Vec::with_capacity(n),
+            vp: v(),
+            vp_y: v(),
+        }
+    }
+
+    /// `n` nodes at rest; never allocates within the capacity.
+    fn resize(&mut self, n: usize) {
+        for v in [
+            &mut self.hair_x,
+            &mut self.hair_v,
+            &mut self.vy,
+            &mut self.y,
+            &mut self.fy,
+            &mut self.force,
+            &mut self.v_delta,
+            &mut self.normal,
+            &mut self.vp,
+            &mut self.vp_y,
+        ] {
+            v.clear();
+            v.resize(n, 0.0);
+        }
+        self.slipping.clear();
+        self.slipping.resize(n, false);
+    }
+}
+
+/// Why a configuration of a thermal string was refused (no allocation: the audio thread
+/// may ask).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ThermalConfigError {
+    Nodes(usize),
+    Width(f64),
+    Rate(f64),
+    /// The bow does not fit on the vibrating length (too high a note for this bow).
+    BowWiderThanString,
+    /// The FTCS bound would need more than [`MAX_THERMAL_SUBSTEPS`] sub-steps.
+    GridTooFine { ratio: f64, substeps: usize },
+    /// More nodes, grid points or delay than the string was allocated for.
+    Capacity,
+}
+
+impl std::fmt::Display for ThermalConfigError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Nodes(n) => write!(f, "the node count must be 1..=200, got {n}"),
+            Self::Width(w) => write!(f, "the bow width must be 0.1..30 mm, got {w} m"),
+            Self::Rate(r) => write!(f, "invalid internal rate {r}"),
+            Self::BowWiderThanString => write!(f, "the bow is wider than the string"),
+            Self::GridTooFine { ratio, substeps } => write!(
+                f,
+                "thermal grid too fine: alpha dt / dx^2 = {ratio:.3} needs {substeps} sub-steps \
+                 (at most {MAX_THERMAL_SUBSTEPS}); use fewer nodes or a lower diffusivity"
+            ),
+            Self::Capacity => write!(f, "configuration beyond the allocated capacity"),
+        }
+    }
+}
+
+/// What a [`ThermalString`] allocates for, so later changes of node count, bow width,
+/// rate and note never allocate.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ThermalCapacity {
+    pub max_nodes: usize,
+    pub max_rate_hz: f64,
+    /// Lowest fundamental the string will be tuned to.
+    pub lowest_hz: f64,
+}
+
 /// A string with a finite-width thermal bow (see the module doc).
 #[derive(Debug, Clone)]
 pub struct ThermalString {
     spec: ThermalStringSpec,
     thermal: ThermalParams,
     hair: HairParams,
+    /// Transverse wave speed `2 L f0` (fixed by tension and density: stopping keeps it).
+    c_m_per_s: f64,
     nodes_count: usize,
     width_m: f64,
     dx_m: f64,
@@ -264,14 +348,16 @@ pub struct ThermalString {
     m: usize,
     /// Position index of the first (bridge-side) bow node.
     bow_start: usize,
-    /// Delay lines per polarisation: `[h, v]`.
+    /// Delay lines per polarisation: `[h, v]`, rings of a power-of-two length.
     right: [Vec<f64>; 2],
     left: [Vec<f64>; 2],
+    mask: usize,
     t: usize,
     nodes: Nodes,
     /// Temperature grid: margin, bow nodes, margin.
     temperature: Vec<f64>,
     temperature_next: Vec<f64>,
+    grid_capacity: usize,
     margin_nodes: usize,
     substeps: usize,
     /// Whether the hair touched the string last sample (its state needs clearing on lift).
@@ -324,6 +410,21 @@ fn check_psd(name: &str, y: [[f64; 2]; 2]) -> Result<(), String> {
     }
 }
 
+/// The loop at `fs` for a fundamental `f0`: loss filter (the fundamental decays at `Q1`,
+/// twenty times its frequency at `Q1 / 2`), integer half-loop `m` and the Thiran
+/// coefficient of the remaining delay `d` in `[0.5, 2.5)`: `2 m + d = fs / f0 - loss delay`.
+fn loop_tuning(fs: f64, f0: f64, q1: f64) -> (OnePoleLoss, usize, f64) {
+    let w1 = 2.0 * PI * f0 / fs;
+    let w2 = (20.0 * w1).min(0.4 * PI);
+    let g1 = (-PI / q1).exp();
+    let g2 = (-PI * (w2 / w1) / (0.5 * q1)).exp();
+    let loss = OnePoleLoss::fit(w1, g1, w2, g2);
+    let remainder = fs / f0 - loss.phase_delay(w1);
+    let m = ((remainder - 0.5) / 2.0).floor().max(0.0) as usize;
+    let a = Allpass1::coefficient_for_delay(remainder - 2.0 * m as f64, w1);
+    (loss, m, a)
+}
+
 impl ThermalString {
     /// Builds the string with `nodes` bow nodes over `width_m`. Errors name the bad value.
     pub fn new(
@@ -345,8 +446,8 @@ impl ThermalString {
     }
 
     /// The string run at a given internal rate (several strings coupled at one bridge share
-    /// one rate, set by the bowed string): the node spacing is then `c / fs`, so the bow
-    /// spans `N_B c / fs`, which is `width_m` only on the string that set the rate.
+    /// one rate): the node spacing is then `c / fs`, so the bow spans `N_B c / fs`, which
+    /// is `width_m` only on a string whose rate it set.
     pub fn at_rate(
         spec: ThermalStringSpec,
         nodes: usize,
@@ -355,91 +456,165 @@ impl ThermalString {
         thermal: ThermalParams,
         hair: HairParams,
     ) -> Result<Self, String> {
+        let capacity = ThermalCapacity {
+            max_nodes: nodes.max(1),
+            max_rate_hz: internal_rate_hz,
+            lowest_hz: spec.f0_hz,
+        };
+        let mut s = Self::with_capacity(spec, thermal, hair, capacity)?;
+        s.configure(nodes, width_m, internal_rate_hz)
+            .map_err(|e| e.to_string())?;
+        Ok(s)
+    }
+
+    /// Allocates for every configuration within `capacity` (node counts, rates and notes)
+    /// and configures the string at its open pitch with one node at the lowest rate that
+    /// fits; call [`ThermalString::configure`] next.
+    pub fn with_capacity(
+        spec: ThermalStringSpec,
+        thermal: ThermalParams,
+        hair: HairParams,
+        capacity: ThermalCapacity,
+    ) -> Result<Self, String> {
         thermal.validate()?;
         check_psd("nut", spec.nut_admittance)?;
         check_psd("bridge", spec.bridge_admittance)?;
-        if !(1..=200).contains(&nodes) {
-            return Err(format!("the node count must be 1..=200, got {nodes}"));
-        }
-        if !(width_m.is_finite() && (1e-4..=0.03).contains(&width_m)) {
-            return Err(format!("the bow width must be 0.1..30 mm, got {width_m} m"));
-        }
         if !(spec.f0_hz > 0.0 && spec.z0_kg_per_s > 0.0 && spec.length_m > 0.0 && spec.q1 > 0.0) {
             return Err("string frequency, impedance, length and Q must be positive".into());
         }
-        if !(internal_rate_hz.is_finite() && internal_rate_hz > 0.0) {
-            return Err(format!("invalid internal rate {internal_rate_hz}"));
+        let ThermalCapacity {
+            max_nodes,
+            max_rate_hz,
+            lowest_hz,
+        } = capacity;
+        if !(max_rate_hz.is_finite() && max_rate_hz > 0.0) {
+            return Err(format!("invalid internal rate {max_rate_hz}"));
+        }
+        if !(lowest_hz.is_finite() && lowest_hz > 0.0) {
+            return Err(format!("invalid lowest frequency {lowest_hz}"));
         }
         let c = 2.0 * spec.length_m * spec.f0_hz;
-        let fs = internal_rate_hz;
-        let dx = c / fs;
-        let w1 = 2.0 * PI * spec.f0_hz / fs;
-        let w2 = (20.0 * w1).min(0.4 * PI);
-        // Per round trip: the fundamental decays at Q1, twenty times the frequency at Q1/2.
-        let g1 = (-PI / spec.q1).exp();
-        let g2 = (-PI * (w2 / w1) / (0.5 * spec.q1)).exp();
-        let loss = OnePoleLoss::fit(w1, g1, w2, g2);
-        // Tuning: 2 m + d = fs / f0 - loss delay, with a Thiran delay d in [0.5, 2.5).
-        let remainder = fs / spec.f0_hz - loss.phase_delay(w1);
-        let m = ((remainder - 0.5) / 2.0).floor().max(0.0) as usize;
-        if m < nodes + 4 {
-            return Err("the bow is wider than the string".into());
-        }
-        let fraction = Allpass1::new(Allpass1::coefficient_for_delay(
-            remainder - 2.0 * m as f64,
-            w1,
-        ));
-        let margin_nodes = (thermal.margin_m / dx).round() as usize;
-        let dt = 1.0 / fs;
-        let r = thermal.diffusivity_m2_per_s * dt / (dx * dx);
-        let substeps = (r / FTCS_TARGET).ceil().max(1.0) as usize;
-        if substeps > MAX_THERMAL_SUBSTEPS {
-            return Err(format!(
-                "thermal grid too fine: alpha dt / dx^2 = {r:.3} needs {substeps} sub-steps \
-                 (at most {MAX_THERMAL_SUBSTEPS}); use fewer nodes or a lower diffusivity"
-            ));
-        }
-        let grid = nodes + 2 * margin_nodes;
+        let ring = ((max_rate_hz / lowest_hz / 2.0).ceil() as usize + 4).next_power_of_two();
+        let dx_min = c / max_rate_hz;
+        let grid_capacity = max_nodes + 2 * ((thermal.margin_m / dx_min).round() as usize + 1);
         let zeros = |n: usize| vec![0.0; n];
         Ok(Self {
             spec,
             thermal,
             hair,
-            nodes_count: nodes,
-            width_m,
-            dx_m: dx,
-            internal_rate_hz: fs,
-            m,
+            c_m_per_s: c,
+            nodes_count: 0,
+            width_m: 0.0,
+            dx_m: dx_min,
+            internal_rate_hz: max_rate_hz,
+            m: 0,
             bow_start: 0,
-            right: [zeros(m + 1), zeros(m + 1)],
-            left: [zeros(m + 1), zeros(m + 1)],
+            right: [zeros(ring), zeros(ring)],
+            left: [zeros(ring), zeros(ring)],
+            mask: ring - 1,
             t: 0,
-            nodes: Nodes {
-                hair_x: zeros(nodes),
-                hair_v: zeros(nodes),
-                vy: zeros(nodes),
-                y: zeros(nodes),
-                fy: zeros(nodes),
-                force: zeros(nodes),
-                v_delta: zeros(nodes),
-                normal: zeros(nodes),
-                slipping: vec![false; nodes],
-                vp: zeros(nodes),
-                vp_y: zeros(nodes),
-            },
-            temperature: zeros(grid),
-            temperature_next: zeros(grid),
-            margin_nodes,
-            substeps,
+            nodes: Nodes::with_capacity(max_nodes),
+            temperature: Vec::with_capacity(grid_capacity),
+            temperature_next: Vec::with_capacity(grid_capacity),
+            grid_capacity,
+            margin_nodes: 0,
+            substeps: 1,
             contact_active: true,
             thermal_active: true,
-            loss: [loss, loss],
-            fraction: [fraction, fraction],
+            loss: [OnePoleLoss::default(); 2],
+            fraction: [Allpass1::new(0.0); 2],
             nut_reflection: reflection(spec.z0_kg_per_s, spec.nut_admittance),
             bridge_reflection: reflection(spec.z0_kg_per_s, spec.bridge_admittance),
         })
     }
 
+    /// Sets the node count, bow width and internal rate, and silences the string. Checks
+    /// the FTCS bound (sub-steps, or refuses), the capacity and that the bow fits; on an
+    /// error nothing changes. Never allocates.
+    pub fn configure(
+        &mut self,
+        nodes: usize,
+        width_m: f64,
+        internal_rate_hz: f64,
+    ) -> Result<(), ThermalConfigError> {
+        if !(1..=200).contains(&nodes) {
+            return Err(ThermalConfigError::Nodes(nodes));
+        }
+        if !(width_m.is_finite() && (1e-4..=0.03).contains(&width_m)) {
+            return Err(ThermalConfigError::Width(width_m));
+        }
+        if !(internal_rate_hz.is_finite() && internal_rate_hz > 0.0) {
+            return Err(ThermalConfigError::Rate(internal_rate_hz));
+        }
+        let fs = internal_rate_hz;
+        let dx = self.c_m_per_s / fs;
+        let margin_nodes = (self.thermal.margin_m / dx).round() as usize;
+        let grid = nodes + 2 * margin_nodes;
+        let r = self.thermal.diffusivity_m2_per_s / fs / (dx * dx);
+        let substeps = (r / FTCS_TARGET).ceil().max(1.0) as usize;
+        if substeps > MAX_THERMAL_SUBSTEPS {
+            return Err(ThermalConfigError::GridTooFine { ratio: r, substeps });
+        }
+        if nodes > self.nodes.hair_x.capacity() || grid > self.grid_capacity {
+            return Err(ThermalConfigError::Capacity);
+        }
+        let (loss, m, a) = loop_tuning(fs, self.spec.f0_hz, self.spec.q1);
+        if m + 4 > self.mask {
+            return Err(ThermalConfigError::Capacity);
+        }
+        if m < nodes + 4 {
+            return Err(ThermalConfigError::BowWiderThanString);
+        }
+        self.nodes_count = nodes;
+        self.width_m = width_m;
+        self.dx_m = dx;
+        self.internal_rate_hz = fs;
+        self.margin_nodes = margin_nodes;
+        self.substeps = substeps;
+        self.nodes.resize(nodes);
+        for v in [&mut self.temperature, &mut self.temperature_next] {
+            v.clear();
+            v.resize(grid, 0.0);
+        }
+        self.m = m;
+        self.loss = [loss; 2];
+        self.fraction = [Allpass1::new(a); 2];
+        self.reset();
+        Ok(())
+    }
+
+    /// Stops the string so its fundamental is `f0_hz` (the wave speed stays, the vibrating
+    /// length shortens): new loss filter, half-loop and Thiran delay, waves kept where they
+    /// are. Returns `false`, changing nothing, if the note does not fit (beyond the
+    /// capacity, or the bow would not fit on the vibrating length). Never allocates.
+    pub fn set_fundamental(&mut self, f0_hz: f64) -> bool {
+        if !(f0_hz.is_finite() && f0_hz > 0.0) {
+            return false;
+        }
+        let (loss, m, a) = loop_tuning(self.internal_rate_hz, f0_hz, self.spec.q1);
+        if m + 4 > self.mask || m < self.nodes_count + 4 {
+            return false;
+        }
+        self.spec.f0_hz = f0_hz;
+        self.spec.length_m = self.c_m_per_s / (2.0 * f0_hz);
+        self.m = m;
+        for p in 0..2 {
+            self.loss[p].g = loss.g;
+            self.loss[p].p = loss.p;
+            self.fraction[p].a = a;
+        }
+        true
+    }
+
+    /// Fundamental the loop is tuned to, Hz.
+    pub fn fundamental_hz(&self) -> f64 {
+        self.spec.f0_hz
+    }
+
+    /// Transverse wave speed, m/s.
+    pub fn wave_speed_m_per_s(&self) -> f64 {
+        self.c_m_per_s
+    }
     pub fn internal_rate_hz(&self) -> f64 {
         self.internal_rate_hz
     }
@@ -498,12 +673,12 @@ impl ThermalString {
     pub fn energy_j(&self) -> f64 {
         let z = self.spec.z0_kg_per_s;
         let fs = self.internal_rate_hz;
-        let cap = self.m + 1;
+        let mask = self.mask;
         let mut sum = 0.0;
         for p in 0..2 {
             for x in 0..self.m {
-                let a = self.right[p][(self.t + cap - x) % cap];
-                let b = self.left[p][(self.t + cap - (self.m - 1 - x)) % cap];
+                let a = self.right[p][self.t.wrapping_sub(x) & mask];
+                let b = self.left[p][self.t.wrapping_sub(self.m - 1 - x) & mask];
                 sum += a * a + b * b;
             }
         }
@@ -551,10 +726,10 @@ impl ThermalString {
 
     /// The bow contact and thermal update of one sample (no terminations).
     pub fn tick_contact(&mut self, bow: ThermalBowControl) -> ThermalFrame {
-        let cap = self.m + 1;
+        let mask = self.mask;
         let m = self.m;
         let t = self.t;
-        let at = |delay: usize| (t + cap - delay) % cap;
+        let at = |delay: usize| t.wrapping_sub(delay) & mask;
         let z = self.spec.z0_kg_per_s;
         let half_y = 0.5 / z;
         let dt = 1.0 / self.internal_rate_hz;
@@ -579,8 +754,8 @@ impl ThermalString {
 
         // Consecutive nodes sit at consecutive positions: step the ring indices instead of
         // taking a modulo per node (right-going index falls, left-going rises with x).
-        let step_r = |i: usize| if i == 0 { cap - 1 } else { i - 1 };
-        let step_l = |i: usize| if i + 1 == cap { 0 } else { i + 1 };
+        let step_r = |i: usize| i.wrapping_sub(1) & mask;
+        let step_l = |i: usize| (i + 1) & mask;
         let (ir0, il0) = (at(self.bow_start), at(m - 1 - self.bow_start));
         let nodes = &mut self.nodes;
         if !on {
@@ -716,8 +891,7 @@ impl ThermalString {
     /// filter). Call once per sample, after [`ThermalString::tick_contact`] and before
     /// [`ThermalString::finish_sample`]; the bridge model answers with the outgoing waves.
     pub fn arriving_at_bridge(&mut self) -> [f64; 2] {
-        let cap = self.m + 1;
-        let i = (self.t + cap - (self.m - 1)) % cap;
+        let i = self.t.wrapping_sub(self.m - 1) & self.mask;
         [
             self.loss[0].tick(self.left[0][i]),
             self.loss[1].tick(self.left[1][i]),
@@ -727,14 +901,13 @@ impl ThermalString {
     /// Ends the sample: writes the waves leaving the bridge, reflects at the nut, and
     /// advances time.
     pub fn finish_sample(&mut self, leaving_bridge: [f64; 2]) {
-        let cap = self.m + 1;
-        let i = (self.t + cap - (self.m - 1)) % cap;
+        let i = self.t.wrapping_sub(self.m - 1) & self.mask;
         let mut at_nut = [0.0; 2];
         for p in 0..2 {
             at_nut[p] = self.fraction[p].tick(self.right[p][i]);
         }
         let rn = self.nut_reflection;
-        let next = (self.t + 1) % cap;
+        let next = (self.t + 1) & self.mask;
         for p in 0..2 {
             self.right[p][next] = flush_tiny(leaving_bridge[p]);
             self.left[p][next] = flush_tiny(rn[p][0] * at_nut[0] + rn[p][1] * at_nut[1]);
@@ -801,87 +974,5 @@ mod tests {
         }
         // Rigid: -I.
         assert_eq!(reflection(1.0, [[0.0; 2]; 2]), [[-1.0, 0.0], [0.0, -1.0]]);
-    }
-}
-
-/// Four strings (both polarisations) meeting at one modal bridge, all at the internal rate
-/// of the string the bow plays (paper B §5): bowing one string makes the others ring.
-#[derive(Debug, Clone)]
-pub struct ThermalQuartet {
-    strings: Vec<ThermalString>,
-    bridge: super::bridge::ModalBridge,
-    arriving: Vec<[f64; 2]>,
-    leaving: Vec<[f64; 2]>,
-    impedances: Vec<f64>,
-}
-
-/// One sample of the quartet.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct QuartetFrame {
-    /// Total force of the strings on the bridge `[h, v]`, N (the body's drive).
-    pub bridge_force_n: [f64; 2],
-    /// Bridge velocity `[h, v]`, m/s.
-    pub bridge_velocity_m_per_s: [f64; 2],
-    /// The bowed string's contact signals.
-    pub bowed: ThermalFrame,
-}
-
-impl ThermalQuartet {
-    /// `specs` are the four strings; `bowed` the one whose bow width sets the rate.
-    pub fn new(
-        specs: &[ThermalStringSpec],
-        bowed: usize,
-        nodes: usize,
-        width_m: f64,
-        bridge: &[super::bridge::BridgeMode],
-        thermal: ThermalParams,
-        hair: HairParams,
-    ) -> Result<Self, String> {
-        let lead = specs.get(bowed).ok_or("no such string")?;
-        let fs = 2.0 * lead.length_m * lead.f0_hz * nodes as f64 / width_m;
-        let strings = specs
-            .iter()
-            .map(|spec| ThermalString::at_rate(*spec, nodes, width_m, fs, thermal, hair))
-            .collect::<Result<Vec<_>, _>>()?;
-        let impedances = specs.iter().map(|s| s.z0_kg_per_s).collect();
-        Ok(Self {
-            bridge: super::bridge::ModalBridge::new(bridge, fs)?,
-            arriving: vec![[0.0; 2]; specs.len()],
-            leaving: vec![[0.0; 2]; specs.len()],
-            impedances,
-            strings,
-        })
-    }
-
-    pub fn internal_rate_hz(&self) -> f64 {
-        self.strings[0].internal_rate_hz()
-    }
-
-    pub fn string(&self, i: usize) -> &ThermalString {
-        &self.strings[i]
-    }
-
-    /// One sample; `bows[i]` is string `i`'s bow (zero force: not bowed).
-    pub fn tick(&mut self, bows: &[ThermalBowControl], report: usize) -> QuartetFrame {
-        let mut frame = QuartetFrame::default();
-        for (i, (string, bow)) in self.strings.iter_mut().zip(bows).enumerate() {
-            let f = string.tick_contact(*bow);
-            if i == report {
-                frame.bowed = f;
-            }
-            self.arriving[i] = string.arriving_at_bridge();
-        }
-        let (v, force) = super::bridge::solve_junction(
-            &mut self.bridge,
-            &self.arriving,
-            &self.impedances,
-            &mut self.leaving,
-        );
-        for (string, leaving) in self.strings.iter_mut().zip(&self.leaving) {
-            string.finish_sample(*leaving);
-        }
-        frame.bridge_force_n = force;
-        frame.bridge_velocity_m_per_s = v;
-        frame
     }
 }

@@ -1,0 +1,465 @@
+//! Paper B's whole instrument, as the plugin plays it: the four strings of a violin, viola or
+//! cello, each with two polarisations and the finite-width thermal bow of
+//! [`super::thermal`], coupled at the instrument's passive modal bridge
+//! ([`super::bridge`]), run at one internal rate and resampled to the host rate.
+//!
+//! **One rate, one bow width.** All strings meet at the bridge sample by sample, so they
+//! share one internal rate: `fs = c_low N_B / w`, set by the lowest string (wave speed
+//! `c_low = 2 L f_low`) so that it carries `N_B` nodes over the bow width `w` (paper B's
+//! Table 1 counts nodes on the cello C string). A higher string has a faster wave speed
+//! `c_i`, hence a wider node spacing `c_i / fs`; it gets `round(N_B c_low / c_i)` nodes
+//! (at least one) so that the bow is about `w` wide on every string.
+//!
+//! **Notes.** As in [`super::instrument::Instrument`]: a note goes to the highest open
+//! string at or below it, stopped to sound it (the wave speed stays, the vibrating length
+//! shortens); the bow lands and lifts over [`BOW_RAMP_S`]. A note whose vibrating length
+//! cannot hold the bow plus a few samples is ignored (coarse bows on high notes). The bow
+//! force in newtons is spread evenly over the width: `F_b = F / w` (N/m).
+//!
+//! **Changing the bow** (node count, width) rebuilds the grid: the output fades out over
+//! [`RECONFIGURE_FADE_S`], the strings are reconfigured in place (no allocation) and the
+//! held notes' bows land again. The audio bandwidth is the internal rate's Nyquist
+//! frequency (a coarse bow is a low rate: `N_B = 1` over 1 cm on the cello is 9 kHz).
+//!
+//! **Skipping.** A lifted bow costs no contact or thermal work (see
+//! [`super::thermal::ThermalString::tick_contact`]). While any string sounds, all four run,
+//! so the open strings ring in sympathy through the bridge; once every bow is lifted and
+//! every string and the bridge have rung out, the whole instrument sleeps at no cost and
+//! wakes exactly.
+//!
+//! ```
+//! use colophony::dsp::instrument::{BowControl, InstrumentKind};
+//! use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
+//! let bridge = colophony::admittance_fit::shipped_cello_bridge().modes;
+//! let mut cello = ThermalInstrument::new(InstrumentKind::Cello, &bridge, 48_000.0, ThermalSettings::default()).unwrap();
+//! cello.note_on(50);
+//! let frame = cello.tick(BowControl::default());
+//! assert!(frame.audio.is_finite());
+//! ```
+
+use super::bridge::{solve_junction, BridgeMode, ModalBridge};
+use super::filters::flush_tiny;
+use super::instrument::{
+    midi_to_hz, BowControl, Frame, InstrumentKind, BOW_RAMP_S, PITCH_BEND_SEMITONES,
+    SLEEP_ENERGY_J, STRINGS,
+};
+use super::resample::Resampler;
+use super::thermal::{
+    HairParams, ThermalBowControl, ThermalCapacity, ThermalConfigError, ThermalParams,
+    ThermalString, ThermalStringSpec,
+};
+
+/// Most bow nodes on the lowest string (paper B's Figure 6 uses 60).
+pub const MAX_NODES: usize = 60;
+/// Narrowest and widest bow, m (a tilted bow touches with a few mm of hair; a flat
+/// violin bow with about 1 cm, paper B's value).
+pub const MIN_WIDTH_M: f64 = 0.005;
+pub const MAX_WIDTH_M: f64 = 0.02;
+/// Fade-out before the grid is rebuilt for a new node count or width, s.
+pub const RECONFIGURE_FADE_S: f64 = 0.01;
+
+/// The bow's discretisation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ThermalSettings {
+    /// Nodes on the lowest string, 1..=[`MAX_NODES`].
+    pub nodes: usize,
+    /// Bow width in contact, m, [`MIN_WIDTH_M`]..=[`MAX_WIDTH_M`].
+    pub width_m: f64,
+}
+
+impl Default for ThermalSettings {
+    /// Ten nodes over 1 cm: 90 kHz on the cello, a few per cent of a core.
+    fn default() -> Self {
+        Self {
+            nodes: 10,
+            width_m: 0.01,
+        }
+    }
+}
+
+impl ThermalSettings {
+    /// Clamped into the supported ranges (a NaN width becomes the default).
+    pub fn clamped(self) -> Self {
+        let width_m = if self.width_m.is_finite() {
+            self.width_m.clamp(MIN_WIDTH_M, MAX_WIDTH_M)
+        } else {
+            Self::default().width_m
+        };
+        Self {
+            nodes: self.nodes.clamp(1, MAX_NODES),
+            width_m,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, Default)]
+struct Voice {
+    note: Option<u8>,
+    bowed: bool,
+    /// Bow envelope, 0 (lifted) to 1 (full force).
+    bow_gain: f64,
+}
+
+/// The strings and bridge at the internal rate.
+#[derive(Debug, Clone)]
+struct Core {
+    strings: Vec<ThermalString>,
+    bridge: ModalBridge,
+    arriving: [[f64; 2]; STRINGS],
+    leaving: [[f64; 2]; STRINGS],
+    impedances: [f64; STRINGS],
+    bows: [ThermalBowControl; STRINGS],
+    probed: usize,
+    /// The probed string's last internal sample: string velocity at the bow's middle node
+    /// and total friction force.
+    probe: (f64, f64),
+}
+
+impl Core {
+    /// One internal sample; returns the horizontal force on the bridge, N.
+    #[inline]
+    fn tick(&mut self) -> f64 {
+        for (i, string) in self.strings.iter_mut().enumerate() {
+            let f = string.tick_contact(self.bows[i]);
+            if i == self.probed {
+                self.probe = (f.string_velocity_m_per_s, f.friction_force_n);
+            }
+            self.arriving[i] = string.arriving_at_bridge();
+        }
+        let (_, force) = solve_junction(
+            &mut self.bridge,
+            &self.arriving,
+            &self.impedances,
+            &mut self.leaving,
+        );
+        for (string, leaving) in self.strings.iter_mut().zip(&self.leaving) {
+            string.finish_sample(*leaving);
+        }
+        force[0]
+    }
+}
+
+/// Paper B's four-string instrument at the host rate (see the module doc).
+#[derive(Debug, Clone)]
+pub struct ThermalInstrument {
+    kind: InstrumentKind,
+    settings: ThermalSettings,
+    /// Settings waiting for the fade-out to end.
+    pending: Option<ThermalSettings>,
+    fade: f64,
+    fade_step: f64,
+    core: Core,
+    resampler: Resampler,
+    voices: [Voice; STRINGS],
+    /// Wave speed of each string, m/s.
+    wave_speeds: [f64; STRINGS],
+    bend_semitones: f64,
+    ramp_step: f64,
+    output_scale: f64,
+    awake: bool,
+}
+
+impl ThermalInstrument {
+    /// Allocates for every setting within the limits ([`MAX_NODES`], [`MIN_WIDTH_M`]) and
+    /// every playable note; later changes never allocate. `bridge` is the instrument's
+    /// modal bridge (validated here).
+    pub fn new(
+        kind: InstrumentKind,
+        bridge: &[BridgeMode],
+        host_rate_hz: f64,
+        settings: ThermalSettings,
+    ) -> Result<Self, String> {
+        if !(host_rate_hz.is_finite() && host_rate_hz > 0.0) {
+            return Err(format!("invalid sample rate {host_rate_hz}"));
+        }
+        let open = kind.strings();
+        let length = kind.string_length_m();
+        let wave_speeds: [f64; STRINGS] = std::array::from_fn(|i| 2.0 * length * open[i].open_hz);
+        let max_rate = wave_speeds[0] * MAX_NODES as f64 / MIN_WIDTH_M;
+        let lowest_hz = open[0].open_hz * 2f64.powf(-PITCH_BEND_SEMITONES / 12.0) * 0.99;
+        let strings = open
+            .iter()
+            .map(|s| {
+                let spec = ThermalStringSpec {
+                    f0_hz: s.open_hz,
+                    z0_kg_per_s: s.z0_kg_per_s,
+                    length_m: length,
+                    ..ThermalStringSpec::cello_c()
+                };
+                ThermalString::with_capacity(
+                    spec,
+                    ThermalParams::default(),
+                    HairParams::default(),
+                    ThermalCapacity {
+                        max_nodes: MAX_NODES,
+                        max_rate_hz: max_rate,
+                        lowest_hz,
+                    },
+                )
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let settings = settings.clamped();
+        let rate = Self::internal_rate(&wave_speeds, settings);
+        let mut instrument = Self {
+            kind,
+            settings,
+            pending: None,
+            fade: 1.0,
+            fade_step: 1.0 / (RECONFIGURE_FADE_S * host_rate_hz).max(1.0),
+            core: Core {
+                strings,
+                bridge: ModalBridge::new(bridge, rate)?,
+                arriving: [[0.0; 2]; STRINGS],
+                leaving: [[0.0; 2]; STRINGS],
+                impedances: std::array::from_fn(|i| open[i].z0_kg_per_s),
+                bows: [ThermalBowControl {
+                    velocity_m_per_s: 0.0,
+                    force_per_m: 0.0,
+                    position_beta: 0.1,
+                }; STRINGS],
+                probed: 0,
+                probe: (0.0, 0.0),
+            },
+            resampler: Resampler::with_capacity(rate, host_rate_hz, max_rate)?,
+            voices: [Voice::default(); STRINGS],
+            wave_speeds,
+            bend_semitones: 0.0,
+            ramp_step: 1.0 / (BOW_RAMP_S * host_rate_hz).max(1.0),
+            output_scale: kind.output_scale_per_n(),
+            awake: false,
+        };
+        instrument
+            .apply_settings(settings)
+            .map_err(|e| e.to_string())?;
+        Ok(instrument)
+    }
+
+    fn internal_rate(wave_speeds: &[f64; STRINGS], settings: ThermalSettings) -> f64 {
+        wave_speeds[0] * settings.nodes as f64 / settings.width_m
+    }
+
+    /// Nodes on string `i` for these settings: about the same width on every string.
+    fn nodes_on(&self, i: usize, settings: ThermalSettings) -> usize {
+        ((settings.nodes as f64 * self.wave_speeds[0] / self.wave_speeds[i]).round() as usize)
+            .max(1)
+    }
+
+    /// Reconfigures everything now (strings silenced, held notes re-landed).
+    fn apply_settings(&mut self, settings: ThermalSettings) -> Result<(), ThermalConfigError> {
+        let rate = Self::internal_rate(&self.wave_speeds, settings);
+        for i in 0..STRINGS {
+            let nodes = self.nodes_on(i, settings);
+            if let Err(e) = self.core.strings[i].configure(nodes, settings.width_m, rate) {
+                // Put every string back on the settings that worked.
+                let old = self.settings;
+                let old_rate = Self::internal_rate(&self.wave_speeds, old);
+                for j in 0..=i {
+                    let n = self.nodes_on(j, old);
+                    let _ = self.core.strings[j].configure(n, old.width_m, old_rate);
+                }
+                return Err(e);
+            }
+        }
+        self.settings = settings;
+        self.core.bridge.set_sample_rate(rate);
+        // Within capacity by construction (rate <= the maximum rate).
+        let _ = self.resampler.set_input_rate(rate);
+        for (voice, string) in self.voices.iter_mut().zip(self.core.strings.iter_mut()) {
+            voice.bow_gain = 0.0;
+            if let Some(note) = voice.note {
+                if !string.set_fundamental(midi_to_hz(note as f64 + self.bend_semitones)) {
+                    *voice = Voice::default();
+                }
+            }
+        }
+        self.awake = self.voices.iter().any(|v| v.bowed);
+        Ok(())
+    }
+
+    /// Asks for new bow settings (clamped to the limits). If the instrument sounds, the
+    /// output fades out first and the change lands after [`RECONFIGURE_FADE_S`].
+    pub fn set_settings(&mut self, settings: ThermalSettings) {
+        let settings = settings.clamped();
+        if settings == self.settings && self.pending.is_none() {
+            return;
+        }
+        if self.awake {
+            self.pending = Some(settings);
+        } else {
+            // Within the limits every setting is valid; keep the old one if not.
+            let _ = self.apply_settings(settings);
+        }
+    }
+
+    pub fn settings(&self) -> ThermalSettings {
+        self.settings
+    }
+
+    pub fn kind(&self) -> InstrumentKind {
+        self.kind
+    }
+
+    pub fn internal_rate_hz(&self) -> f64 {
+        Self::internal_rate(&self.wave_speeds, self.settings)
+    }
+
+    /// Nodes on each string at the current settings.
+    pub fn nodes_per_string(&self) -> [usize; STRINGS] {
+        std::array::from_fn(|i| self.core.strings[i].nodes())
+    }
+
+    /// Stops the string for `note` and lands the bow. `None` (ignored) if no string can
+    /// play it with this bow.
+    pub fn note_on(&mut self, note: u8) -> Option<usize> {
+        let index = self.kind.string_for_note(note)?;
+        let f0 = midi_to_hz(note as f64 + self.bend_semitones);
+        if !self.core.strings[index].set_fundamental(f0) {
+            return None;
+        }
+        let voice = &mut self.voices[index];
+        voice.note = Some(note);
+        voice.bowed = true;
+        self.core.probed = index;
+        self.awake = true;
+        Some(index)
+    }
+
+    /// Lifts the bow from the string playing `note`, if any.
+    pub fn note_off(&mut self, note: u8) {
+        for voice in &mut self.voices {
+            if voice.note == Some(note) {
+                voice.bowed = false;
+            }
+        }
+    }
+
+    pub fn all_notes_off(&mut self) {
+        for voice in &mut self.voices {
+            voice.bowed = false;
+        }
+    }
+
+    /// Pitch bend in semitones (clamped to the bend range).
+    pub fn set_pitch_bend(&mut self, semitones: f64) {
+        let semitones = semitones.clamp(-PITCH_BEND_SEMITONES, PITCH_BEND_SEMITONES);
+        if semitones == self.bend_semitones {
+            return;
+        }
+        self.bend_semitones = semitones;
+        for (voice, string) in self.voices.iter_mut().zip(self.core.strings.iter_mut()) {
+            if let Some(note) = voice.note {
+                if !string.set_fundamental(midi_to_hz(note as f64 + semitones)) {
+                    // Bent out of what the bow allows: lift it, the string rings on.
+                    voice.bowed = false;
+                }
+            }
+        }
+    }
+
+    pub fn reset(&mut self) {
+        for s in &mut self.core.strings {
+            s.reset();
+        }
+        self.core.bridge.reset();
+        self.resampler.reset();
+        for voice in &mut self.voices {
+            *voice = Voice::default();
+        }
+        self.core.probe = (0.0, 0.0);
+        self.awake = false;
+    }
+
+    /// Whether anything sounds (a bow down or a string still ringing).
+    pub fn is_sounding(&self) -> bool {
+        self.awake
+    }
+
+    /// The string a note went to last (for the editor's views and the tests).
+    pub fn probed_string(&self) -> &ThermalString {
+        &self.core.strings[self.core.probed]
+    }
+
+    pub fn string(&self, i: usize) -> &ThermalString {
+        &self.core.strings[i]
+    }
+
+    /// Total wave and hair energy of the strings, J.
+    pub fn energy_j(&self) -> f64 {
+        self.core.strings.iter().map(|s| s.energy_j()).sum()
+    }
+
+    /// Puts the instrument to sleep once every bow is lifted and the strings and the
+    /// bridge have rung out (called once per block: it walks the delay lines).
+    pub fn update_sleep(&mut self) {
+        if !self.awake || self.pending.is_some() {
+            return;
+        }
+        let lifted = self.voices.iter().all(|v| !v.bowed && v.bow_gain == 0.0);
+        if lifted
+            && self.core.bridge.is_quiet(1e-12)
+            && self.core.strings.iter().all(|s| s.energy_j() < SLEEP_ENERGY_J)
+        {
+            for s in &mut self.core.strings {
+                s.reset();
+            }
+            self.core.bridge.reset();
+            self.resampler.reset();
+            self.core.probe = (0.0, 0.0);
+            self.awake = false;
+        }
+    }
+
+    /// One host sample.
+    #[inline]
+    pub fn tick(&mut self, bow: BowControl) -> Frame {
+        if !self.awake {
+            return Frame::default();
+        }
+        if let Some(settings) = self.pending {
+            self.fade -= self.fade_step;
+            if self.fade <= 0.0 {
+                self.pending = None;
+                self.fade = 1.0;
+                let _ = self.apply_settings(settings);
+                return Frame::default();
+            }
+        }
+        let force_per_m = bow.force_n.max(0.0) / self.settings.width_m;
+        for (voice, control) in self.voices.iter_mut().zip(self.core.bows.iter_mut()) {
+            let target = if voice.bowed { 1.0 } else { 0.0 };
+            if voice.bow_gain != target {
+                voice.bow_gain = if voice.bowed {
+                    (voice.bow_gain + self.ramp_step).min(1.0)
+                } else {
+                    (voice.bow_gain - self.ramp_step).max(0.0)
+                };
+            }
+            *control = ThermalBowControl {
+                velocity_m_per_s: bow.velocity_m_per_s,
+                force_per_m: force_per_m * voice.bow_gain,
+                position_beta: bow.position_beta,
+            };
+        }
+        let mut out = [0.0];
+        let core = &mut self.core;
+        self.resampler.process(|| core.tick(), &mut out);
+        let audio = flush_tiny(out[0] * self.output_scale * self.fade);
+        if !audio.is_finite() {
+            // Cannot happen with finite inputs; recover to silence rather than emit garbage.
+            self.reset();
+            return Frame::default();
+        }
+        Frame {
+            audio,
+            bow_point_velocity_m_per_s: self.core.probe.0,
+            friction_force_n: self.core.probe.1,
+        }
+    }
+
+    /// A loop over [`ThermalInstrument::tick`] with constant bow settings.
+    pub fn process(&mut self, bow: BowControl, out: &mut [f64]) {
+        for sample in out {
+            *sample = self.tick(bow).audio;
+        }
+    }
+}
