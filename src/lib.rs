@@ -275,7 +275,12 @@ impl Plugin for Colophony {
         context: &mut impl ProcessContext<Self>,
     ) -> ProcessStatus {
         let p = &self.params;
-        self.instrument.set_kind(p.instrument.value().into());
+        // The waveguide strings change instrument at once (silenced) only while they are
+        // what the notes play; ringing on behind another source, they finish first.
+        let wanted = self.wanted_source();
+        if wanted == Source::Strings || !self.instrument.is_sounding() {
+            self.instrument.set_kind(p.instrument.value().into());
+        }
         // The rubbed objects keep the last point law while the thermal model is chosen.
         if let Some(friction) = p.friction_model.value().point_law() {
             self.instrument.set_friction_model(friction);
@@ -285,7 +290,7 @@ impl Plugin for Colophony {
         for engine in &mut self.thermal {
             engine.set_settings(settings);
         }
-        self.apply_source(self.wanted_source());
+        self.apply_source(wanted);
         self.instrument.update_sleep();
         for engine in &mut self.thermal {
             engine.update_sleep();

@@ -687,3 +687,61 @@ fn extreme_bowing_never_exceeds_full_scale() {
     assert!(out.iter().flatten().all(|x| x.is_finite()));
     assert!(peak < 1.0 && peak > 0.5, "peak {peak}");
 }
+
+#[test]
+fn thermal_model_plays_in_tune_and_survives_bow_changes_and_switches_during_notes() {
+    let mut plugin = active_plugin(FS, BLOCK);
+    let switch_at = [24_001u64, 48_007, 72_011, 96_013, 120_017];
+    let events = [
+        plugin.plain("Bow Nodes", 20.0),
+        plugin.plain("Bow Width", 6.0),
+        plugin.text("Friction Model", "Hyperbolic"),
+        plugin.text("Friction Model", "Thermal (paper B)"),
+        plugin.text("Instrument", "Violin"),
+    ];
+    let mut score = Score::new()
+        .at(0, plugin.text("Friction Model", "Thermal (paper B)"))
+        .at(0, plugin.plain("Bow Force", 2.0))
+        .at(0, Event::note_on(57));
+    for (at, event) in switch_at.iter().zip(events) {
+        score.push(*at, event);
+    }
+    score.push(144_000, Event::note_off(57));
+    let out = plugin.render(168_000, BLOCK, &score);
+    write_wav("thermal-switches", FS, &out);
+    let x = channel_f64(&out, 0);
+    assert!(x.iter().all(|v| v.is_finite() && (*v == 0.0 || v.is_normal())));
+    let peak = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    println!("peak {peak:.3}");
+    assert!(peak < 1.0, "peak {peak}");
+    // Sounds in every section: the rebuilds fade out and land the bow again.
+    for at in [0u64, 24_001, 48_007, 72_011, 96_013, 120_017] {
+        let from = at as usize + 9_600;
+        let level = rms(&x[from..from + 9_600]);
+        println!("from sample {from}: RMS {level:.4}");
+        assert!(level > 1e-3, "silent after {from}");
+    }
+    // After the note off, A3 (moved to the violin's G string by the instrument switch)
+    // rings at its pitch: 5 cents, about the smallest difference players notice on
+    // sustained tones (the bowed pitch flattens with force: tests/paper_b.rs).
+    let nominal = midi_to_hz(57.0);
+    let error = cents(
+        peak_frequency_hz(&x[148_800..168_000], FS, nominal, 50.0),
+        nominal,
+    );
+    println!("thermal A3 free decay: {error:+.2} cents");
+    assert!(error.abs() < 5.0, "{error:+.2} cents");
+    // No click at the switches: the step right at each is no larger than the waveform's.
+    for at in switch_at {
+        let at = at as usize;
+        let step = |r: std::ops::Range<usize>| {
+            x[r].windows(2)
+                .map(|w| (w[1] - w[0]).abs())
+                .fold(0.0f64, f64::max)
+        };
+        let at_switch = step(at - 1..at + 3);
+        let before = step(at - 480..at - 1);
+        // 1.5x: a step no larger than the waveform's own corners is not a click.
+        assert!(at_switch <= 1.5 * before.max(1e-4), "click at sample {at}");
+    }
+}

@@ -412,14 +412,16 @@ fn check_psd(name: &str, y: [[f64; 2]; 2]) -> Result<(), String> {
 
 /// The loop at `fs` for a fundamental `f0`: loss filter (the fundamental decays at `Q1`,
 /// twenty times its frequency at `Q1 / 2`), integer half-loop `m` and the Thiran
-/// coefficient of the remaining delay `d` in `[0.5, 2.5)`: `2 m + d = fs / f0 - loss delay`.
-fn loop_tuning(fs: f64, f0: f64, q1: f64) -> (OnePoleLoss, usize, f64) {
+/// coefficient of the remaining delay `d` in `[0.5, 2.5)`:
+/// `2 m + d = fs / f0 - loss delay - extra`, `extra` being a termination's phase delay at
+/// `f0` in samples (a modal bridge's; 0 for the real 2x2 terminations).
+fn loop_tuning(fs: f64, f0: f64, q1: f64, extra_delay: f64) -> (OnePoleLoss, usize, f64) {
     let w1 = 2.0 * PI * f0 / fs;
     let w2 = (20.0 * w1).min(0.4 * PI);
     let g1 = (-PI / q1).exp();
     let g2 = (-PI * (w2 / w1) / (0.5 * q1)).exp();
     let loss = OnePoleLoss::fit(w1, g1, w2, g2);
-    let remainder = fs / f0 - loss.phase_delay(w1);
+    let remainder = fs / f0 - loss.phase_delay(w1) - extra_delay;
     let m = ((remainder - 0.5) / 2.0).floor().max(0.0) as usize;
     let a = Allpass1::coefficient_for_delay(remainder - 2.0 * m as f64, w1);
     (loss, m, a)
@@ -558,7 +560,7 @@ impl ThermalString {
         if nodes > self.nodes.hair_x.capacity() || grid > self.grid_capacity {
             return Err(ThermalConfigError::Capacity);
         }
-        let (loss, m, a) = loop_tuning(fs, self.spec.f0_hz, self.spec.q1);
+        let (loss, m, a) = loop_tuning(fs, self.spec.f0_hz, self.spec.q1, 0.0);
         if m + 4 > self.mask {
             return Err(ThermalConfigError::Capacity);
         }
@@ -588,10 +590,17 @@ impl ThermalString {
     /// are. Returns `false`, changing nothing, if the note does not fit (beyond the
     /// capacity, or the bow would not fit on the vibrating length). Never allocates.
     pub fn set_fundamental(&mut self, f0_hz: f64) -> bool {
-        if !(f0_hz.is_finite() && f0_hz > 0.0) {
+        self.set_fundamental_with_delay(f0_hz, 0.0)
+    }
+
+    /// [`ThermalString::set_fundamental`] on an end whose reflection delays the
+    /// fundamental by `extra_delay` samples more than the string's own terminations (a
+    /// modal bridge's phase delay at `f0`): the loop is shortened by it.
+    pub fn set_fundamental_with_delay(&mut self, f0_hz: f64, extra_delay: f64) -> bool {
+        if !(f0_hz.is_finite() && f0_hz > 0.0 && extra_delay.is_finite()) {
             return false;
         }
-        let (loss, m, a) = loop_tuning(self.internal_rate_hz, f0_hz, self.spec.q1);
+        let (loss, m, a) = loop_tuning(self.internal_rate_hz, f0_hz, self.spec.q1, extra_delay);
         if m + 4 > self.mask || m < self.nodes_count + 4 {
             return false;
         }

@@ -244,6 +244,27 @@ impl ThermalInstrument {
             .max(1)
     }
 
+    /// Phase delay (internal samples) that the bridge adds, over a rigid end, to the
+    /// horizontal wave of string `i` reflecting at `f0_hz`: with every string's impedance
+    /// on the bridge (`Z_s`), a wave arriving on string `i` leaves as
+    /// `r = -(1 + (Z_s - 2 Z_i) Y) / (1 + Z_s Y)` times itself, `Y = Y_hh(e^jw)`.
+    fn bridge_delay(&self, i: usize, f0_hz: f64) -> f64 {
+        let y = self.core.bridge.response(f0_hz)[0][0];
+        let z_s: f64 = self.core.impedances.iter().sum();
+        let z_i = self.core.impedances[i];
+        let num = (1.0 + (z_s - 2.0 * z_i) * y.0, (z_s - 2.0 * z_i) * y.1);
+        let den = (1.0 + z_s * y.0, z_s * y.1);
+        let phase = num.1.atan2(num.0) - den.1.atan2(den.0);
+        let w = 2.0 * std::f64::consts::PI * f0_hz / self.internal_rate_hz();
+        -phase / w
+    }
+
+    /// Tunes string `i` to `f0_hz` with the bridge's delay accounted for.
+    fn tune(&mut self, i: usize, f0_hz: f64) -> bool {
+        let delay = self.bridge_delay(i, f0_hz);
+        self.core.strings[i].set_fundamental_with_delay(f0_hz, delay)
+    }
+
     /// Reconfigures everything now (strings silenced, held notes re-landed).
     fn apply_settings(&mut self, settings: ThermalSettings) -> Result<(), ThermalConfigError> {
         let rate = Self::internal_rate(&self.wave_speeds, settings);
@@ -264,12 +285,14 @@ impl ThermalInstrument {
         self.core.bridge.set_sample_rate(rate);
         // Within capacity by construction (rate <= the maximum rate).
         let _ = self.resampler.set_input_rate(rate);
-        for (voice, string) in self.voices.iter_mut().zip(self.core.strings.iter_mut()) {
-            voice.bow_gain = 0.0;
-            if let Some(note) = voice.note {
-                if !string.set_fundamental(midi_to_hz(note as f64 + self.bend_semitones)) {
-                    *voice = Voice::default();
-                }
+        for i in 0..STRINGS {
+            self.voices[i].bow_gain = 0.0;
+            let f0 = match self.voices[i].note {
+                Some(note) => midi_to_hz(note as f64 + self.bend_semitones),
+                None => self.kind.strings()[i].open_hz,
+            };
+            if !self.tune(i, f0) {
+                self.voices[i] = Voice::default();
             }
         }
         self.awake = self.voices.iter().any(|v| v.bowed);
@@ -313,7 +336,7 @@ impl ThermalInstrument {
     pub fn note_on(&mut self, note: u8) -> Option<usize> {
         let index = self.kind.string_for_note(note)?;
         let f0 = midi_to_hz(note as f64 + self.bend_semitones);
-        if !self.core.strings[index].set_fundamental(f0) {
+        if !self.tune(index, f0) {
             return None;
         }
         let voice = &mut self.voices[index];
@@ -346,11 +369,11 @@ impl ThermalInstrument {
             return;
         }
         self.bend_semitones = semitones;
-        for (voice, string) in self.voices.iter_mut().zip(self.core.strings.iter_mut()) {
-            if let Some(note) = voice.note {
-                if !string.set_fundamental(midi_to_hz(note as f64 + semitones)) {
+        for i in 0..STRINGS {
+            if let Some(note) = self.voices[i].note {
+                if !self.tune(i, midi_to_hz(note as f64 + semitones)) {
                     // Bent out of what the bow allows: lift it, the string rings on.
-                    voice.bowed = false;
+                    self.voices[i].bowed = false;
                 }
             }
         }
