@@ -124,7 +124,10 @@ impl Colophony {
     /// The source the parameters ask for.
     fn wanted_source(&self) -> Source {
         let p = &self.params;
-        match (p.resonator.value().preset(), p.friction_model.value().point_law()) {
+        match (
+            p.resonator.value().preset(),
+            p.friction_model.value().point_law(),
+        ) {
             (Some(preset), _) => Source::Rubbed(preset),
             (None, Some(_)) => Source::Strings,
             (None, None) => {

@@ -333,7 +333,14 @@ fn the_thermal_instrument_rings_in_tune_and_flattens_with_bow_force() {
     use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
     let bridge = shipped_cello_bridge().modes;
     let mut g_string = Vec::new();
-    for (note, force_n) in [(36u8, 2.0), (43, 0.5), (43, 1.0), (43, 2.0), (50, 1.0), (57, 1.0)] {
+    for (note, force_n) in [
+        (36u8, 2.0),
+        (43, 0.5),
+        (43, 1.0),
+        (43, 2.0),
+        (50, 1.0),
+        (57, 1.0),
+    ] {
         let mut cello = ThermalInstrument::new(
             InstrumentKind::Cello,
             &bridge,
@@ -351,11 +358,17 @@ fn the_thermal_instrument_rings_in_tune_and_flattens_with_bow_force() {
         cello.process(bow, &mut out);
         let nominal = midi_to_hz(note as f64);
         // +-600 cents: wide enough for any flattening, narrower than the octave.
-        let bowed = cents(peak_frequency_hz(&out[9_600..], 48_000.0, nominal, 600.0), nominal);
+        let bowed = cents(
+            peak_frequency_hz(&out[9_600..], 48_000.0, nominal, 600.0),
+            nominal,
+        );
         cello.note_off(note);
         let mut decay = vec![0.0; 96_000];
         cello.process(bow, &mut decay);
-        let free = cents(peak_frequency_hz(&decay[4_800..], 48_000.0, nominal, 600.0), nominal);
+        let free = cents(
+            peak_frequency_hz(&decay[4_800..], 48_000.0, nominal, 600.0),
+            nominal,
+        );
         println!(
             "cello MIDI {note} at {force_n} N: bowed {bowed:+.2} cents, free {free:+.2} cents, RMS {:.4}, nodes {:?}",
             rms(&out[9_600..]),
@@ -368,11 +381,17 @@ fn the_thermal_instrument_rings_in_tune_and_flattens_with_bow_force() {
         assert!(free.abs() < 5.0, "MIDI {note}: free decay {free:+.2} cents");
         // Bowing only flattens (the capture is delayed under force), never sharpens by more
         // than the free string's error.
-        assert!(bowed < free + 1.0, "MIDI {note}: bowed {bowed:+.2}, free {free:+.2}");
+        assert!(
+            bowed < free + 1.0,
+            "MIDI {note}: bowed {bowed:+.2}, free {free:+.2}"
+        );
         if note == 43 {
             g_string.push(bowed);
         }
     }
     // Flattening grows with bow force (0.5, 1, 2 N on the open G).
-    assert!(g_string[0] > g_string[1] && g_string[1] > g_string[2], "{g_string:?}");
+    assert!(
+        g_string[0] > g_string[1] && g_string[1] > g_string[2],
+        "{g_string:?}"
+    );
 }

@@ -710,7 +710,9 @@ fn thermal_model_plays_in_tune_and_survives_bow_changes_and_switches_during_note
     let out = plugin.render(168_000, BLOCK, &score);
     write_wav("thermal-switches", FS, &out);
     let x = channel_f64(&out, 0);
-    assert!(x.iter().all(|v| v.is_finite() && (*v == 0.0 || v.is_normal())));
+    assert!(x
+        .iter()
+        .all(|v| v.is_finite() && (*v == 0.0 || v.is_normal())));
     let peak = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     println!("peak {peak:.3}");
     assert!(peak < 1.0, "peak {peak}");

@@ -300,7 +300,10 @@ pub enum ThermalConfigError {
     /// The bow does not fit on the vibrating length (too high a note for this bow).
     BowWiderThanString,
     /// The FTCS bound would need more than [`MAX_THERMAL_SUBSTEPS`] sub-steps.
-    GridTooFine { ratio: f64, substeps: usize },
+    GridTooFine {
+        ratio: f64,
+        substeps: usize,
+    },
     /// More nodes, grid points or delay than the string was allocated for.
     Capacity,
 }
@@ -332,9 +335,110 @@ pub struct ThermalCapacity {
     pub lowest_hz: f64,
 }
 
+/// Per-sample constants of the node solve (see [`ThermalString::tick_contact`]).
+#[derive(Debug, Clone, Copy)]
+struct NodeConsts {
+    dt: f64,
+    a: f64,
+    k_h: f64,
+    k_y: f64,
+    e_y: f64,
+    inv_d_y: f64,
+    inv_y_load: f64,
+    inv_x_load: f64,
+    half_y: f64,
+    f_b: f64,
+    v_b: f64,
+    mu_cold: f64,
+    mu_slope: f64,
+    t_cold: f64,
+    mu_lo: f64,
+    mu_hi: f64,
+}
+
+/// Every node's vertical junction and horizontal stick/slip solve for one sample: the
+/// nodes are independent within a sample, so the loop runs over equal-length slices,
+/// branch-free, and vectorises.
+#[inline(always)]
+fn solve_nodes_body(k: NodeConsts, nodes: &mut Nodes, temps: &[f64], n_b: usize) {
+    let fy_s = &mut nodes.fy[..n_b];
+    let vy_s = &mut nodes.vy[..n_b];
+    let y_s = &mut nodes.y[..n_b];
+    let vp_y = &nodes.vp_y[..n_b];
+    let vp = &nodes.vp[..n_b];
+    let hx = &mut nodes.hair_x[..n_b];
+    let hv = &mut nodes.hair_v[..n_b];
+    let force_s = &mut nodes.force[..n_b];
+    let normal_s = &mut nodes.normal[..n_b];
+    let vd_s = &mut nodes.v_delta[..n_b];
+    let temps = &temps[..n_b];
+    for i in 0..n_b {
+        // Vertical junction: the string and the hair mass move together.
+        let rhs = -0.5 * fy_s[i] + k.e_y * vy_s[i] - k.k_y * y_s[i];
+        let fy = (rhs * k.inv_d_y - vp_y[i]) * k.inv_y_load;
+        let vy = vp_y[i] + fy * k.half_y;
+        y_s[i] += 0.5 * k.dt * (vy + vy_s[i]);
+        vy_s[i] = vy;
+        fy_s[i] = fy;
+        let f_n = (k.f_b + fy).max(0.0);
+        // Horizontal: Friedlander with the hair's compliance; the clamp is the stick/slip
+        // decision (slip exactly when |F_stick| > mu F_N). mu(T) is ThermalParams::mu
+        // written out with min/max.
+        let b = -k.a * k.k_h * (hx[i] + 0.5 * k.dt * hv[i]);
+        let mu = (k.mu_cold + k.mu_slope * (temps[i] - k.t_cold))
+            .max(k.mu_lo)
+            .min(k.mu_hi);
+        let limit = mu * f_n;
+        let f_stick = (k.v_b + b - vp[i]) * k.inv_x_load;
+        let force = f_stick.max(-limit).min(limit);
+        let v_h = -k.a * force + b;
+        hx[i] += 0.5 * k.dt * (v_h + hv[i]);
+        hv[i] = v_h;
+        force_s[i] = force;
+        normal_s[i] = f_n;
+        // v_s - (v_b + v_h) = (F - F_stick)(1 / 2Z + a): exactly 0 while sticking.
+        vd_s[i] = (force - f_stick) * (k.half_y + k.a);
+    }
+}
+
+/// The same loop compiled for AVX2 (four lanes of f64 instead of SSE2's two); chosen at
+/// run time. No FMA contraction happens (Rust keeps `a * b + c` as two roundings), so both
+/// paths give bit-identical results.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn solve_nodes_avx2(k: NodeConsts, nodes: &mut Nodes, temps: &[f64], n_b: usize) {
+    solve_nodes_body(k, nodes, temps, n_b)
+}
+
+#[inline]
+fn solve_nodes(wide_simd: bool, k: NodeConsts, nodes: &mut Nodes, temps: &[f64], n_b: usize) {
+    #[cfg(target_arch = "x86_64")]
+    if wide_simd {
+        // SAFETY: `wide_simd` is true only where AVX2 was detected at run time.
+        unsafe { solve_nodes_avx2(k, nodes, temps, n_b) };
+        return;
+    }
+    let _ = wide_simd;
+    solve_nodes_body(k, nodes, temps, n_b)
+}
+
+/// Whether this CPU runs the AVX2 node loop.
+fn detect_wide_simd() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
 /// A string with a finite-width thermal bow (see the module doc).
 #[derive(Debug, Clone)]
 pub struct ThermalString {
+    /// AVX2 available for the node loop (detected once, at construction).
+    wide_simd: bool,
     spec: ThermalStringSpec,
     thermal: ThermalParams,
     hair: HairParams,
@@ -501,6 +605,7 @@ impl ThermalString {
         let grid_capacity = max_nodes + 2 * ((thermal.margin_m / dx_min).round() as usize + 1);
         let zeros = |n: usize| vec![0.0; n];
         Ok(Self {
+            wide_simd: detect_wide_simd(),
             spec,
             thermal,
             hair,
@@ -686,7 +791,7 @@ impl ThermalString {
         let mut sum = 0.0;
         for p in 0..2 {
             for x in 0..self.m {
-                let a = self.right[p][self.t.wrapping_sub(x) & mask];
+                let a = self.right[p][x.wrapping_sub(self.t) & mask];
                 let b = self.left[p][self.t.wrapping_sub(self.m - 1 - x) & mask];
                 sum += a * a + b * b;
             }
@@ -761,11 +866,12 @@ impl ThermalString {
         let d_y = m_y / dt + 0.5 * c_y + 0.25 * k_y * dt;
         let e_y = m_y / dt - 0.5 * c_y - 0.25 * k_y * dt;
 
-        // Consecutive nodes sit at consecutive positions: step the ring indices instead of
-        // taking a modulo per node (right-going index falls, left-going rises with x).
-        let step_r = |i: usize| i.wrapping_sub(1) & mask;
-        let step_l = |i: usize| (i + 1) & mask;
-        let (ir0, il0) = (at(self.bow_start), at(m - 1 - self.bow_start));
+        // Consecutive nodes sit at consecutive ring indices in both lines (see the layout
+        // note in `finish_sample`): contiguous slices unless a ring wraps under the bow.
+        let step = |i: usize| (i + 1) & mask;
+        let ir0 = self.bow_start.wrapping_sub(t) & mask;
+        let il0 = at(m - 1 - self.bow_start);
+        let contiguous = ir0 + n_b <= mask + 1 && il0 + n_b <= mask + 1;
         let nodes = &mut self.nodes;
         if !on {
             if !self.contact_active {
@@ -790,12 +896,29 @@ impl ThermalString {
             self.contact_active = true;
             // Gather the incoming waves, solve every node (independent within a sample,
             // branch-free so it vectorises), scatter the outgoing waves.
-            let (mut ir, mut il) = (ir0, il0);
-            for i in 0..n_b {
-                nodes.vp[i] = self.right[0][ir] + self.left[0][il];
-                nodes.vp_y[i] = self.right[1][ir] + self.left[1][il];
-                ir = step_r(ir);
-                il = step_l(il);
+            if contiguous {
+                let (r0, r1) = (
+                    &self.right[0][ir0..ir0 + n_b],
+                    &self.right[1][ir0..ir0 + n_b],
+                );
+                let (l0, l1) = (&self.left[0][il0..il0 + n_b], &self.left[1][il0..il0 + n_b]);
+                for (((v, a), b), (vy, (c, d))) in nodes.vp[..n_b]
+                    .iter_mut()
+                    .zip(r0)
+                    .zip(l0)
+                    .zip(nodes.vp_y[..n_b].iter_mut().zip(r1.iter().zip(l1)))
+                {
+                    *v = a + b;
+                    *vy = c + d;
+                }
+            } else {
+                let (mut ir, mut il) = (ir0, il0);
+                for i in 0..n_b {
+                    nodes.vp[i] = self.right[0][ir] + self.left[0][il];
+                    nodes.vp_y[i] = self.right[1][ir] + self.left[1][il];
+                    ir = step(ir);
+                    il = step(il);
+                }
             }
             let inv_d_y = 1.0 / d_y;
             let inv_y_load = 1.0 / (half_y + 0.5 * inv_d_y);
@@ -805,58 +928,55 @@ impl ThermalString {
             let temps = &self.temperature[self.margin_nodes..self.margin_nodes + n_b];
             let mu_slope = (th.mu_hot - th.mu_cold) / (th.t_hot_kelvin - th.t_cold_kelvin);
             let (mu_lo, mu_hi) = (th.mu_hot.min(th.mu_cold), th.mu_hot.max(th.mu_cold));
-            // Equal-length slices: the bounds checks go and the loop vectorises.
-            let fy_s = &mut nodes.fy[..n_b];
-            let vy_s = &mut nodes.vy[..n_b];
-            let y_s = &mut nodes.y[..n_b];
-            let vp_y = &nodes.vp_y[..n_b];
-            let vp = &nodes.vp[..n_b];
-            let hx = &mut nodes.hair_x[..n_b];
-            let hv = &mut nodes.hair_v[..n_b];
-            let force_s = &mut nodes.force[..n_b];
-            let normal_s = &mut nodes.normal[..n_b];
+            let k = NodeConsts {
+                dt,
+                a,
+                k_h,
+                k_y,
+                e_y,
+                inv_d_y,
+                inv_y_load,
+                inv_x_load,
+                half_y,
+                f_b,
+                v_b,
+                mu_cold: th.mu_cold,
+                mu_slope,
+                t_cold: th.t_cold_kelvin,
+                mu_lo,
+                mu_hi,
+            };
+            solve_nodes(self.wide_simd, k, nodes, temps, n_b);
             let slip_s = &mut nodes.slipping[..n_b];
-            let vd_s = &mut nodes.v_delta[..n_b];
-            for i in 0..n_b {
-                // Vertical junction: the string and the hair mass move together.
-                let rhs = -0.5 * fy_s[i] + e_y * vy_s[i] - k_y * y_s[i];
-                let fy = (rhs * inv_d_y - vp_y[i]) * inv_y_load;
-                let vy = vp_y[i] + fy * half_y;
-                y_s[i] += 0.5 * dt * (vy + vy_s[i]);
-                vy_s[i] = vy;
-                fy_s[i] = fy;
-                let f_n = (f_b + fy).max(0.0);
-                // Horizontal: Friedlander with the hair's compliance; the clamp is the
-                // stick/slip decision (slip exactly when |F_stick| > mu F_N). mu(T) is
-                // ThermalParams::mu written out with min/max.
-                let b = -a * k_h * (hx[i] + 0.5 * dt * hv[i]);
-                let mu = (th.mu_cold + mu_slope * (temps[i] - th.t_cold_kelvin))
-                    .max(mu_lo)
-                    .min(mu_hi);
-                let limit = mu * f_n;
-                let f_stick = (v_b + b - vp[i]) * inv_x_load;
-                let force = f_stick.max(-limit).min(limit);
-                let v_h = -a * force + b;
-                hx[i] += 0.5 * dt * (v_h + hv[i]);
-                hv[i] = v_h;
-                force_s[i] = force;
-                normal_s[i] = f_n;
-                // v_s - (v_b + v_h) = (F - F_stick)(1 / 2Z + a): exactly 0 while sticking.
-                vd_s[i] = (force - f_stick) * (half_y + a);
-            }
+            let vd_s = &nodes.v_delta[..n_b];
             for (slip, vd) in slip_s.iter_mut().zip(vd_s.iter()) {
                 *slip = *vd != 0.0;
             }
-            let (mut ir, mut il) = (ir0, il0);
-            for i in 0..n_b {
-                let dv = nodes.force[i] * half_y;
-                let dv_y = nodes.fy[i] * half_y;
-                self.right[0][ir] += dv;
-                self.left[0][il] += dv;
-                self.right[1][ir] += dv_y;
-                self.left[1][il] += dv_y;
-                ir = step_r(ir);
-                il = step_l(il);
+            if contiguous {
+                let [r0, r1] = &mut self.right;
+                let [l0, l1] = &mut self.left;
+                for (i, f) in nodes.force[..n_b].iter().enumerate() {
+                    let dv = f * half_y;
+                    r0[ir0 + i] += dv;
+                    l0[il0 + i] += dv;
+                }
+                for (i, f) in nodes.fy[..n_b].iter().enumerate() {
+                    let dv = f * half_y;
+                    r1[ir0 + i] += dv;
+                    l1[il0 + i] += dv;
+                }
+            } else {
+                let (mut ir, mut il) = (ir0, il0);
+                for i in 0..n_b {
+                    let dv = nodes.force[i] * half_y;
+                    let dv_y = nodes.fy[i] * half_y;
+                    self.right[0][ir] += dv;
+                    self.left[0][il] += dv;
+                    self.right[1][ir] += dv_y;
+                    self.left[1][il] += dv_y;
+                    ir = step(ir);
+                    il = step(il);
+                }
             }
             frame.friction_force_n = nodes.force.iter().sum();
             frame.normal_force_n = nodes.normal.iter().sum();
@@ -866,7 +986,8 @@ impl ThermalString {
         }
         if !on {
             let x = self.bow_start + mid;
-            frame.string_velocity_m_per_s = self.right[0][at(x)] + self.left[0][at(m - 1 - x)];
+            frame.string_velocity_m_per_s =
+                self.right[0][x.wrapping_sub(t) & mask] + self.left[0][at(m - 1 - x)];
         }
         // The grid idles once the bow is off and the contact has cooled to nothing.
         if on || self.thermal_active {
@@ -909,16 +1030,22 @@ impl ThermalString {
 
     /// Ends the sample: writes the waves leaving the bridge, reflects at the nut, and
     /// advances time.
+    ///
+    /// Layout: the left-going wave at position `x` (samples from the bridge) and time `t`
+    /// is `left[(t - (m - 1 - x)) & mask]`, the right-going one `right[(x - t) & mask]`; the
+    /// waves never move in memory, and both indices grow with `x`, so the bow's nodes
+    /// read and write contiguous slices.
     pub fn finish_sample(&mut self, leaving_bridge: [f64; 2]) {
-        let i = self.t.wrapping_sub(self.m - 1) & self.mask;
+        let j = (self.m - 1).wrapping_sub(self.t) & self.mask;
         let mut at_nut = [0.0; 2];
         for p in 0..2 {
-            at_nut[p] = self.fraction[p].tick(self.right[p][i]);
+            at_nut[p] = self.fraction[p].tick(self.right[p][j]);
         }
         let rn = self.nut_reflection;
         let next = (self.t + 1) & self.mask;
+        let bridge_end = 0usize.wrapping_sub(next) & self.mask;
         for p in 0..2 {
-            self.right[p][next] = flush_tiny(leaving_bridge[p]);
+            self.right[p][bridge_end] = flush_tiny(leaving_bridge[p]);
             self.left[p][next] = flush_tiny(rn[p][0] * at_nut[0] + rn[p][1] * at_nut[1]);
         }
         self.t = next;
@@ -932,6 +1059,24 @@ impl ThermalString {
     /// the whole grid (branch-free interior), then the friction source and convective loss
     /// on the bow's nodes.
     fn update_temperature(&mut self, dt: f64, dx: f64) {
+        #[cfg(target_arch = "x86_64")]
+        if self.wide_simd {
+            // SAFETY: `wide_simd` is true only where AVX2 was detected at run time.
+            unsafe { self.update_temperature_avx2(dt, dx) };
+            return;
+        }
+        self.update_temperature_body(dt, dx)
+    }
+
+    /// [`ThermalString::update_temperature`] compiled for AVX2 (bit-identical: no FMA).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn update_temperature_avx2(&mut self, dt: f64, dx: f64) {
+        self.update_temperature_body(dt, dx)
+    }
+
+    #[inline(always)]
+    fn update_temperature_body(&mut self, dt: f64, dx: f64) {
         let p = self.thermal;
         let h = dt / self.substeps as f64;
         let r = p.diffusivity_m2_per_s * h / (dx * dx);

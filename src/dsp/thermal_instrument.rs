@@ -420,7 +420,11 @@ impl ThermalInstrument {
         let lifted = self.voices.iter().all(|v| !v.bowed && v.bow_gain == 0.0);
         if lifted
             && self.core.bridge.is_quiet(1e-12)
-            && self.core.strings.iter().all(|s| s.energy_j() < SLEEP_ENERGY_J)
+            && self
+                .core
+                .strings
+                .iter()
+                .all(|s| s.energy_j() < SLEEP_ENERGY_J)
         {
             for s in &mut self.core.strings {
                 s.reset();
