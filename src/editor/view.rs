@@ -207,6 +207,15 @@ impl EditorUi {
                 ui.label("Output gain");
                 ui.add(ParamSlider::for_param(&p.gain, setter).with_width(100.0));
                 ui.end_row();
+                // The thermal bow's discretisation: shown only while that model plays.
+                if p.friction_model.value() == crate::params::FrictionChoice::Thermal {
+                    ui.label("Bow nodes");
+                    ui.add(ParamSlider::for_param(&p.bow_nodes, setter).with_width(100.0));
+                    ui.end_row();
+                    ui.label("Bow width");
+                    ui.add(ParamSlider::for_param(&p.bow_width_mm, setter).with_width(100.0));
+                    ui.end_row();
+                }
             });
         ui.add_space(6.0);
         ui.separator();
