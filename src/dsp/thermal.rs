@@ -50,6 +50,8 @@ use std::f64::consts::PI;
 
 /// Largest `alpha dt / dx^2` used per thermal sub-step (the bound is 1/2).
 pub const FTCS_TARGET: f64 = 0.45;
+/// Samples between flushes of tiny temperatures to zero (see `update_temperature`).
+const FLUSH_PERIOD: u32 = 32;
 /// Most thermal sub-steps per sample before a configuration is refused.
 pub const MAX_THERMAL_SUBSTEPS: usize = 64;
 
@@ -336,7 +338,7 @@ pub struct ThermalCapacity {
 }
 
 /// Per-sample constants of the node solve (see [`ThermalString::tick_contact`]).
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, Default)]
 struct NodeConsts {
     dt: f64,
     a: f64,
@@ -422,6 +424,21 @@ fn solve_nodes(wide_simd: bool, k: NodeConsts, nodes: &mut Nodes, temps: &[f64],
     solve_nodes_body(k, nodes, temps, n_b)
 }
 
+/// A sum in four interleaved partial sums (independent chains, so it vectorises instead
+/// of waiting on one addition after another); deterministic for the same input.
+#[inline]
+fn sum_lanes(x: &[f64]) -> f64 {
+    let mut acc = [0.0; 4];
+    let chunks = x.chunks_exact(4);
+    let rest: f64 = chunks.remainder().iter().sum();
+    for c in chunks {
+        for k in 0..4 {
+            acc[k] += c[k];
+        }
+    }
+    (acc[0] + acc[1]) + (acc[2] + acc[3]) + rest
+}
+
 /// Whether this CPU runs the AVX2 node loop.
 fn detect_wide_simd() -> bool {
     #[cfg(target_arch = "x86_64")]
@@ -439,6 +456,8 @@ fn detect_wide_simd() -> bool {
 pub struct ThermalString {
     /// AVX2 available for the node loop (detected once, at construction).
     wide_simd: bool,
+    /// The node solve's constants for the current configuration.
+    consts: NodeConsts,
     spec: ThermalStringSpec,
     thermal: ThermalParams,
     hair: HairParams,
@@ -462,6 +481,7 @@ pub struct ThermalString {
     temperature: Vec<f64>,
     temperature_next: Vec<f64>,
     grid_capacity: usize,
+    flush_countdown: u32,
     margin_nodes: usize,
     substeps: usize,
     /// Whether the hair touched the string last sample (its state needs clearing on lift).
@@ -606,6 +626,7 @@ impl ThermalString {
         let zeros = |n: usize| vec![0.0; n];
         Ok(Self {
             wide_simd: detect_wide_simd(),
+            consts: NodeConsts::default(),
             spec,
             thermal,
             hair,
@@ -624,6 +645,7 @@ impl ThermalString {
             temperature: Vec::with_capacity(grid_capacity),
             temperature_next: Vec::with_capacity(grid_capacity),
             grid_capacity,
+            flush_countdown: FLUSH_PERIOD,
             margin_nodes: 0,
             substeps: 1,
             contact_active: true,
@@ -686,8 +708,47 @@ impl ThermalString {
         self.m = m;
         self.loss = [loss; 2];
         self.fraction = [Allpass1::new(a); 2];
+        self.consts = self.node_consts();
         self.reset();
         Ok(())
+    }
+
+    /// The node solve's constants at the current rate and spacing (divisions done once
+    /// per configuration, not per sample); the bow's force and velocity are filled in per
+    /// sample.
+    fn node_consts(&self) -> NodeConsts {
+        let dt = 1.0 / self.internal_rate_hz;
+        let dx = self.dx_m;
+        let half_y = 0.5 / self.spec.z0_kg_per_s;
+        // Hair constants per node (trapezoid).
+        let k_h = self.hair.k_n_per_m_per_m * dx;
+        let c_h = self.hair.c_kg_per_s_per_m * dx;
+        let a = 1.0 / (c_h + 0.5 * k_h * dt);
+        let m_y = self.hair.vertical_mass_kg_per_m * dx;
+        let k_y = self.hair.vertical_k_n_per_m_per_m * dx;
+        let c_y = self.hair.vertical_c_kg_per_s_per_m * dx;
+        let d_y = m_y / dt + 0.5 * c_y + 0.25 * k_y * dt;
+        let e_y = m_y / dt - 0.5 * c_y - 0.25 * k_y * dt;
+        let inv_d_y = 1.0 / d_y;
+        let th = self.thermal;
+        NodeConsts {
+            dt,
+            a,
+            k_h,
+            k_y,
+            e_y,
+            inv_d_y,
+            inv_y_load: 1.0 / (half_y + 0.5 * inv_d_y),
+            inv_x_load: 1.0 / (half_y + a),
+            half_y,
+            f_b: 0.0,
+            v_b: 0.0,
+            mu_cold: th.mu_cold,
+            mu_slope: (th.mu_hot - th.mu_cold) / (th.t_hot_kelvin - th.t_cold_kelvin),
+            t_cold: th.t_cold_kelvin,
+            mu_lo: th.mu_hot.min(th.mu_cold),
+            mu_hi: th.mu_hot.max(th.mu_cold),
+        }
     }
 
     /// Stops the string so its fundamental is `f0_hz` (the wave speed stays, the vibrating
@@ -844,27 +905,19 @@ impl ThermalString {
         let m = self.m;
         let t = self.t;
         let at = |delay: usize| t.wrapping_sub(delay) & mask;
-        let z = self.spec.z0_kg_per_s;
-        let half_y = 0.5 / z;
-        let dt = 1.0 / self.internal_rate_hz;
         let n_b = self.nodes_count;
-        let centre = (bow.position_beta.clamp(0.01, 0.5) * m as f64).round() as usize;
+        // Round half up (beta * m >= 0), without a libm call per sample.
+        let centre = (bow.position_beta.clamp(0.01, 0.5) * m as f64 + 0.5) as usize;
         self.bow_start = centre.saturating_sub(n_b / 2).clamp(1, m - n_b - 1);
         let dx = self.dx_m;
         let f_b = bow.force_per_m.max(0.0) * dx;
         let on = f_b > 0.0;
         let mut frame = ThermalFrame::default();
         let mid = n_b / 2;
-
-        // Hair constants per node (trapezoid).
-        let k_h = self.hair.k_n_per_m_per_m * dx;
-        let c_h = self.hair.c_kg_per_s_per_m * dx;
-        let a = 1.0 / (c_h + 0.5 * k_h * dt);
-        let m_y = self.hair.vertical_mass_kg_per_m * dx;
-        let k_y = self.hair.vertical_k_n_per_m_per_m * dx;
-        let c_y = self.hair.vertical_c_kg_per_s_per_m * dx;
-        let d_y = m_y / dt + 0.5 * c_y + 0.25 * k_y * dt;
-        let e_y = m_y / dt - 0.5 * c_y - 0.25 * k_y * dt;
+        let mut k = self.consts;
+        let (dt, half_y) = (k.dt, k.half_y);
+        k.f_b = f_b;
+        k.v_b = bow.velocity_m_per_s;
 
         // Consecutive nodes sit at consecutive ring indices in both lines (see the layout
         // note in `finish_sample`): contiguous slices unless a ring wraps under the bow.
@@ -920,32 +973,7 @@ impl ThermalString {
                     il = step(il);
                 }
             }
-            let inv_d_y = 1.0 / d_y;
-            let inv_y_load = 1.0 / (half_y + 0.5 * inv_d_y);
-            let inv_x_load = 1.0 / (half_y + a);
-            let v_b = bow.velocity_m_per_s;
-            let th = self.thermal;
             let temps = &self.temperature[self.margin_nodes..self.margin_nodes + n_b];
-            let mu_slope = (th.mu_hot - th.mu_cold) / (th.t_hot_kelvin - th.t_cold_kelvin);
-            let (mu_lo, mu_hi) = (th.mu_hot.min(th.mu_cold), th.mu_hot.max(th.mu_cold));
-            let k = NodeConsts {
-                dt,
-                a,
-                k_h,
-                k_y,
-                e_y,
-                inv_d_y,
-                inv_y_load,
-                inv_x_load,
-                half_y,
-                f_b,
-                v_b,
-                mu_cold: th.mu_cold,
-                mu_slope,
-                t_cold: th.t_cold_kelvin,
-                mu_lo,
-                mu_hi,
-            };
             solve_nodes(self.wide_simd, k, nodes, temps, n_b);
             let slip_s = &mut nodes.slipping[..n_b];
             let vd_s = &nodes.v_delta[..n_b];
@@ -955,15 +983,14 @@ impl ThermalString {
             if contiguous {
                 let [r0, r1] = &mut self.right;
                 let [l0, l1] = &mut self.left;
-                for (i, f) in nodes.force[..n_b].iter().enumerate() {
-                    let dv = f * half_y;
-                    r0[ir0 + i] += dv;
-                    l0[il0 + i] += dv;
-                }
-                for (i, f) in nodes.fy[..n_b].iter().enumerate() {
-                    let dv = f * half_y;
-                    r1[ir0 + i] += dv;
-                    l1[il0 + i] += dv;
+                for (forces, r, l) in [(&nodes.force, r0, l0), (&nodes.fy, r1, l1)] {
+                    let r = &mut r[ir0..ir0 + n_b];
+                    let l = &mut l[il0..il0 + n_b];
+                    for ((f, a), b) in forces[..n_b].iter().zip(r).zip(l) {
+                        let dv = f * half_y;
+                        *a += dv;
+                        *b += dv;
+                    }
                 }
             } else {
                 let (mut ir, mut il) = (ir0, il0);
@@ -978,9 +1005,9 @@ impl ThermalString {
                     il = step(il);
                 }
             }
-            frame.friction_force_n = nodes.force.iter().sum();
-            frame.normal_force_n = nodes.normal.iter().sum();
-            frame.slipping_nodes = nodes.slipping.iter().filter(|s| **s).count();
+            frame.friction_force_n = sum_lanes(&nodes.force);
+            frame.normal_force_n = sum_lanes(&nodes.normal);
+            frame.slipping_nodes = nodes.slipping.iter().map(|s| *s as usize).sum();
             frame.string_velocity_m_per_s = nodes.vp[mid] + nodes.force[mid] * half_y;
             frame.hair_velocity_m_per_s = nodes.hair_v[mid];
         }
@@ -1091,20 +1118,35 @@ impl ThermalString {
                 next[0] = t[0] * (1.0 - 2.0 * r);
             } else {
                 next[0] = t[0] + r * (t[1] - 2.0 * t[0]);
-                for j in 1..n - 1 {
-                    next[j] = t[j] + r * (t[j - 1] - 2.0 * t[j] + t[j + 1]);
+                for (out, w) in next[1..n - 1].iter_mut().zip(t.windows(3)) {
+                    *out = w[1] + r * (w[0] - 2.0 * w[1] + w[2]);
                 }
                 next[n - 1] = t[n - 1] + r * (t[n - 2] - 2.0 * t[n - 1]);
             }
-            for i in 0..self.nodes_count {
-                let v = self.nodes.v_delta[i].abs();
-                let j = off + i;
-                next[j] += heat * self.nodes.force[i].abs() * v - cool * t[j] * v;
-            }
-            for x in next.iter_mut() {
-                *x = flush_tiny(*x);
+            let n_b = self.nodes_count;
+            let bow = &mut next[off..off + n_b];
+            let t_bow = &t[off..off + n_b];
+            for (((out, tj), vd), f) in bow
+                .iter_mut()
+                .zip(t_bow)
+                .zip(&self.nodes.v_delta[..n_b])
+                .zip(&self.nodes.force[..n_b])
+            {
+                let v = vd.abs();
+                *out += heat * f.abs() * v - cool * tj * v;
             }
             std::mem::swap(&mut self.temperature, &mut self.temperature_next);
+        }
+        // Tiny temperatures go to zero every FLUSH_PERIOD samples: in that many steps a
+        // value above 1e-30 K cannot decay into the subnormals (each FTCS step scales a
+        // mode by at least 1 - 4 * 0.45 = -0.8 in magnitude, and the convective loss per
+        // step is far below 1), so no step ever computes with subnormals.
+        self.flush_countdown = self.flush_countdown.saturating_sub(1);
+        if self.flush_countdown == 0 {
+            self.flush_countdown = FLUSH_PERIOD;
+            for x in self.temperature.iter_mut() {
+                *x = flush_tiny(*x);
+            }
         }
     }
 }
