@@ -977,11 +977,8 @@ pub fn figure(rows: &[Row], out: &Path) -> Result<(), String> {
         RGBColor(255, 127, 14),
         RGBColor(23, 190, 207),
     ];
-    let panels: [(
-        &DrawingArea<BitMapBackend, _>,
-        &str,
-        fn(&Row) -> Option<f64>,
-    ); 2] = [
+    type Metric = fn(&Row) -> Option<f64>;
+    let panels: [(&DrawingArea<BitMapBackend, _>, &str, Metric); 2] = [
         (&left, "|f0 error| (cents)", |r| {
             r.errors.f0_cents.map(f64::abs)
         }),
