@@ -32,6 +32,13 @@ fn windowed_dtft(x: &[f64], sample_rate_hz: f64, freq_hz: f64) -> f64 {
     (re * re + im * im).sqrt()
 }
 
+/// Amplitude of a sinusoid at `freq_hz` in `x`, from the Hann-windowed DTFT (exact for a
+/// stationary sinusoid whose frequency is given, away from other partials).
+pub fn partial_amplitude(x: &[f64], sample_rate_hz: f64, freq_hz: f64) -> f64 {
+    // The Hann window's coherent gain is 1/2: a unit sinusoid gives N/4.
+    4.0 * windowed_dtft(x, sample_rate_hz, freq_hz) / x.len().max(1) as f64
+}
+
 /// Frequency of the strongest spectral peak within `search_cents` of `guess_hz`: a scan
 /// at 1-cent steps, then a golden-section refinement of the windowed DTFT magnitude.
 /// With a second or more of signal the estimate is far inside 0.1 cent for a clean partial.

@@ -12,6 +12,7 @@ pub mod dsp;
 pub mod editor;
 pub mod figures;
 pub mod params;
+pub mod precision;
 pub mod render;
 
 use dsp::instrument::{BowControl, Instrument, InstrumentKind, PITCH_BEND_SEMITONES};

@@ -80,8 +80,18 @@ enum Command {
         fit: Option<PathBuf>,
     },
     /// Print real-time ratios (run a release build): `friction` times 10 s of cello D at
-    /// 48 kHz with each friction law; `table1` times paper B's thermal bow per node count.
-    Bench { what: String },
+    /// 48 kHz with each friction law; `table1` times paper B's thermal bow per node count;
+    /// `precision --out DIR [--quick]` writes the work-precision benchmark (errors against
+    /// refined references beside the cost, and the STK and Faust peers) to DIR.
+    Bench {
+        what: String,
+        /// Output directory (precision).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// A one-minute variant with fewer configurations (precision).
+        #[arg(long)]
+        quick: bool,
+    },
     /// Fit a passive modal bridge admittance to measured data (CSV in, JSON out).
     FitBridge {
         input: PathBuf,
@@ -227,12 +237,16 @@ fn main() -> ExitCode {
             },
             other => colophony::figures::draw(other, &out),
         }),
-        Command::Bench { what } => report(match what.as_str() {
+        Command::Bench { what, out, quick } => report(match what.as_str() {
             "friction" => colophony::bench::friction_table(),
             "table1" => colophony::bench::table1(),
             "scenes" => colophony::bench::scenes(),
+            "precision" => match out {
+                Some(dir) => colophony::precision::run(&dir, quick),
+                None => Err("bench precision needs --out DIR".into()),
+            },
             other => Err(format!(
-                "unknown bench '{other}': choose friction, table1 or scenes"
+                "unknown bench '{other}': choose friction, table1, scenes or precision"
             )),
         }),
         Command::FitBridge { input, modes, out } => {

@@ -151,6 +151,16 @@ fn check(settings: &RenderSettings) -> Result<(), RenderError> {
 
 /// Bows one note for `seconds` (lifting the bow at `release_s` if set).
 pub fn render(settings: &RenderSettings) -> Result<Rendered, RenderError> {
+    render_with(settings, |_| {})
+}
+
+/// [`render`], with `configure` called on the instrument once it is set up and before the
+/// note starts (solver settings such as
+/// [`Instrument::set_newton_tolerance`]).
+pub fn render_with(
+    settings: &RenderSettings,
+    configure: impl FnOnce(&mut Instrument),
+) -> Result<Rendered, RenderError> {
     check(settings)?;
     let fs = settings.sample_rate_hz;
     let frames = (settings.seconds * fs).round() as usize;
@@ -160,6 +170,7 @@ pub fn render(settings: &RenderSettings) -> Result<Rendered, RenderError> {
         .set_bristle_params(settings.bristle)
         .map_err(RenderError::BadSetting)?;
     instrument.set_friction_model(settings.friction);
+    configure(&mut instrument);
     instrument.note_on(settings.note);
     let mut out = Rendered::with_capacity(fs, frames);
     for i in 0..frames {
@@ -190,30 +201,8 @@ pub fn render_thermal(
     width_m: f64,
 ) -> Result<Rendered, RenderError> {
     use crate::dsp::resample::Resampler;
-    use crate::dsp::thermal::{
-        HairParams, ThermalBowControl, ThermalParams, ThermalString, ThermalStringSpec,
-    };
-    check(settings)?;
-    let kind = settings.instrument;
-    let index = kind
-        .string_for_note(settings.note)
-        .expect("check() accepted the note");
-    let open = kind.strings()[index];
-    let f0 = crate::dsp::instrument::midi_to_hz(settings.note as f64);
-    let spec = ThermalStringSpec {
-        f0_hz: f0,
-        z0_kg_per_s: open.z0_kg_per_s,
-        length_m: kind.string_length_m() * open.open_hz / f0,
-        ..ThermalStringSpec::cello_c()
-    };
-    let mut string = ThermalString::new(
-        spec,
-        nodes,
-        width_m,
-        ThermalParams::default(),
-        HairParams::default(),
-    )
-    .map_err(RenderError::BadSetting)?;
+    use crate::dsp::thermal::ThermalBowControl;
+    let mut string = thermal_string(settings, nodes, width_m)?;
     let fs = settings.sample_rate_hz;
     let mut resampler =
         Resampler::new(string.internal_rate_hz(), fs).map_err(RenderError::BadSetting)?;
@@ -224,7 +213,7 @@ pub fn render_thermal(
     // share the audio's resampler by running the string once per block into buffers.
     let mut probe_resamplers = [resampler.clone(), resampler.clone()];
     let bow = settings.bow;
-    let scale = 0.1 / spec.z0_kg_per_s;
+    let scale = 0.1 / string.z0_kg_per_s();
     let block = 256;
     let mut internal: Vec<(f64, f64, f64)> = Vec::new();
     let mut buf = [vec![0.0; block], vec![0.0; block], vec![0.0; block]];
@@ -274,6 +263,38 @@ pub fn render_thermal(
     Ok(out)
 }
 
+/// The thermal string [`render_thermal`] bows: the open string under `settings.note`,
+/// stopped to its pitch (the vibrating length shortens), with the default thermal and
+/// hair constants.
+pub fn thermal_string(
+    settings: &RenderSettings,
+    nodes: usize,
+    width_m: f64,
+) -> Result<crate::dsp::thermal::ThermalString, RenderError> {
+    use crate::dsp::thermal::{HairParams, ThermalParams, ThermalString, ThermalStringSpec};
+    check(settings)?;
+    let kind = settings.instrument;
+    let index = kind
+        .string_for_note(settings.note)
+        .expect("check() accepted the note");
+    let open = kind.strings()[index];
+    let f0 = crate::dsp::instrument::midi_to_hz(settings.note as f64);
+    let spec = ThermalStringSpec {
+        f0_hz: f0,
+        z0_kg_per_s: open.z0_kg_per_s,
+        length_m: kind.string_length_m() * open.open_hz / f0,
+        ..ThermalStringSpec::cello_c()
+    };
+    ThermalString::new(
+        spec,
+        nodes,
+        width_m,
+        ThermalParams::default(),
+        HairParams::default(),
+    )
+    .map_err(RenderError::BadSetting)
+}
+
 /// Rubs one of the modal presets for `seconds` with the given friction law. The probe
 /// channels hold the resonator velocity at the contact and the friction force.
 pub fn render_rubbed(
@@ -281,6 +302,17 @@ pub fn render_rubbed(
     friction: FrictionModel,
     seconds: f64,
     sample_rate_hz: f64,
+) -> Result<Rendered, RenderError> {
+    render_rubbed_with(preset, friction, seconds, sample_rate_hz, |_| {})
+}
+
+/// [`render_rubbed`], with `configure` called on the scene before the first sample.
+pub fn render_rubbed_with(
+    preset: RubbedPreset,
+    friction: FrictionModel,
+    seconds: f64,
+    sample_rate_hz: f64,
+    configure: impl FnOnce(&mut RubbedScene),
 ) -> Result<Rendered, RenderError> {
     if !(seconds.is_finite() && seconds > 0.0 && seconds <= 600.0) {
         return Err(RenderError::BadSetting(format!(
@@ -294,6 +326,7 @@ pub fn render_rubbed(
     }
     let mut scene = RubbedScene::from_spec(preset.spec(), friction, sample_rate_hz)
         .map_err(RenderError::BadSetting)?;
+    configure(&mut scene);
     let frames = (seconds * sample_rate_hz).round() as usize;
     let mut out = Rendered::with_capacity(sample_rate_hz, frames);
     for _ in 0..frames {

@@ -438,6 +438,18 @@ impl Instrument {
         Ok(())
     }
 
+    /// Sets every string's Newton tolerance for the bristle laws (see
+    /// [`crate::dsp::friction::bristle::BristleFriction::set_newton_tolerance`]). Call it
+    /// after [`Self::set_bristle_params`], which rebuilds the contacts at the default.
+    pub fn set_newton_tolerance(&mut self, tolerance_m_per_s: f64) {
+        for voice in &mut self.voices {
+            voice
+                .contact
+                .bristle_mut()
+                .set_newton_tolerance(tolerance_m_per_s);
+        }
+    }
+
     pub fn friction_model(&self) -> FrictionModel {
         self.voices[0].contact.model()
     }

@@ -259,6 +259,14 @@ impl RubbedScene {
         self.contact.bristle().stats
     }
 
+    /// Newton tolerance of the bristle laws (see
+    /// [`crate::dsp::friction::bristle::BristleFriction::set_newton_tolerance`]).
+    pub fn set_newton_tolerance(&mut self, tolerance_m_per_s: f64) {
+        self.contact
+            .bristle_mut()
+            .set_newton_tolerance(tolerance_m_per_s);
+    }
+
     pub fn is_sticking(&self) -> bool {
         self.contact.is_sticking()
     }

@@ -57,7 +57,8 @@ use super::{BowInput, FrictionContact, LoadLine};
 pub const NEWTON_CAP: u32 = 20;
 /// Step halvings per Newton iteration when `|g|` does not fall.
 pub const MAX_DAMPING_HALVINGS: u32 = 8;
-/// Convergence: `|dy| <= Y_TOLERANCE_M_PER_S * max(1, |y|)`.
+/// Default convergence test: `|dy| <= Y_TOLERANCE_M_PER_S * max(1, |y|)` (see
+/// [`BristleFriction::set_newton_tolerance`]).
 pub const Y_TOLERANCE_M_PER_S: f64 = 1e-10;
 /// The contact counts as sticking while `|v|` is below this fraction of `v_s`.
 pub const STICK_FRACTION_OF_STRIBECK: f64 = 0.01;
@@ -204,6 +205,8 @@ pub struct BristleFriction {
     y_m_per_s: f64,
     /// Relative velocity `v(n-1)`, m/s.
     v_m_per_s: f64,
+    /// Newton stops once a step moves `y` by at most this times `max(1, |y|)`, m/s.
+    newton_tolerance_m_per_s: f64,
     pub stats: SolverStats,
 }
 
@@ -285,8 +288,23 @@ impl BristleFriction {
             z_m: 0.0,
             y_m_per_s: 0.0,
             v_m_per_s: 0.0,
+            newton_tolerance_m_per_s: Y_TOLERANCE_M_PER_S,
             stats: SolverStats::default(),
         })
+    }
+
+    /// Sets the Newton convergence tolerance on the step (m/s, relative above 1 m/s;
+    /// default [`Y_TOLERANCE_M_PER_S`]); a tolerance that is not finite and positive is
+    /// ignored. Looser tolerances trade accuracy for iterations (`colophony bench
+    /// precision` measures both).
+    pub fn set_newton_tolerance(&mut self, tolerance_m_per_s: f64) {
+        if tolerance_m_per_s.is_finite() && tolerance_m_per_s > 0.0 {
+            self.newton_tolerance_m_per_s = tolerance_m_per_s;
+        }
+    }
+
+    pub fn newton_tolerance_m_per_s(&self) -> f64 {
+        self.newton_tolerance_m_per_s
     }
 
     pub fn params(&self) -> BristleParams {
@@ -378,7 +396,8 @@ impl BristleFriction {
             let Some((candidate, gc, dc)) = accepted else {
                 // No descent along the Newton direction: either converged to rounding or
                 // stuck at a kink; the fallback decides.
-                if (t * step).abs() <= Y_TOLERANCE_M_PER_S * y.abs().max(1.0) || gy == 0.0 {
+                if (t * step).abs() <= self.newton_tolerance_m_per_s * y.abs().max(1.0) || gy == 0.0
+                {
                     return (y, Some(iteration));
                 }
                 break;
@@ -387,7 +406,7 @@ impl BristleFriction {
             y = candidate;
             gy = gc;
             dg = dc;
-            if moved <= Y_TOLERANCE_M_PER_S * y.abs().max(1.0) || gy == 0.0 {
+            if moved <= self.newton_tolerance_m_per_s * y.abs().max(1.0) || gy == 0.0 {
                 return (y, Some(iteration));
             }
         }

@@ -1,0 +1,147 @@
+//! Criterion benches per component, for profiling (`cargo bench --bench components`;
+//! `-- --quick` for a fast pass): one friction solve per law on the cello D load line, one
+//! waveguide string sample, one thermal string sample at N_B 10 and 60, and one modal
+//! bridge junction solve (four strings, the shipped 14-mode cello bridge). Whole-model
+//! costs against precision are `colophony bench precision`.
+
+use colophony::admittance_fit::shipped_cello_bridge;
+use colophony::dsp::bridge::{solve_junction, ModalBridge};
+use colophony::dsp::friction::bristle::{BristleFriction, BristleLaw, BristleParams};
+use colophony::dsp::friction::stribeck::StribeckFriction;
+use colophony::dsp::friction::{
+    AnyFriction, BowInput, FrictionContact, FrictionModel, HyperbolicFriction, LoadLine,
+};
+use colophony::dsp::instrument::InstrumentKind;
+use colophony::dsp::thermal::{
+    HairParams, ThermalBowControl, ThermalParams, ThermalString, ThermalStringSpec,
+};
+use colophony::dsp::waveguide::WaveguideString;
+use criterion::{criterion_group, criterion_main, Criterion};
+use std::hint::black_box;
+
+const FS: f64 = 48_000.0;
+/// Cello D, bow at one point: the two half-strings in parallel, `Y = 1 / (2 Z0)`.
+const CELLO_D_ADMITTANCE_S_PER_KG: f64 = 1.0 / (2.0 * 0.506);
+
+/// Free velocities across one Helmholtz period (sticking near the bow velocity, slipping
+/// far below it), so each solve sees a changing load as in the string.
+fn load_lines() -> Vec<LoadLine> {
+    (0..64)
+        .map(|i| LoadLine {
+            free_velocity_m_per_s: if i < 58 {
+                0.1 - 0.002 * (i % 7) as f64
+            } else {
+                -0.9
+            },
+            admittance_s_per_kg: CELLO_D_ADMITTANCE_S_PER_KG,
+        })
+        .collect()
+}
+
+fn friction_solve(c: &mut Criterion) {
+    let bow = BowInput {
+        velocity_m_per_s: 0.1,
+        normal_force_n: 1.1,
+    };
+    let loads = load_lines();
+    let mut group = c.benchmark_group("friction solve (one sample)");
+    let mut bench = |name: &str, contact: &mut dyn FrictionContact| {
+        let mut i = 0;
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                i = (i + 1) % loads.len();
+                black_box(contact.solve(black_box(loads[i]), bow))
+            })
+        });
+    };
+    bench("hyperbolic", &mut HyperbolicFriction::default());
+    bench("static (Stribeck)", &mut StribeckFriction::default());
+    for (name, law) in [
+        ("lugre", BristleLaw::LuGre),
+        ("elasto-plastic", BristleLaw::ElastoPlastic),
+    ] {
+        let mut contact =
+            BristleFriction::new(BristleParams::waveguide_string(), law, FS).expect("valid");
+        bench(name, &mut contact);
+    }
+    group.finish();
+}
+
+fn waveguide_tick(c: &mut Criterion) {
+    let spec = InstrumentKind::Cello.strings()[2];
+    let mut string = WaveguideString::new(spec, FS, 60.0);
+    let mut contact = AnyFriction::new(
+        FrictionModel::Hyperbolic,
+        BristleParams::waveguide_string(),
+        FS,
+    )
+    .expect("valid");
+    let bow = BowInput {
+        velocity_m_per_s: 0.1,
+        normal_force_n: 1.1,
+    };
+    // Into Helmholtz motion first, so the bench times the steady loop.
+    for _ in 0..FS as usize / 2 {
+        string.tick(&mut contact, bow);
+    }
+    c.bench_function("waveguide string tick (cello D, hyperbolic)", |b| {
+        b.iter(|| black_box(string.tick(&mut contact, black_box(bow))))
+    });
+}
+
+fn thermal_tick(c: &mut Criterion) {
+    let bow = ThermalBowControl {
+        velocity_m_per_s: 0.15,
+        force_per_m: 300.0,
+        position_beta: 0.1,
+    };
+    let mut group = c.benchmark_group("thermal string tick (internal rate)");
+    for nodes in [10, 60] {
+        let mut string = ThermalString::new(
+            ThermalStringSpec::cello_c(),
+            nodes,
+            0.01,
+            ThermalParams::default(),
+            HairParams::default(),
+        )
+        .expect("valid");
+        // A tenth of a second into the note.
+        for _ in 0..(0.1 * string.internal_rate_hz()) as usize {
+            string.tick(bow);
+        }
+        group.bench_function(format!("N_B {nodes}"), |b| {
+            b.iter(|| black_box(string.tick(black_box(bow))))
+        });
+    }
+    group.finish();
+}
+
+fn bridge_junction(c: &mut Criterion) {
+    let modes = shipped_cello_bridge().modes;
+    let mut bridge = ModalBridge::new(&modes, FS).expect("valid");
+    let z = [0.9, 0.7, 0.5, 0.35];
+    let mut leaving = [[0.0; 2]; 4];
+    let mut n = 0u32;
+    c.bench_function("modal bridge junction (4 strings, 14 modes)", |b| {
+        b.iter(|| {
+            n = n.wrapping_add(1);
+            let s = (n % 97) as f64 * 1e-3;
+            let arriving = [[s, -s], [0.5 * s, 0.0], [0.0, s], [-s, 0.2 * s]];
+            black_box(solve_junction(
+                &mut bridge,
+                black_box(&arriving),
+                &z,
+                &mut leaving,
+            ))
+        })
+    });
+}
+
+criterion_group!(
+    components,
+    friction_solve,
+    waveguide_tick,
+    thermal_tick,
+    bridge_junction
+);
+criterion_main!(components);
