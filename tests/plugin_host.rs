@@ -549,23 +549,7 @@ fn friction_model_and_resonator_switch_during_notes_without_allocation_nan_or_cl
     let x = channel_f64(&out, 0);
     assert!(x.iter().all(|v| v.is_finite()));
     let peak = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    // Largest sample-to-sample step right at each switch against the largest anywhere in
-    // the 10 ms before it (the waveform's own corners).
-    for at in switch_at {
-        let at = at as usize;
-        let step = |r: std::ops::Range<usize>| {
-            x[r].windows(2)
-                .map(|w| (w[1] - w[0]).abs())
-                .fold(0.0f64, f64::max)
-        };
-        let at_switch = step(at - 1..at + 3);
-        let before = step(at - 480..at - 1);
-        println!(
-            "switch at {at}: step {at_switch:.4}, largest step in the 10 ms before {before:.4}"
-        );
-        // 1.5x: a step no larger than the waveform's own corners is not a click.
-        assert!(at_switch <= 1.5 * before.max(1e-4), "click at sample {at}");
-    }
+    assert_no_click_at(&x, &switch_at);
     println!("peak {peak:.3}");
     assert!(peak < 1.0, "peak {peak}");
     for (from, to) in [(12_000, 24_000), (48_100, 60_000), (72_100, 84_000)] {
@@ -733,16 +717,24 @@ fn thermal_model_plays_in_tune_and_survives_bow_changes_and_switches_during_note
     );
     println!("thermal A3 free decay: {error:+.2} cents");
     assert!(error.abs() < 5.0, "{error:+.2} cents");
-    // No click at the switches: the step right at each is no larger than the waveform's.
-    for at in switch_at {
+    assert_no_click_at(&x, &switch_at);
+}
+
+/// Largest sample-to-sample step right at each switch against the largest anywhere in the
+/// 10 ms before it (the waveform's own corners).
+fn assert_no_click_at(x: &[f64], switch_at: &[u64]) {
+    let step = |r: std::ops::Range<usize>| {
+        x[r].windows(2)
+            .map(|w| (w[1] - w[0]).abs())
+            .fold(0.0f64, f64::max)
+    };
+    for &at in switch_at {
         let at = at as usize;
-        let step = |r: std::ops::Range<usize>| {
-            x[r].windows(2)
-                .map(|w| (w[1] - w[0]).abs())
-                .fold(0.0f64, f64::max)
-        };
         let at_switch = step(at - 1..at + 3);
         let before = step(at - 480..at - 1);
+        println!(
+            "switch at {at}: step {at_switch:.4}, largest step in the 10 ms before {before:.4}"
+        );
         // 1.5x: a step no larger than the waveform's own corners is not a click.
         assert!(at_switch <= 1.5 * before.max(1e-4), "click at sample {at}");
     }
