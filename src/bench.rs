@@ -194,63 +194,136 @@ pub fn scenes() -> Result<String, String> {
             ],
         ),
     ];
-    let render = |score: &Score, skipping: bool| -> Vec<f64> {
-        let mut inst = Instrument::new(InstrumentKind::Cello, fs);
-        inst.set_skipping(skipping);
-        let bow = BowControl::default();
-        let mut out = Vec::with_capacity(frames);
-        let mut next = 0;
-        for i in 0..frames {
-            if i % 256 == 0 {
-                inst.update_sleep();
-            }
-            while next < score.len() && score[next].0 == i {
-                let (_, down, note) = score[next];
-                if down {
-                    inst.note_on(note);
-                } else {
-                    inst.note_off(note);
-                }
-                next += 1;
-            }
-            out.push(inst.tick(bow).audio);
+    // The point-bow cello (paper A's hyperbolic law) and paper B's thermal cello (default
+    // bow: 10 nodes over 1 cm).
+    let bridge = crate::admittance_fit::shipped_cello_bridge().modes;
+    let render = |score: &Score, skipping: bool, thermal: bool| -> Vec<f64> {
+        if thermal {
+            let inst = crate::dsp::thermal_instrument::ThermalInstrument::new(
+                InstrumentKind::Cello,
+                &bridge,
+                fs,
+                Default::default(),
+            )
+            .expect("the shipped bridge and default bow are valid");
+            play_scene(inst, score, skipping, frames)
+        } else {
+            play_scene(
+                Instrument::new(InstrumentKind::Cello, fs),
+                score,
+                skipping,
+                frames,
+            )
         }
-        out
     };
     let mut lines = vec![
         format!("Cello, {seconds} s at 48 kHz, best of three; cost in % of one core."),
         String::new(),
-        "| scene | computing everything (%) | skipping (%) | saving | largest difference (dB below peak) |".to_string(),
-        "|---|---|---|---|---|".to_string(),
+        "| model | scene | computing everything (%) | skipping (%) | saving | largest difference (dB below peak) |".to_string(),
+        "|---|---|---|---|---|---|".to_string(),
     ];
     let mut costs = Vec::new();
-    for (name, score) in &scenes {
-        let mut full = Vec::new();
-        let mut skipped = Vec::new();
-        let full_s = best_of_three(|| full = render(score, false));
-        let skip_s = best_of_three(|| skipped = render(score, true));
-        let peak = full.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        let diff = full
-            .iter()
-            .zip(&skipped)
-            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
-        let db = if diff == 0.0 {
-            "identical".to_string()
+    for thermal in [false, true] {
+        let model = if thermal {
+            "thermal (paper B)"
         } else {
-            format!("{:.0}", 20.0 * (diff / peak.max(1e-30)).log10())
+            "point bow"
         };
-        lines.push(format!(
-            "| {name} | {:.3} | {:.3} | {:.1}x | {db} |",
-            100.0 * full_s / seconds,
-            100.0 * skip_s / seconds,
-            full_s / skip_s
-        ));
-        costs.push(skip_s);
+        for (name, score) in &scenes {
+            let mut full = Vec::new();
+            let mut skipped = Vec::new();
+            let full_s = best_of_three(|| full = render(score, false, thermal));
+            let skip_s = best_of_three(|| skipped = render(score, true, thermal));
+            let peak = full.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            let diff = full
+                .iter()
+                .zip(&skipped)
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            let db = if diff == 0.0 {
+                "identical".to_string()
+            } else {
+                format!("{:.0}", 20.0 * (diff / peak.max(1e-30)).log10())
+            };
+            lines.push(format!(
+                "| {model} | {name} | {:.3} | {:.3} | {:.1}x | {db} |",
+                100.0 * full_s / seconds,
+                100.0 * skip_s / seconds,
+                full_s / skip_s
+            ));
+            if !thermal {
+                costs.push(skip_s);
+            }
+        }
     }
     lines.push(String::new());
     lines.push(format!(
-        "Silence costs {:.1} % of one bowed string.",
+        "Silence costs {:.1} % of one bowed string (point bow).",
         100.0 * costs[0] / costs[1]
     ));
     Ok(lines.join("\n"))
 }
+
+/// Plays a score of `(sample, note down, note)` with the default bow (generic, so `tick`
+/// inlines as in the plugin).
+fn play_scene<I: SceneInstrument>(
+    mut inst: I,
+    score: &[(usize, bool, u8)],
+    skipping: bool,
+    frames: usize,
+) -> Vec<f64> {
+    inst.set_skipping(skipping);
+    let bow = BowControl::default();
+    let mut out = Vec::with_capacity(frames);
+    let mut next = 0;
+    for i in 0..frames {
+        if i % 256 == 0 {
+            inst.update_sleep();
+        }
+        while next < score.len() && score[next].0 == i {
+            let (_, down, note) = score[next];
+            if down {
+                inst.note_on(note);
+            } else {
+                inst.note_off(note);
+            }
+            next += 1;
+        }
+        out.push(inst.tick(bow).audio);
+    }
+    out
+}
+
+/// What `bench scenes` plays: both cellos, with sleeping on or off.
+trait SceneInstrument {
+    fn set_skipping(&mut self, skipping: bool);
+    fn update_sleep(&mut self);
+    fn note_on(&mut self, note: u8);
+    fn note_off(&mut self, note: u8);
+    fn tick(&mut self, bow: BowControl) -> crate::dsp::instrument::Frame;
+}
+
+macro_rules! scene_instrument {
+    ($t:ty) => {
+        impl SceneInstrument for $t {
+            fn set_skipping(&mut self, skipping: bool) {
+                <$t>::set_skipping(self, skipping)
+            }
+            fn update_sleep(&mut self) {
+                <$t>::update_sleep(self)
+            }
+            fn note_on(&mut self, note: u8) {
+                <$t>::note_on(self, note);
+            }
+            fn note_off(&mut self, note: u8) {
+                <$t>::note_off(self, note)
+            }
+            #[inline]
+            fn tick(&mut self, bow: BowControl) -> crate::dsp::instrument::Frame {
+                <$t>::tick(self, bow)
+            }
+        }
+    };
+}
+
+scene_instrument!(crate::dsp::instrument::Instrument);
+scene_instrument!(crate::dsp::thermal_instrument::ThermalInstrument);

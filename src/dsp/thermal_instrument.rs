@@ -157,6 +157,9 @@ pub struct ThermalInstrument {
     ramp_step: f64,
     output_scale: f64,
     awake: bool,
+    /// Whether the instrument sleeps when silent (the default; off only to measure what
+    /// sleeping saves: `colophony bench scenes`).
+    skipping: bool,
 }
 
 impl ThermalInstrument {
@@ -227,6 +230,7 @@ impl ThermalInstrument {
             ramp_step: 1.0 / (BOW_RAMP_S * host_rate_hz).max(1.0),
             output_scale: kind.output_scale_per_n(),
             awake: false,
+            skipping: true,
         };
         instrument
             .apply_settings(settings)
@@ -414,7 +418,7 @@ impl ThermalInstrument {
     /// Puts the instrument to sleep once every bow is lifted and the strings and the
     /// bridge have rung out (called once per block: it walks the delay lines).
     pub fn update_sleep(&mut self) {
-        if !self.awake || self.pending.is_some() {
+        if !self.skipping || !self.awake || self.pending.is_some() {
             return;
         }
         let lifted = self.voices.iter().all(|v| !v.bowed && v.bow_gain == 0.0);
@@ -439,7 +443,7 @@ impl ThermalInstrument {
     /// One host sample.
     #[inline]
     pub fn tick(&mut self, bow: BowControl) -> Frame {
-        if !self.awake {
+        if !self.awake && self.skipping {
             return Frame::default();
         }
         if let Some(settings) = self.pending {
@@ -481,6 +485,11 @@ impl ThermalInstrument {
             bow_point_velocity_m_per_s: self.core.probe.0,
             friction_force_n: self.core.probe.1,
         }
+    }
+
+    /// Turns sleeping off (everything is computed every sample, silent or not) or on.
+    pub fn set_skipping(&mut self, skipping: bool) {
+        self.skipping = skipping;
     }
 
     /// A loop over [`ThermalInstrument::tick`] with constant bow settings.
