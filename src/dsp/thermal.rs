@@ -29,7 +29,8 @@
 //! **Terminations.** At each end the two polarisations reflect through a real 2x2
 //! admittance `Y` (nut) or `Y` plus a one-pole loss per polarisation (bridge):
 //! `R = -(I + Z Y)^-1 (I - Z Y)`, passive for any PSD `Y`. The four-string modal bridge of
-//! paper B is not in this struct (see the issue notes).
+//! paper B couples four of these strings in
+//! [`super::thermal_instrument`].
 //!
 //! Values paper B does not publish are chosen here and justified in
 //! [`ThermalParams::default`] and [`HairParams::default`].
@@ -50,8 +51,6 @@ use std::f64::consts::PI;
 
 /// Largest `alpha dt / dx^2` used per thermal sub-step (the bound is 1/2).
 pub const FTCS_TARGET: f64 = 0.45;
-/// Samples between flushes of tiny temperatures to zero (see `update_temperature`).
-const FLUSH_PERIOD: u32 = 32;
 /// Most thermal sub-steps per sample before a configuration is refused.
 pub const MAX_THERMAL_SUBSTEPS: usize = 64;
 
@@ -481,7 +480,6 @@ pub struct ThermalString {
     temperature: Vec<f64>,
     temperature_next: Vec<f64>,
     grid_capacity: usize,
-    flush_countdown: u32,
     margin_nodes: usize,
     substeps: usize,
     /// Whether the hair touched the string last sample (its state needs clearing on lift).
@@ -645,7 +643,6 @@ impl ThermalString {
             temperature: Vec::with_capacity(grid_capacity),
             temperature_next: Vec::with_capacity(grid_capacity),
             grid_capacity,
-            flush_countdown: FLUSH_PERIOD,
             margin_nodes: 0,
             substeps: 1,
             contact_active: true,
@@ -914,10 +911,7 @@ impl ThermalString {
         let on = f_b > 0.0;
         let mut frame = ThermalFrame::default();
         let mid = n_b / 2;
-        let mut k = self.consts;
-        let (dt, half_y) = (k.dt, k.half_y);
-        k.f_b = f_b;
-        k.v_b = bow.velocity_m_per_s;
+        let (dt, half_y) = (self.consts.dt, self.consts.half_y);
 
         // Consecutive nodes sit at consecutive ring indices in both lines (see the layout
         // note in `finish_sample`): contiguous slices unless a ring wraps under the bow.
@@ -974,6 +968,11 @@ impl ThermalString {
                 }
             }
             let temps = &self.temperature[self.margin_nodes..self.margin_nodes + n_b];
+            let k = NodeConsts {
+                f_b,
+                v_b: bow.velocity_m_per_s,
+                ..self.consts
+            };
             solve_nodes(self.wide_simd, k, nodes, temps, n_b);
             let slip_s = &mut nodes.slipping[..n_b];
             let vd_s = &nodes.v_delta[..n_b];
@@ -1115,13 +1114,15 @@ impl ThermalString {
             let t = &self.temperature;
             let next = &mut self.temperature_next;
             if n == 1 {
-                next[0] = t[0] * (1.0 - 2.0 * r);
+                next[0] = flush_tiny(t[0] * (1.0 - 2.0 * r));
             } else {
-                next[0] = t[0] + r * (t[1] - 2.0 * t[0]);
+                next[0] = flush_tiny(t[0] + r * (t[1] - 2.0 * t[0]));
+                // Tiny values are flushed to zero inside the loop (a select, which
+                // vectorises), so no later step computes with subnormals.
                 for (out, w) in next[1..n - 1].iter_mut().zip(t.windows(3)) {
-                    *out = w[1] + r * (w[0] - 2.0 * w[1] + w[2]);
+                    *out = flush_tiny(w[1] + r * (w[0] - 2.0 * w[1] + w[2]));
                 }
-                next[n - 1] = t[n - 1] + r * (t[n - 2] - 2.0 * t[n - 1]);
+                next[n - 1] = flush_tiny(t[n - 1] + r * (t[n - 2] - 2.0 * t[n - 1]));
             }
             let n_b = self.nodes_count;
             let bow = &mut next[off..off + n_b];
@@ -1133,20 +1134,9 @@ impl ThermalString {
                 .zip(&self.nodes.force[..n_b])
             {
                 let v = vd.abs();
-                *out += heat * f.abs() * v - cool * tj * v;
+                *out = flush_tiny(*out + heat * f.abs() * v - cool * tj * v);
             }
             std::mem::swap(&mut self.temperature, &mut self.temperature_next);
-        }
-        // Tiny temperatures go to zero every FLUSH_PERIOD samples: in that many steps a
-        // value above 1e-30 K cannot decay into the subnormals (each FTCS step scales a
-        // mode by at least 1 - 4 * 0.45 = -0.8 in magnitude, and the convective loss per
-        // step is far below 1), so no step ever computes with subnormals.
-        self.flush_countdown = self.flush_countdown.saturating_sub(1);
-        if self.flush_countdown == 0 {
-            self.flush_countdown = FLUSH_PERIOD;
-            for x in self.temperature.iter_mut() {
-                *x = flush_tiny(*x);
-            }
         }
     }
 }
