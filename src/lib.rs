@@ -13,6 +13,7 @@ pub mod editor;
 pub mod figures;
 pub mod params;
 pub mod precision;
+pub mod quality;
 pub mod render;
 
 use dsp::instrument::{BowControl, Instrument, InstrumentKind, PITCH_BEND_SEMITONES};
@@ -28,6 +29,7 @@ const DEFAULT_BOW: BowControl = BowControl {
 use nice_plug::midi::Key;
 use nice_plug::prelude::*;
 use params::ColophonyParams;
+use quality::Quality;
 use std::sync::Arc;
 
 /// What the notes play: the waveguide strings with one of paper A's laws, paper B's
@@ -53,6 +55,8 @@ pub struct Colophony {
     last_note: Option<u8>,
     /// Written once per block for the editor (one relaxed atomic store).
     editor_link: Arc<editor::EditorLink>,
+    /// The thermal node count `quality = auto` chose at the last note-on.
+    auto_nodes: usize,
 }
 
 impl Default for Colophony {
@@ -67,6 +71,7 @@ impl Default for Colophony {
             held: [false; 128],
             last_note: None,
             editor_link: Arc::new(editor::EditorLink::default()),
+            auto_nodes: quality::GOOD_NODES,
             params,
         }
     }
@@ -83,7 +88,11 @@ impl Colophony {
                 }
             }
             Source::Thermal(k) => {
+                self.choose_auto_nodes(note);
+                let settings = self.thermal_settings();
                 if let Some(engine) = self.thermal.get_mut(k) {
+                    // A new node count fades the instrument out and lands the note after.
+                    engine.set_settings(settings);
                     if engine.note_on(note).is_some() {
                         self.held[note as usize & 127] = true;
                         self.last_note = Some(note);
@@ -159,9 +168,34 @@ impl Colophony {
     }
 
     fn thermal_settings(&self) -> ThermalSettings {
+        let p = &self.params;
+        let nodes = match p.quality.value().preset() {
+            None => p.bow_nodes.value().max(1) as usize,
+            Some(Quality::Auto) => self.auto_nodes,
+            // The fixed presets do not depend on the note.
+            Some(q) => q.thermal_nodes(p.instrument.value().into(), 1.0, 1.0, 0.01),
+        };
         ThermalSettings {
-            nodes: self.params.bow_nodes.value().max(1) as usize,
-            width_m: self.params.bow_width_mm.value() as f64 * 1e-3,
+            nodes,
+            width_m: p.bow_width_mm.value() as f64 * 1e-3,
+        }
+    }
+
+    /// `quality = auto`: the node count for a new note at the current bow position, kept
+    /// if the current one is close enough ([`quality::auto_needs_rebuild`]).
+    fn choose_auto_nodes(&mut self, note: u8) {
+        let p = &self.params;
+        if p.quality.value() != params::QualityChoice::Auto {
+            return;
+        }
+        let wanted = quality::auto_nodes(
+            p.instrument.value().into(),
+            dsp::instrument::midi_to_hz(note as f64),
+            p.bow_position.value() as f64,
+            p.bow_width_mm.value() as f64 * 1e-3,
+        );
+        if quality::auto_needs_rebuild(self.auto_nodes, wanted) {
+            self.auto_nodes = wanted;
         }
     }
 
@@ -289,6 +323,20 @@ impl Plugin for Colophony {
         if let Some(friction) = p.friction_model.value().point_law() {
             self.instrument.set_friction_model(friction);
             self.rubbed.set_friction_model(friction);
+        }
+        // Custom quality solves the bristle laws to the reference's tolerance.
+        let tolerance = p
+            .quality
+            .value()
+            .preset()
+            .unwrap_or(Quality::Reference)
+            .newton_tolerance_m_per_s();
+        self.instrument.set_newton_tolerance(tolerance);
+        self.rubbed.set_newton_tolerance(tolerance);
+        let preferred = p.string.value().index();
+        self.instrument.set_preferred_string(preferred);
+        for engine in &mut self.thermal {
+            engine.set_preferred_string(preferred);
         }
         let settings = self.thermal_settings();
         for engine in &mut self.thermal {

@@ -4,7 +4,8 @@ use clap::{Parser, Subcommand};
 use colophony::dsp::friction::FrictionModel;
 use colophony::dsp::instrument::{BowControl, InstrumentKind};
 use colophony::dsp::rubbed::RubbedPreset;
-use colophony::render::{parse_note, render, write_wav, RenderSettings};
+use colophony::quality::Quality;
+use colophony::render::{parse_note, render_with, write_wav, RenderSettings};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -56,9 +57,14 @@ enum Command {
         /// (paper B's finite-width bow; see --nodes and --bow-width).
         #[arg(long, default_value = "hyperbolic", value_parser = parse_friction)]
         friction: FrictionArg,
-        /// Thermal bow: hair nodes across the bow.
+        /// Thermal bow: hair nodes across the bow (ignored with --quality).
         #[arg(long, default_value_t = 10)]
         nodes: usize,
+        /// Solver preset from the work-precision benchmark: draft, good, reference or auto
+        /// (sets the Newton tolerance and the thermal node count; see src/quality.rs).
+        /// Without it: --nodes, and the reference's tolerance.
+        #[arg(long, value_parser = parse_quality)]
+        quality: Option<Quality>,
         /// Thermal bow: width of the hair ribbon, m (the force is spread over it).
         #[arg(long, default_value_t = 0.01)]
         bow_width: f64,
@@ -140,6 +146,11 @@ fn parse_friction(s: &str) -> Result<FrictionArg, String> {
     })
 }
 
+fn parse_quality(s: &str) -> Result<Quality, String> {
+    Quality::from_name(s)
+        .ok_or_else(|| format!("unknown quality '{s}': choose draft, good, reference or auto"))
+}
+
 fn parse_instrument(s: &str) -> Result<InstrumentKind, String> {
     InstrumentKind::from_name(s)
         .ok_or_else(|| format!("unknown instrument '{s}': choose violin, viola or cello"))
@@ -162,8 +173,21 @@ fn main() -> ExitCode {
             friction,
             nodes,
             bow_width,
+            quality,
             preset,
         } => {
+            let tolerance = quality.map(|q| q.newton_tolerance_m_per_s());
+            // The renderer's thermal string runs at its own rate (its nodes, its wave speed).
+            let nodes = match (quality, instrument.string_for_note(note)) {
+                (Some(Quality::Auto), Some(i)) => colophony::quality::auto_nodes_at_speed(
+                    2.0 * instrument.string_length_m() * instrument.strings()[i].open_hz,
+                    colophony::dsp::instrument::midi_to_hz(note as f64),
+                    bow_position,
+                    bow_width,
+                ),
+                (Some(q), _) => q.thermal_nodes(instrument, 1.0, 1.0, bow_width),
+                (None, _) => nodes,
+            };
             let thermal = friction == FrictionArg::Thermal;
             let friction = match friction {
                 FrictionArg::Point(model) => model,
@@ -176,11 +200,16 @@ fn main() -> ExitCode {
                     ));
                 }
                 return report(
-                    colophony::render::render_rubbed(
+                    colophony::render::render_rubbed_with(
                         preset,
                         friction_or_default(friction),
                         seconds,
                         sample_rate,
+                        |scene| {
+                            if let Some(t) = tolerance {
+                                scene.set_newton_tolerance(t);
+                            }
+                        },
                     )
                     .and_then(|r| write_wav(&out, &r, probe))
                     .map(|()| format!("wrote {} ({} preset)", out.display(), preset.name()))
@@ -205,7 +234,11 @@ fn main() -> ExitCode {
             let rendered = if thermal {
                 colophony::render::render_thermal(&settings, nodes, bow_width)
             } else {
-                render(&settings)
+                render_with(&settings, |instrument| {
+                    if let Some(t) = tolerance {
+                        instrument.set_newton_tolerance(t);
+                    }
+                })
             };
             match rendered.and_then(|r| write_wav(&out, &r, probe)) {
                 Ok(()) => {

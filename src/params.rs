@@ -9,12 +9,15 @@
 //! | `gain` | Output Gain | dB | -40 .. 12 | 0 |
 //! | `friction_model` | Friction Model | - | hyperbolic, static (Stribeck), LuGre, elasto-plastic, thermal (paper B) | hyperbolic |
 //! | `resonator` | Resonator | - | strings, paper A modal, door hinge, chalk, wine glass, brake squeal | strings |
-//! | `bow_nodes` | Bow Nodes | nodes on the lowest string (thermal model) | 1 .. 60 | 10 |
+//! | `bow_nodes` | Bow Nodes | nodes on the lowest string (thermal model, quality custom) | 1 .. 60 | 10 |
 //! | `bow_width` | Bow Width | mm of hair in contact (thermal model) | 5 .. 20 | 10 |
+//! | `string` | String | - | auto, I (highest) .. IV (lowest) | auto |
+//! | `quality` | Quality | - | draft, good, reference, auto, custom | good |
 
 use crate::dsp::friction::FrictionModel;
 use crate::dsp::instrument::InstrumentKind;
 use crate::dsp::rubbed::RubbedPreset;
+use crate::quality::Quality;
 use nice_plug::prelude::*;
 
 /// Smoothing time for the bow controls: short enough for sample-accurate gestures to
@@ -109,6 +112,72 @@ impl ResonatorChoice {
     }
 }
 
+/// Which string a note goes to: the usual choice (the highest string that reaches it,
+/// the lowest hand position) or one the player names, as in "sul G". Strings are counted
+/// from the highest: I is the violin's E and the viola's and cello's A, IV the lowest. A
+/// note the named string cannot play goes where it usually would.
+#[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StringChoice {
+    #[id = "auto"]
+    Auto,
+    #[id = "i"]
+    #[name = "I (highest)"]
+    I,
+    #[id = "ii"]
+    #[name = "II"]
+    II,
+    #[id = "iii"]
+    #[name = "III"]
+    III,
+    #[id = "iv"]
+    #[name = "IV (lowest)"]
+    IV,
+}
+
+impl StringChoice {
+    /// String index counted from the lowest (0), or `None` for the usual choice.
+    pub fn index(self) -> Option<usize> {
+        match self {
+            StringChoice::Auto => None,
+            StringChoice::I => Some(3),
+            StringChoice::II => Some(2),
+            StringChoice::III => Some(1),
+            StringChoice::IV => Some(0),
+        }
+    }
+}
+
+/// Solver quality ([`crate::quality`]): the presets chosen from the work-precision
+/// benchmark, or `custom` (the Bow Nodes parameter sets the thermal node count and the
+/// Newton tolerance is the reference's).
+#[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum QualityChoice {
+    #[id = "draft"]
+    Draft,
+    #[id = "good"]
+    Good,
+    #[id = "reference"]
+    Reference,
+    #[id = "auto"]
+    Auto,
+    #[id = "custom"]
+    #[name = "Custom (Bow Nodes)"]
+    Custom,
+}
+
+impl QualityChoice {
+    /// The preset, or `None` for custom.
+    pub fn preset(self) -> Option<Quality> {
+        match self {
+            QualityChoice::Draft => Some(Quality::Draft),
+            QualityChoice::Good => Some(Quality::Good),
+            QualityChoice::Reference => Some(Quality::Reference),
+            QualityChoice::Auto => Some(Quality::Auto),
+            QualityChoice::Custom => None,
+        }
+    }
+}
+
 #[derive(Params)]
 pub struct ColophonyParams {
     #[id = "bow_velocity"]
@@ -129,6 +198,10 @@ pub struct ColophonyParams {
     pub bow_nodes: IntParam,
     #[id = "bow_width"]
     pub bow_width_mm: FloatParam,
+    #[id = "string"]
+    pub string: EnumParam<StringChoice>,
+    #[id = "quality"]
+    pub quality: EnumParam<QualityChoice>,
     /// The editor window's size, saved with the plugin state (not a parameter).
     #[persist = "editor-state"]
     pub editor_state: crate::editor::EditorState,
@@ -208,6 +281,8 @@ impl Default for ColophonyParams {
                 .with_unit(" mm")
                 .with_step_size(0.5)
                 .with_value_to_string(formatters::v2s_f32_rounded(1)),
+            string: EnumParam::new("String", StringChoice::Auto),
+            quality: EnumParam::new("Quality", QualityChoice::Good),
             editor_state: Default::default(),
         }
     }

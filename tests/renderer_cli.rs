@@ -77,7 +77,8 @@ fn probe_at_default_settings_shows_one_slip_per_period_of_length_beta_at_bow_vel
 
 #[test]
 fn bad_arguments_fail_with_one_line_and_write_nothing() {
-    let cases: [(&str, &[&str]); 6] = [
+    let cases: [(&str, &[&str]); 7] = [
+        ("quality", &["--quality", "best"]),
         ("instrument", &["--instrument", "banjo"]),
         ("note-range", &["--note", "C1"]),
         ("note-name", &["--note", "H2"]),
@@ -190,4 +191,55 @@ fn paper_figures_are_written_as_png() {
         scratch("x.png").to_str().unwrap(),
     ]);
     assert!(!run.status.success());
+}
+
+/// The quality presets as the renderer's user picks them: each renders, and the draft's
+/// thermal bowed pitch stays within a cent of the reference's (docs/precision.md measured
+/// 0.07 cents at N_B 6 against N_B 120 on the same scenario).
+#[test]
+fn quality_presets_render_and_the_draft_bows_the_references_pitch() {
+    let mut pitch = Vec::new();
+    for quality in ["draft", "good", "reference", "auto"] {
+        let out = scratch(&format!("quality-{quality}.wav"));
+        let run = colophony(&[
+            "render",
+            "--out",
+            out.to_str().unwrap(),
+            "--friction",
+            "thermal",
+            "--note",
+            "C2",
+            "--bow-velocity",
+            "0.15",
+            "--bow-force",
+            "3",
+            "--seconds",
+            "1.5",
+            "--quality",
+            quality,
+            "--probe",
+        ]);
+        assert!(
+            run.status.success(),
+            "{quality}: {}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let mut reader = hound::WavReader::open(&out).unwrap();
+        let fs = reader.spec().sample_rate as f64;
+        // Probe files: channel 0 is the audio.
+        let x: Vec<f64> = reader
+            .samples::<f32>()
+            .step_by(3)
+            .map(|s| s.unwrap() as f64)
+            .collect();
+        assert!(x.iter().all(|v| v.is_finite()));
+        let steady = &x[x.len() / 2..];
+        let f0 = colophony::analysis::peak_frequency_hz(steady, fs, midi_to_hz(36.0), 100.0);
+        println!("{quality}: {f0:.3} Hz");
+        pitch.push(f0);
+    }
+    let cents = |a: f64, b: f64| 1200.0 * (a / b).log2();
+    let draft_error = cents(pitch[0], pitch[2]);
+    println!("draft against reference: {draft_error:+.3} cents");
+    assert!(draft_error.abs() < 1.0, "{draft_error:+.3} cents");
 }

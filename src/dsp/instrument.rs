@@ -137,6 +137,19 @@ impl InstrumentKind {
         open.iter().rposition(|&o| o <= note)
     }
 
+    /// The string a note goes to when the player asks for string `preferred` (0 = the
+    /// lowest): that string if it can play the note (at or above its open pitch, at most
+    /// [`MAX_STOP_SEMITONES`] above), else the usual choice of [`Self::string_for_note`].
+    pub fn string_for_note_on(self, note: u8, preferred: Option<usize>) -> Option<usize> {
+        if let Some(p) = preferred.filter(|&p| p < STRINGS) {
+            let open = self.open_notes()[p];
+            if note >= open && note <= open + MAX_STOP_SEMITONES {
+                return Some(p);
+            }
+        }
+        self.string_for_note(note)
+    }
+
     /// Playable notes, inclusive.
     pub fn note_range(self) -> (u8, u8) {
         let open = self.open_notes();
@@ -196,6 +209,8 @@ pub struct Instrument {
     voices: [StringVoice; STRINGS],
     body: BodyModes,
     bend_semitones: f64,
+    /// The string the player asks notes to go to (0 = lowest), `None` for the usual choice.
+    preferred_string: Option<usize>,
     probed: usize,
     ramp_step: f64,
     output_scale: f64,
@@ -230,6 +245,7 @@ impl Instrument {
             voices,
             body: BodyModes::new(&kind.body_modes(), 1.0, sample_rate_hz),
             bend_semitones: 0.0,
+            preferred_string: None,
             probed: 0,
             ramp_step: 1.0 / (BOW_RAMP_S * sample_rate_hz),
             output_scale: kind.output_scale_per_n(),
@@ -279,7 +295,7 @@ impl Instrument {
     /// Stops the string for `note` and lands the bow on it. Returns the string index, or
     /// `None` if the instrument cannot play the note (it is then ignored).
     pub fn note_on(&mut self, note: u8) -> Option<usize> {
-        let index = self.kind.string_for_note(note)?;
+        let index = self.kind.string_for_note_on(note, self.preferred_string)?;
         let bend = self.bend_semitones;
         let voice = &mut self.voices[index];
         voice.string.stop_at(midi_to_hz(note as f64 + bend));
@@ -304,6 +320,13 @@ impl Instrument {
         for voice in &mut self.voices {
             voice.bowed = false;
         }
+    }
+
+    /// Asks later notes to go to string `preferred` (0 = the lowest) where it can play
+    /// them ([`InstrumentKind::string_for_note_on`]); `None` restores the usual choice.
+    /// Notes already sounding stay where they are.
+    pub fn set_preferred_string(&mut self, preferred: Option<usize>) {
+        self.preferred_string = preferred.filter(|&p| p < STRINGS);
     }
 
     /// Pitch bend in semitones (clamped to the bend range): moves every stopping point.
@@ -478,5 +501,31 @@ mod tests {
         assert_eq!(cello.string_for_note(80), Some(3));
         assert_eq!(cello.string_for_note(35), None);
         assert_eq!(cello.string_for_note(57 + MAX_STOP_SEMITONES + 1), None);
+    }
+
+    #[test]
+    fn a_named_string_takes_the_notes_it_reaches_and_leaves_the_rest_to_the_usual_string() {
+        let cello = InstrumentKind::Cello;
+        // A3 sul C (C2 + 21 semitones) and sul G.
+        assert_eq!(cello.string_for_note_on(57, Some(0)), Some(0));
+        assert_eq!(cello.string_for_note_on(57, Some(1)), Some(1));
+        // G2 cannot be played on the D string: it goes to the G string as usual.
+        assert_eq!(cello.string_for_note_on(43, Some(2)), Some(1));
+        // Beyond the stop range of the C string: the usual string.
+        assert_eq!(cello.string_for_note_on(36 + MAX_STOP_SEMITONES + 1, Some(0)), Some(3));
+        // No preference, or a string that does not exist: the usual choice.
+        assert_eq!(cello.string_for_note_on(57, None), cello.string_for_note(57));
+        assert_eq!(cello.string_for_note_on(57, Some(7)), cello.string_for_note(57));
+        // Unplayable notes stay unplayable.
+        assert_eq!(cello.string_for_note_on(35, Some(0)), None);
+    }
+
+    #[test]
+    fn the_instrument_plays_a_note_on_the_string_the_player_names() {
+        let mut cello = Instrument::new(InstrumentKind::Cello, 48_000.0);
+        cello.set_preferred_string(Some(1));
+        assert_eq!(cello.note_on(57), Some(1));
+        cello.set_preferred_string(None);
+        assert_eq!(cello.note_on(57), Some(3));
     }
 }

@@ -373,6 +373,13 @@ impl RubbedInstrument {
         }
     }
 
+    /// Newton tolerance of every voice's bristle law (m/s).
+    pub fn set_newton_tolerance(&mut self, tolerance_m_per_s: f64) {
+        for voice in &mut self.voices {
+            voice.scene.set_newton_tolerance(tolerance_m_per_s);
+        }
+    }
+
     pub fn note_on(&mut self) {
         self.notes_down += 1;
         self.voices[self.active].awake = true;

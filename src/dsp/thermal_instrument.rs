@@ -154,6 +154,8 @@ pub struct ThermalInstrument {
     /// Wave speed of each string, m/s.
     wave_speeds: [f64; STRINGS],
     bend_semitones: f64,
+    /// The string the player asks notes to go to (0 = lowest), `None` for the usual choice.
+    preferred_string: Option<usize>,
     ramp_step: f64,
     output_scale: f64,
     awake: bool,
@@ -227,6 +229,7 @@ impl ThermalInstrument {
             voices: [Voice::default(); STRINGS],
             wave_speeds,
             bend_semitones: 0.0,
+            preferred_string: None,
             ramp_step: 1.0 / (BOW_RAMP_S * host_rate_hz).max(1.0),
             output_scale: kind.output_scale_per_n(),
             awake: false,
@@ -338,7 +341,7 @@ impl ThermalInstrument {
     /// Stops the string for `note` and lands the bow. `None` (ignored) if no string can
     /// play it with this bow.
     pub fn note_on(&mut self, note: u8) -> Option<usize> {
-        let index = self.kind.string_for_note(note)?;
+        let index = self.kind.string_for_note_on(note, self.preferred_string)?;
         let f0 = midi_to_hz(note as f64 + self.bend_semitones);
         if !self.tune(index, f0) {
             return None;
@@ -364,6 +367,13 @@ impl ThermalInstrument {
         for voice in &mut self.voices {
             voice.bowed = false;
         }
+    }
+
+    /// Asks later notes to go to string `preferred` (0 = the lowest) where it can play
+    /// them ([`InstrumentKind::string_for_note_on`]); `None` restores the usual choice.
+    /// Notes already sounding stay where they are.
+    pub fn set_preferred_string(&mut self, preferred: Option<usize>) {
+        self.preferred_string = preferred.filter(|&p| p < STRINGS);
     }
 
     /// Pitch bend in semitones (clamped to the bend range).
