@@ -439,7 +439,7 @@ fn sum_lanes(x: &[f64]) -> f64 {
 }
 
 /// Whether this CPU runs the AVX2 node loop.
-fn detect_wide_simd() -> bool {
+pub(crate) fn detect_wide_simd() -> bool {
     #[cfg(target_arch = "x86_64")]
     {
         std::is_x86_feature_detected!("avx2")
@@ -897,6 +897,7 @@ impl ThermalString {
     }
 
     /// The bow contact and thermal update of one sample (no terminations).
+    #[inline(always)]
     pub fn tick_contact(&mut self, bow: ThermalBowControl) -> ThermalFrame {
         let mask = self.mask;
         let m = self.m;
@@ -1046,6 +1047,7 @@ impl ThermalString {
     /// The `[h, v]` velocity waves arriving at the bridge this sample (after the loss
     /// filter). Call once per sample, after [`ThermalString::tick_contact`] and before
     /// [`ThermalString::finish_sample`]; the bridge model answers with the outgoing waves.
+    #[inline(always)]
     pub fn arriving_at_bridge(&mut self) -> [f64; 2] {
         let i = self.t.wrapping_sub(self.m - 1) & self.mask;
         [
@@ -1061,6 +1063,7 @@ impl ThermalString {
     /// is `left[(t - (m - 1 - x)) & mask]`, the right-going one `right[(x - t) & mask]`; the
     /// waves never move in memory, and both indices grow with `x`, so the bow's nodes
     /// read and write contiguous slices.
+    #[inline(always)]
     pub fn finish_sample(&mut self, leaving_bridge: [f64; 2]) {
         let j = (self.m - 1).wrapping_sub(self.t) & self.mask;
         let mut at_nut = [0.0; 2];
