@@ -5,6 +5,7 @@
 //! * [`pad`]: the pad widget and its begin/set/end gestures.
 //! * [`view`]: the editor's contents, drawn into any `egui::Ui` ([`EditorUi`]).
 //! * [`live`]: the live views and the wait-free ring that feeds them from the audio thread.
+//! * [`regime`]: the regime the string is in, classified from the live samples (pure).
 //! * This file: the window glue. [`ColophonyEditor`] is the plugin's `Editor`;
 //!   [`EditorState`] is the window size saved with the plugin state
 //!   (`#[persist = "editor-state"]` in [`crate::params::ColophonyParams`]); [`EditorLink`]
@@ -21,6 +22,7 @@
 pub mod live;
 pub mod mapping;
 pub mod pad;
+pub mod regime;
 pub mod view;
 
 pub use view::EditorUi;
