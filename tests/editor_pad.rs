@@ -352,3 +352,40 @@ fn live_views_are_fed_only_while_an_open_editor_shows_them() {
     drop(f.editor);
     assert!(!link.is_listening(), "a closed editor is not fed");
 }
+
+/// Pushes `periods` periods of a stick-slip train into the scope: `slips` equal slips per
+/// 327-sample period (cello D3 at 48 kHz) with friction `mu` (0: the bow is lifted).
+fn push_stick_slip(link: &EditorLink, periods: usize, slips: usize, mu: f32) {
+    let spacing = 327 / slips;
+    for i in 0..periods * 327 {
+        let slipping = (i % 327) % spacing < 30 && (i % 327) < slips * spacing;
+        link.scope.push(ContactSample {
+            string_velocity: if slipping { -0.9 } else { 0.1 },
+            relative_velocity: if slipping { -1.0 } else { 0.0 },
+            mu,
+        });
+    }
+}
+
+#[test]
+fn the_detected_regime_is_shown_beside_the_predicted_one() {
+    let mut f = fixture();
+    let link = f.link.clone();
+    let mut h = harness(&mut f.editor);
+    assert_shows(&h, "Predicted: Helmholtz motion");
+    assert_shows(&h, "Detected: (waiting for audio)");
+    push_stick_slip(&link, 10, 1, 0.3);
+    h.run();
+    assert_shows(&h, "Detected: Helmholtz motion (1 slip per period)");
+    push_stick_slip(&link, 10, 3, 0.3);
+    h.run();
+    assert_shows(&h, "Detected: multiple slips (3 per period)");
+    // The bow lifted: no friction.
+    push_stick_slip(&link, 10, 1, 0.0);
+    h.run();
+    assert_shows(&h, "Detected: silent");
+    h.get_by_role_and_label(egui::Role::CheckBox, "Live views")
+        .click();
+    h.run();
+    assert_shows(&h, "Detected: (live views off)");
+}

@@ -6,6 +6,7 @@
 use super::live::{paint_friction_loop, paint_velocity_trace, ContactSample, SCOPE_LEN};
 use super::mapping::SchellengWindow;
 use super::pad::{format_force, format_velocity, XyPad, MAX_FORCE_COLOUR, MIN_FORCE_COLOUR};
+use super::regime::{classify_regime, Regime};
 use super::{EditorLink, EditorSize};
 use crate::dsp::instrument::{midi_to_hz, InstrumentKind};
 use crate::params::{ColophonyParams, ResonatorChoice};
@@ -23,6 +24,12 @@ const SIDE_WIDTH: f32 = 290.0;
 const LIVE_HEIGHT: f32 = 170.0;
 /// Periods of the current note the velocity trace shows.
 const TRACE_PERIODS: f32 = 3.0;
+/// Periods of the current note the regime is detected from (the ring holds more than
+/// five of the lowest note at 96 kHz, and [`Scope::copy_latest`] caps the count).
+///
+/// [`Scope::copy_latest`]: super::live::Scope::copy_latest
+const REGIME_PERIODS: f32 = 8.0;
+const HELMHOLTZ_COLOUR: Color32 = Color32::from_rgb(120, 210, 120);
 /// How often the live views look for new samples.
 const LIVE_REFRESH: Duration = Duration::from_millis(33);
 
@@ -37,6 +44,8 @@ pub struct EditorUi {
     pub live: bool,
     /// The live samples copied out of the scope, reused every frame.
     samples: Vec<ContactSample>,
+    /// The regime detected from [`Self::samples`] (`None`: too few samples yet).
+    detected: Option<Regime>,
 }
 
 impl EditorUi {
@@ -48,11 +57,18 @@ impl EditorUi {
             pad: XyPad::default(),
             live: true,
             samples: Vec::with_capacity(SCOPE_LEN),
+            detected: None,
         }
     }
 
     pub fn pad(&self) -> &XyPad {
         &self.pad
+    }
+
+    /// The regime detected from the live samples on the last frame (`None` while the
+    /// live views are off or hold too few samples).
+    pub fn detected_regime(&self) -> Option<Regime> {
+        self.detected
     }
 
     /// Stops the audio thread feeding the live views (the editor closing).
@@ -113,6 +129,11 @@ impl EditorUi {
         });
         ui.separator();
 
+        if self.live {
+            self.refresh_live(ui);
+        } else {
+            self.detected = None;
+        }
         let window = self.window();
         let available = ui.available_size();
         let live_height = if self.live { LIVE_HEIGHT } else { 0.0 };
@@ -146,15 +167,28 @@ impl EditorUi {
         }
     }
 
+    /// The fundamental of the note the strings play (or the window's default note).
+    fn note_hz(&self) -> f32 {
+        let kind: InstrumentKind = self.params.instrument.value().into();
+        midi_to_hz(self.window_note(kind) as f64) as f32
+    }
+
+    /// Copies the newest samples out of the scope and detects the regime from them.
+    fn refresh_live(&mut self, ui: &Ui) {
+        let scope = &self.link.scope;
+        let f0 = self.note_hz();
+        let sample_rate = scope.sample_rate();
+        let wanted = (REGIME_PERIODS * sample_rate / f0).ceil() as usize;
+        scope.copy_latest(wanted, &mut self.samples);
+        self.detected = classify_regime(&self.samples, sample_rate, f0);
+        ui.ctx().request_repaint_after(LIVE_REFRESH);
+    }
+
     /// The velocity trace and the friction loop side by side.
     fn live_views(&mut self, ui: &mut Ui, size: egui::Vec2) {
-        let scope = &self.link.scope;
-        let kind: InstrumentKind = self.params.instrument.value().into();
-        let f0 = midi_to_hz(self.window_note(kind) as f64) as f32;
-        let sample_rate = scope.sample_rate();
-        let wanted = (TRACE_PERIODS * sample_rate / f0).ceil() as usize;
-        scope.copy_latest(wanted, &mut self.samples);
-        ui.ctx().request_repaint_after(LIVE_REFRESH);
+        let sample_rate = self.link.scope.sample_rate();
+        let shown = (TRACE_PERIODS * sample_rate / self.note_hz()).ceil() as usize;
+        let samples = &self.samples[self.samples.len().saturating_sub(shown)..];
 
         let (rect, _) = ui.allocate_exact_size(size, egui::Sense::hover());
         let margin_left = 52.0;
@@ -168,7 +202,7 @@ impl EditorUi {
                 vec2(width, rect.height() - 22.0),
             )
         };
-        if self.samples.is_empty() {
+        if samples.is_empty() {
             ui.painter().text(
                 rect.center(),
                 egui::Align2::CENTER_CENTER,
@@ -181,11 +215,11 @@ impl EditorUi {
         paint_velocity_trace(
             ui,
             plot(0.0),
-            &self.samples,
+            samples,
             sample_rate,
             self.params.bow_velocity.value(),
         );
-        paint_friction_loop(ui, plot(1.0), &self.samples);
+        paint_friction_loop(ui, plot(1.0), samples);
     }
 
     fn side_panel(&self, ui: &mut Ui, setter: &ParamSetter, window: Option<&SchellengWindow>) {
@@ -277,6 +311,18 @@ impl EditorUi {
             });
         let (text, colour) = predicted_regime(v as f64, f as f64, f_min, f_max);
         ui.label(RichText::new(format!("Predicted: {text}")).color(colour));
+        let (text, colour) = match (self.live, self.detected) {
+            (false, _) => (
+                "(live views off)".to_owned(),
+                ui.visuals().weak_text_color(),
+            ),
+            (true, None) => (
+                "(waiting for audio)".to_owned(),
+                ui.visuals().weak_text_color(),
+            ),
+            (true, Some(regime)) => (regime.describe(), regime_colour(regime)),
+        };
+        ui.label(RichText::new(format!("Detected: {text}")).color(colour));
     }
 }
 
@@ -291,7 +337,17 @@ fn predicted_regime(v: f64, f: f64, f_min: f64, f_max: f64) -> (&'static str, Co
     } else if f < f_min {
         ("multiple slips (below F_min)", MIN_FORCE_COLOUR)
     } else {
-        ("Helmholtz motion", Color32::from_rgb(120, 210, 120))
+        ("Helmholtz motion", HELMHOLTZ_COLOUR)
+    }
+}
+
+/// The colour of the region of Schelleng's diagram a detected regime belongs to.
+fn regime_colour(regime: Regime) -> Color32 {
+    match regime {
+        Regime::Silent | Regime::Sliding => Color32::GRAY,
+        Regime::Helmholtz => HELMHOLTZ_COLOUR,
+        Regime::MultipleSlips(_) => MIN_FORCE_COLOUR,
+        Regime::Raucous => MAX_FORCE_COLOUR,
     }
 }
 
