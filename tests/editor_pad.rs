@@ -4,9 +4,11 @@
 
 use colophony::editor::live::ContactSample;
 use colophony::editor::mapping::PadMapping;
+use colophony::editor::nodes::NodeRecord;
 use colophony::editor::pad::{pad_value_text, PAD_LABEL};
+use colophony::editor::view::THERMAL_LABEL;
 use colophony::editor::{EditorLink, EditorUi};
-use colophony::params::{ColophonyParams, InstrumentChoice};
+use colophony::params::{ColophonyParams, FrictionChoice, InstrumentChoice};
 use egui::{pos2, vec2, Pos2, Rect};
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
@@ -388,4 +390,41 @@ fn the_detected_regime_is_shown_beside_the_predicted_one() {
         .click();
     h.run();
     assert_shows(&h, "Detected: (live views off)");
+}
+
+#[test]
+fn the_thermal_bow_views_show_the_audio_threads_node_records_only_with_the_thermal_model() {
+    let mut f = fixture();
+    let link = f.link.clone();
+    let params = f.params.clone();
+    // Two records from the audio thread: 4 nodes, the second warmer and slipping more.
+    for (t, s) in [(1.0f32, 0.25f32), (4.5, 0.5)] {
+        let mut record = NodeRecord {
+            count: 4,
+            ..NodeRecord::default()
+        };
+        record.temperature_kelvin[..4].copy_from_slice(&[t - 1.0, t, t, t - 1.0]);
+        record.slip_fraction[..4].fill(s);
+        link.nodes.push(&record);
+    }
+    let mut h = harness(&mut f.editor);
+    assert!(
+        h.query_by_label(THERMAL_LABEL).is_none(),
+        "not shown with a point law"
+    );
+    unsafe {
+        params
+            .friction_model
+            .as_ptr()
+            ._internal_set_normalized_value(
+                params
+                    .friction_model
+                    .preview_normalized(FrictionChoice::Thermal),
+            );
+    }
+    h.run();
+    assert_eq!(
+        h.get_by_label(THERMAL_LABEL).value().as_deref(),
+        Some("4 nodes, hottest 4.5 K above ambient, slipping 50 % of the time")
+    );
 }

@@ -5,11 +5,12 @@
 
 use super::live::{paint_friction_loop, paint_velocity_trace, ContactSample, SCOPE_LEN};
 use super::mapping::SchellengWindow;
+use super::nodes::{paint_slip_image, paint_temperature_profile, NodeRecord, RING_LEN};
 use super::pad::{format_force, format_velocity, XyPad, MAX_FORCE_COLOUR, MIN_FORCE_COLOUR};
 use super::regime::{classify_regime, Regime};
 use super::{EditorLink, EditorSize};
 use crate::dsp::instrument::{midi_to_hz, InstrumentKind};
-use crate::params::{ColophonyParams, ResonatorChoice};
+use crate::params::{ColophonyParams, FrictionChoice, ResonatorChoice};
 use egui::{vec2, Color32, Layout, RichText, Ui};
 use nice_plug::context::gui::GuiContext;
 use nice_plug::prelude::{Enum, EnumParam, ParamSetter};
@@ -22,6 +23,10 @@ use std::time::Duration;
 const SIDE_WIDTH: f32 = 290.0;
 /// Height of the live views' row, points.
 const LIVE_HEIGHT: f32 = 170.0;
+/// Height of the thermal bow's row (shown with the thermal model), points.
+const THERMAL_HEIGHT: f32 = 150.0;
+/// Node records the slip image shows (5 ms each: 0.64 s).
+const SLIP_IMAGE_RECORDS: usize = 128;
 /// Periods of the current note the velocity trace shows.
 const TRACE_PERIODS: f32 = 3.0;
 /// Periods of the current note the regime is detected from (the ring holds more than
@@ -46,6 +51,8 @@ pub struct EditorUi {
     samples: Vec<ContactSample>,
     /// The regime detected from [`Self::samples`] (`None`: too few samples yet).
     detected: Option<Regime>,
+    /// The thermal bow's node records copied out of the ring, reused every frame.
+    records: Vec<NodeRecord>,
 }
 
 impl EditorUi {
@@ -58,6 +65,7 @@ impl EditorUi {
             live: true,
             samples: Vec::with_capacity(SCOPE_LEN),
             detected: None,
+            records: Vec::with_capacity(RING_LEN),
         }
     }
 
@@ -136,7 +144,12 @@ impl EditorUi {
         }
         let window = self.window();
         let available = ui.available_size();
-        let live_height = if self.live { LIVE_HEIGHT } else { 0.0 };
+        let thermal_height = if self.thermal_shown() {
+            THERMAL_HEIGHT
+        } else {
+            0.0
+        };
+        let live_height = if self.live { LIVE_HEIGHT } else { 0.0 } + thermal_height;
         ui.horizontal_top(|ui| {
             let pad_size = vec2(
                 (available.x - SIDE_WIDTH - 12.0).max(200.0),
@@ -165,6 +178,9 @@ impl EditorUi {
         if self.live {
             self.live_views(ui, vec2(available.x, LIVE_HEIGHT - 8.0));
         }
+        if thermal_height > 0.0 {
+            self.thermal_views(ui, vec2(available.x, THERMAL_HEIGHT - 8.0));
+        }
     }
 
     /// The fundamental of the note the strings play (or the window's default note).
@@ -181,7 +197,58 @@ impl EditorUi {
         let wanted = (REGIME_PERIODS * sample_rate / f0).ceil() as usize;
         scope.copy_latest(wanted, &mut self.samples);
         self.detected = classify_regime(&self.samples, sample_rate, f0);
+        if self.thermal_shown() {
+            self.link
+                .nodes
+                .copy_latest(SLIP_IMAGE_RECORDS, &mut self.records);
+        }
         ui.ctx().request_repaint_after(LIVE_REFRESH);
+    }
+
+    /// Whether the thermal bow's views are shown: live views on, the thermal model chosen
+    /// and the bow on the strings.
+    pub fn thermal_shown(&self) -> bool {
+        self.live
+            && self.params.friction_model.value() == FrictionChoice::Thermal
+            && self.params.resonator.value() == ResonatorChoice::Strings
+    }
+
+    /// Two plot areas side by side in `rect`, with room for the axis labels.
+    fn plot_pair(rect: egui::Rect) -> [egui::Rect; 2] {
+        let margin_left = 52.0;
+        let gap = 16.0;
+        let margin_right = 8.0;
+        let width = (rect.width() - 2.0 * margin_left - gap - margin_right) / 2.0;
+        [0.0, 1.0].map(|i| {
+            let left = rect.left() + margin_left + i * (width + margin_left + gap);
+            egui::Rect::from_min_size(
+                egui::pos2(left, rect.top() + 4.0),
+                vec2(width, rect.height() - 22.0),
+            )
+        })
+    }
+
+    /// The temperature across the bow and the slip image side by side.
+    fn thermal_views(&self, ui: &mut Ui, size: egui::Vec2) {
+        let (rect, response) = ui.allocate_exact_size(size, egui::Sense::hover());
+        // The newest record in words: the views' accessible value (the tests read it).
+        response.widget_info(|| {
+            let mut info =
+                egui::WidgetInfo::labeled(egui::Role::Image, ui.is_enabled(), THERMAL_LABEL);
+            info.current_text_value = Some(
+                self.records
+                    .last()
+                    .map_or_else(|| "waiting for audio".to_owned(), describe_record),
+            );
+            info
+        });
+        if self.records.is_empty() {
+            paint_waiting(ui, rect, "Thermal bow: waiting for audio");
+            return;
+        }
+        let [left, right] = Self::plot_pair(rect);
+        paint_temperature_profile(ui, left, &self.records);
+        paint_slip_image(ui, right, &self.records);
     }
 
     /// The velocity trace and the friction loop side by side.
@@ -191,35 +258,18 @@ impl EditorUi {
         let samples = &self.samples[self.samples.len().saturating_sub(shown)..];
 
         let (rect, _) = ui.allocate_exact_size(size, egui::Sense::hover());
-        let margin_left = 52.0;
-        let gap = 16.0;
-        let margin_right = 8.0;
-        let width = (rect.width() - 2.0 * margin_left - gap - margin_right) / 2.0;
-        let plot = |i: f32| {
-            let left = rect.left() + margin_left + i * (width + margin_left + gap);
-            egui::Rect::from_min_size(
-                egui::pos2(left, rect.top() + 4.0),
-                vec2(width, rect.height() - 22.0),
-            )
-        };
         if samples.is_empty() {
-            ui.painter().text(
-                rect.center(),
-                egui::Align2::CENTER_CENTER,
-                "Live views: waiting for audio (play a note)",
-                egui::FontId::proportional(13.0),
-                ui.visuals().weak_text_color(),
-            );
+            paint_waiting(ui, rect, "Live views: waiting for audio (play a note)");
             return;
         }
         paint_velocity_trace(
             ui,
-            plot(0.0),
+            Self::plot_pair(rect)[0],
             samples,
             sample_rate,
             self.params.bow_velocity.value(),
         );
-        paint_friction_loop(ui, plot(1.0), samples);
+        paint_friction_loop(ui, Self::plot_pair(rect)[1], samples);
     }
 
     fn side_panel(&self, ui: &mut Ui, setter: &ParamSetter, window: Option<&SchellengWindow>) {
@@ -242,7 +292,7 @@ impl EditorUi {
                 ui.add(ParamSlider::for_param(&p.gain, setter).with_width(100.0));
                 ui.end_row();
                 // The thermal bow's discretisation: shown only while that model plays.
-                if p.friction_model.value() == crate::params::FrictionChoice::Thermal {
+                if p.friction_model.value() == FrictionChoice::Thermal {
                     ui.label("Bow nodes");
                     ui.add(ParamSlider::for_param(&p.bow_nodes, setter).with_width(100.0));
                     ui.end_row();
@@ -324,6 +374,33 @@ impl EditorUi {
         };
         ui.label(RichText::new(format!("Detected: {text}")).color(colour));
     }
+}
+
+/// A faint note in the middle of an empty view.
+fn paint_waiting(ui: &Ui, rect: egui::Rect, text: &str) {
+    ui.painter().text(
+        rect.center(),
+        egui::Align2::CENTER_CENTER,
+        text,
+        egui::FontId::proportional(13.0),
+        ui.visuals().weak_text_color(),
+    );
+}
+
+/// Accessible label of the thermal bow's views.
+pub const THERMAL_LABEL: &str = "Thermal bow: temperature and slipping per node";
+
+/// A node record in words: the hottest node and the share of node-samples slipping.
+pub fn describe_record(record: &NodeRecord) -> String {
+    let nodes = &record.temperature_kelvin[..record.count];
+    let hottest = nodes.iter().copied().fold(0.0f32, f32::max);
+    let slipping =
+        record.slip_fraction[..record.count].iter().sum::<f32>() / record.count.max(1) as f32;
+    format!(
+        "{} nodes, hottest {hottest:.1} K above ambient, slipping {:.0} % of the time",
+        record.count,
+        100.0 * slipping
+    )
 }
 
 /// Where the bow sits relative to the window, as Schelleng's diagram names the regions.
