@@ -54,8 +54,8 @@ pub struct EditorSize {
 
 impl EditorSize {
     pub const DEFAULT: Self = Self {
-        width: 860.0,
-        height: 640.0,
+        width: 880.0,
+        height: 760.0,
     };
     pub const MIN: Self = Self {
         width: 640.0,

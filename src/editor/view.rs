@@ -171,7 +171,11 @@ impl EditorUi {
                 Layout::top_down(egui::Align::Min),
                 |ui| {
                     ui.set_width(SIDE_WIDTH);
-                    self.side_panel(ui, &setter, window.as_ref());
+                    // Scrolls rather than spill over the live views in a short window.
+                    egui::ScrollArea::vertical()
+                        .max_height(pad_size.y)
+                        .auto_shrink([false, true])
+                        .show(ui, |ui| self.side_panel(ui, &setter, window.as_ref()));
                 },
             );
         });
