@@ -289,7 +289,9 @@ pub fn paint_temperature_profile(ui: &Ui, rect: Rect, records: &[NodeRecord]) {
     if count == 0 {
         return;
     }
-    let y = |t: f32| rect.bottom() - (t / limit).clamp(0.0, 1.0) * rect.height();
+    // Below the title.
+    let plot = Rect::from_min_max(pos2(rect.left(), rect.top() + 18.0), rect.max);
+    let y = |t: f32| plot.bottom() - (t / limit).clamp(0.0, 1.0) * plot.height();
     let painter = ui.painter();
     let band = PROFILE.gamma_multiply(0.25);
     for i in 0..count {

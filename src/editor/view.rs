@@ -281,7 +281,7 @@ impl EditorUi {
         ui.label(RichText::new("Bow").strong());
         egui::Grid::new("bow-sliders")
             .num_columns(2)
-            .spacing(vec2(8.0, 6.0))
+            .spacing(vec2(8.0, 4.0))
             .show(ui, |ui| {
                 ui.label("Velocity");
                 ui.add(ParamSlider::for_param(&p.bow_velocity, setter).with_width(100.0));
@@ -305,16 +305,21 @@ impl EditorUi {
                     ui.end_row();
                 }
             });
-        ui.add_space(6.0);
+        ui.add_space(4.0);
         ui.separator();
-        ui.label(RichText::new("Schelleng window").strong());
         let Some(w) = window else {
+            ui.label(RichText::new("Schelleng window").strong());
             ui.label(format!(
                 "Not shown: the bow rubs the {} resonator, not a string.",
                 ResonatorChoice::variants()[p.resonator.value().to_index()].to_lowercase()
             ));
             return;
         };
+        ui.label(RichText::new("Regime").strong());
+        self.regime_lines(ui, w);
+        ui.add_space(4.0);
+        ui.separator();
+        ui.label(RichText::new("Schelleng window").strong());
         let kind: InstrumentKind = p.instrument.value().into();
         let note = self.window_note(kind);
         let string = kind.string_for_note(note).unwrap_or(0);
@@ -363,17 +368,18 @@ impl EditorUi {
                 ui.label(format_force(f));
                 ui.end_row();
             });
-        let (text, colour) = predicted_regime(v as f64, f as f64, f_min, f_max);
+    }
+
+    /// The regime the window predicts for the bow and the one detected in the simulation.
+    fn regime_lines(&self, ui: &mut Ui, window: &SchellengWindow) {
+        let v = self.params.bow_velocity.value() as f64;
+        let f = self.params.bow_force.value() as f64;
+        let (text, colour) = predicted_regime(v, f, window.min_force_n(v), window.max_force_n(v));
         ui.label(RichText::new(format!("Predicted: {text}")).color(colour));
+        let weak = ui.visuals().weak_text_color();
         let (text, colour) = match (self.live, self.detected) {
-            (false, _) => (
-                "(live views off)".to_owned(),
-                ui.visuals().weak_text_color(),
-            ),
-            (true, None) => (
-                "(waiting for audio)".to_owned(),
-                ui.visuals().weak_text_color(),
-            ),
+            (false, _) => ("(live views off)".to_owned(), weak),
+            (true, None) => ("(waiting for audio)".to_owned(), weak),
             (true, Some(regime)) => (regime.describe(), regime_colour(regime)),
         };
         ui.label(RichText::new(format!("Detected: {text}")).color(colour));
