@@ -8,7 +8,9 @@ use colophony::editor::nodes::NodeRecord;
 use colophony::editor::pad::{pad_value_text, PAD_LABEL};
 use colophony::editor::view::THERMAL_LABEL;
 use colophony::editor::{EditorLink, EditorUi};
-use colophony::params::{ColophonyParams, FrictionChoice, InstrumentChoice};
+use colophony::params::{
+    ColophonyParams, FrictionChoice, InstrumentChoice, QualityChoice, StringChoice,
+};
 use egui::{pos2, vec2, Pos2, Rect};
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
@@ -279,21 +281,41 @@ fn the_pad_follows_host_automation_when_not_dragged() {
     assert!(f.recorder.calls().is_empty(), "the editor sent nothing");
 }
 
-#[test]
-fn choosing_an_instrument_is_one_gesture() {
-    let mut f = fixture();
+/// Opens the selector labelled `label`, checks it shows `before`, picks `after`, closes
+/// the editor, and checks the host saw one gesture with one value.
+fn choose(f: &mut Fixture, label: &str, before: &str, after: &str) {
     {
         let mut h = harness(&mut f.editor);
-        let combo = h.get_by_role_and_label(egui::Role::ComboBox, "Instrument");
-        assert_eq!(combo.value().as_deref(), Some("Cello"));
+        let combo = h.get_by_role_and_label(egui::Role::ComboBox, label);
+        assert_eq!(combo.value().as_deref(), Some(before));
         combo.click();
         h.run();
-        h.get_by_label("Violin").click();
+        h.get_by_label(after).click();
         h.run();
     }
     let calls = f.recorder.calls();
-    assert_eq!(assert_one_gesture(&calls, "Instrument"), 1, "{calls:?}");
+    assert_eq!(assert_one_gesture(&calls, label), 1, "{calls:?}");
+}
+
+#[test]
+fn choosing_an_instrument_is_one_gesture() {
+    let mut f = fixture();
+    choose(&mut f, "Instrument", "Cello", "Violin");
     assert_eq!(f.params.instrument.value(), InstrumentChoice::Violin);
+}
+
+#[test]
+fn choosing_a_string_is_one_gesture() {
+    let mut f = fixture();
+    choose(&mut f, "String", "Auto", "IV (lowest)");
+    assert_eq!(f.params.string.value(), StringChoice::IV);
+}
+
+#[test]
+fn choosing_a_quality_is_one_gesture() {
+    let mut f = fixture();
+    choose(&mut f, "Quality", "Good", "Reference");
+    assert_eq!(f.params.quality.value(), QualityChoice::Reference);
 }
 
 /// Whether some label shows exactly `text`.
@@ -319,6 +341,17 @@ fn the_schelleng_numbers_follow_the_note_the_audio_thread_reports() {
     assert_shows(&h, "0.833 kg/s");
     assert_shows(&h, "G2 (last note), 98.0 Hz");
     assert_shows(&h, "G string");
+    // The player asks for the lowest string: G2 sul C (Z0 1.91 kg/s).
+    let params = f.params.clone();
+    unsafe {
+        params
+            .string
+            .as_ptr()
+            ._internal_set_normalized_value(params.string.preview_normalized(StringChoice::IV));
+    }
+    h.run();
+    assert_shows(&h, "1.910 kg/s");
+    assert_shows(&h, "C string");
 }
 
 #[test]

@@ -10,7 +10,7 @@ use super::pad::{format_force, format_velocity, XyPad, MAX_FORCE_COLOUR, MIN_FOR
 use super::regime::{classify_regime, Regime};
 use super::{EditorLink, EditorSize};
 use crate::dsp::instrument::{midi_to_hz, InstrumentKind};
-use crate::params::{ColophonyParams, FrictionChoice, ResonatorChoice};
+use crate::params::{ColophonyParams, FrictionChoice, QualityChoice, ResonatorChoice};
 use egui::{vec2, Color32, Layout, RichText, Ui};
 use nice_plug::context::gui::GuiContext;
 use nice_plug::prelude::{Enum, EnumParam, ParamSetter};
@@ -100,6 +100,14 @@ impl EditorUi {
             .unwrap_or(kind.open_notes()[2])
     }
 
+    /// The string (0 = the lowest) that plays `note` with the String parameter's choice.
+    /// A note keeps its string if the choice changes while it sounds; the window follows
+    /// the choice at once.
+    fn window_string(&self, kind: InstrumentKind, note: u8) -> usize {
+        kind.string_for_note_on(note, self.params.string.value().index())
+            .unwrap_or(0)
+    }
+
     /// The Schelleng window for the current note and bow position, `None` while the bow
     /// rubs a modal resonator instead of the strings.
     pub fn window(&self) -> Option<SchellengWindow> {
@@ -108,7 +116,8 @@ impl EditorUi {
         }
         let kind: InstrumentKind = self.params.instrument.value().into();
         let beta = self.params.bow_position.value() as f64;
-        SchellengWindow::for_note(kind, self.window_note(kind), beta)
+        let string = self.window_string(kind, self.window_note(kind));
+        Some(SchellengWindow::for_string(kind, string, beta))
     }
 
     /// Draws one frame.
@@ -127,11 +136,14 @@ impl EditorUi {
         let params = self.params.clone();
         let context = self.context.clone();
         let setter = context.param_setter();
-        ui.horizontal(|ui| {
+        // Wraps onto a second line in a narrow window.
+        ui.horizontal_wrapped(|ui| {
             ui.heading("Colophony");
             ui.add_space(12.0);
             enum_selector(ui, "Instrument", &params.instrument, &setter);
+            enum_selector(ui, "String", &params.string, &setter);
             enum_selector(ui, "Friction model", &params.friction_model, &setter);
+            enum_selector(ui, "Quality", &params.quality, &setter);
             enum_selector(ui, "Resonator", &params.resonator, &setter);
             ui.checkbox(&mut self.live, "Live views");
         });
@@ -295,10 +307,15 @@ impl EditorUi {
                 ui.label("Output gain");
                 ui.add(ParamSlider::for_param(&p.gain, setter).with_width(100.0));
                 ui.end_row();
-                // The thermal bow's discretisation: shown only while that model plays.
+                // The thermal bow's discretisation: shown only while that model plays; the
+                // node count is the Quality preset's unless the quality is custom.
                 if p.friction_model.value() == FrictionChoice::Thermal {
                     ui.label("Bow nodes");
-                    ui.add(ParamSlider::for_param(&p.bow_nodes, setter).with_width(100.0));
+                    if p.quality.value() == QualityChoice::Custom {
+                        ui.add(ParamSlider::for_param(&p.bow_nodes, setter).with_width(100.0));
+                    } else {
+                        ui.label(RichText::new("set by Quality").weak());
+                    }
                     ui.end_row();
                     ui.label("Bow width");
                     ui.add(ParamSlider::for_param(&p.bow_width_mm, setter).with_width(100.0));
@@ -322,8 +339,7 @@ impl EditorUi {
         ui.label(RichText::new("Schelleng window").strong());
         let kind: InstrumentKind = p.instrument.value().into();
         let note = self.window_note(kind);
-        let string = kind.string_for_note(note).unwrap_or(0);
-        let open = kind.open_notes()[string];
+        let open = kind.open_notes()[self.window_string(kind, note)];
         let heard = if self.link.note().is_some() {
             "last note"
         } else {
