@@ -6,8 +6,11 @@
 //! cargo run --release --features standalone --example editor_standalone -- --backend dummy
 //! ```
 //!
-//! `COLOPHONY_DEMO_NOTE` picks the MIDI note (default 50, cello D3). The wrapper plugin only
-//! adds that note-on before the host's first event; everything else is Colophony's.
+//! `COLOPHONY_DEMO_NOTE` picks the MIDI note (default 50, cello D3).
+//! `COLOPHONY_DEMO_SET` sets parameters before the first block, as `id=value` pairs
+//! separated by `;`, each value as the parameter displays it (for example
+//! `friction_model=Thermal (paper B);bow_force=2`). The wrapper plugin only adds these and
+//! the note-on before the host's first event; everything else is Colophony's.
 
 use colophony::Colophony;
 use nice_plug::midi::{Channel, Key, VoiceID};
@@ -88,6 +91,35 @@ impl<C: ActivateContext<Demo>> ActivateContext<Colophony> for Activate<'_, C> {
     }
 }
 
+/// Applies `COLOPHONY_DEMO_SET` (see the module doc) to `params`; unknown ids and values
+/// are reported and skipped.
+fn apply_demo_settings(params: &dyn Params) {
+    let Ok(settings) = std::env::var("COLOPHONY_DEMO_SET") else {
+        return;
+    };
+    let map = params.param_map();
+    for pair in settings.split(';').filter(|p| !p.trim().is_empty()) {
+        let Some((id, value)) = pair.split_once('=') else {
+            eprintln!("COLOPHONY_DEMO_SET: expected id=value, got {pair:?}");
+            continue;
+        };
+        let Some((_, param, _)) = map.iter().find(|(i, _, _)| i == id.trim()) else {
+            eprintln!("COLOPHONY_DEMO_SET: no parameter {id:?}");
+            continue;
+        };
+        // SAFETY: the pointers come from `params`, which outlives this call, and the audio
+        // thread has not started (called from `activate`, before the first block).
+        unsafe {
+            match param.string_to_normalized_value(value.trim()) {
+                Some(normalized) => {
+                    param._internal_set_normalized_value(normalized);
+                }
+                None => eprintln!("COLOPHONY_DEMO_SET: {id} cannot be {value:?}"),
+            }
+        }
+    }
+}
+
 fn demo_note() -> u8 {
     std::env::var("COLOPHONY_DEMO_NOTE")
         .ok()
@@ -127,6 +159,7 @@ impl Plugin for Demo {
     ) -> bool {
         self.note = demo_note();
         self.note_sent = false;
+        apply_demo_settings(&*self.inner.params());
         self.inner
             .activate(audio_io_layout, buffer_config, &mut Activate(context))
     }

@@ -9,16 +9,17 @@
 # Installs what it needs with apt-get if missing (as root, or through sudo): pkg-config,
 # libasound2-dev and libjack-jackd2-dev (the standalone wrapper links ALSA and JACK), xvfb,
 # x11-apps (xwd), netpbm (xwdtopnm, pnmcut, pnmtopng) and Mesa's OpenGL drivers.
-# Environment: COLOPHONY_DEMO_NOTE (MIDI note, default 50), SETTLE_S (seconds between
-# opening the window and the screenshot, default 6).
+# Environment: COLOPHONY_DEMO_NOTE (MIDI note, default 50), COLOPHONY_DEMO_SET (parameters,
+# `id=value;...`, default the thermal model so the shot shows its views; set it empty for
+# the defaults), SETTLE_S (seconds between opening the window and the screenshot, default 6).
 set -euo pipefail
 
 cd "$(dirname "$0")/.."
 out=${1:-docs/editor.png}
 settle=${SETTLE_S:-6}
 # The window's default size (EditorSize::DEFAULT in src/editor/mod.rs).
-width=860
-height=640
+width=880
+height=760
 
 packages=(pkg-config libasound2-dev libjack-jackd2-dev xvfb xauth x11-apps netpbm
     libgl1 libgl1-mesa-dri libx11-xcb1 libxcursor1 libxrandr2 libxi6)
@@ -50,6 +51,7 @@ cleanup() {
 trap cleanup EXIT
 sleep 1.5
 
+export COLOPHONY_DEMO_SET=${COLOPHONY_DEMO_SET-friction_model=Thermal (paper B)}
 DISPLAY=$display LIBGL_ALWAYS_SOFTWARE=1 "$app" --backend dummy >/dev/null 2>&1 &
 app_pid=$!
 sleep "$settle"

@@ -57,6 +57,8 @@ pub struct Colophony {
     editor_link: Arc<editor::EditorLink>,
     /// The thermal node count `quality = auto` chose at the last note-on.
     auto_nodes: usize,
+    /// The thermal bow's nodes, summed for the editor while it listens.
+    node_probe: editor::nodes::NodeProbe,
 }
 
 impl Default for Colophony {
@@ -72,6 +74,7 @@ impl Default for Colophony {
             last_note: None,
             editor_link: Arc::new(editor::EditorLink::default()),
             auto_nodes: quality::GOOD_NODES,
+            node_probe: editor::nodes::NodeProbe::default(),
             params,
         }
     }
@@ -382,6 +385,12 @@ impl Plugin for Colophony {
                 self.editor_link
                     .scope
                     .push(editor::live::ContactSample::new(&frame, &bow));
+                if let Source::Thermal(k) = self.source {
+                    if let Some(engine) = self.thermal.get(k) {
+                        self.node_probe
+                            .add_string(engine.probed_string(), &self.editor_link);
+                    }
+                }
             }
             let mut audio = frame.audio;
             if self.rubbed.is_sounding() {

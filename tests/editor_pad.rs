@@ -4,9 +4,13 @@
 
 use colophony::editor::live::ContactSample;
 use colophony::editor::mapping::PadMapping;
+use colophony::editor::nodes::NodeRecord;
 use colophony::editor::pad::{pad_value_text, PAD_LABEL};
+use colophony::editor::view::THERMAL_LABEL;
 use colophony::editor::{EditorLink, EditorUi};
-use colophony::params::{ColophonyParams, InstrumentChoice};
+use colophony::params::{
+    ColophonyParams, FrictionChoice, InstrumentChoice, QualityChoice, StringChoice,
+};
 use egui::{pos2, vec2, Pos2, Rect};
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
@@ -277,21 +281,41 @@ fn the_pad_follows_host_automation_when_not_dragged() {
     assert!(f.recorder.calls().is_empty(), "the editor sent nothing");
 }
 
-#[test]
-fn choosing_an_instrument_is_one_gesture() {
-    let mut f = fixture();
+/// Opens the selector labelled `label`, checks it shows `before`, picks `after`, closes
+/// the editor, and checks the host saw one gesture with one value.
+fn choose(f: &mut Fixture, label: &str, before: &str, after: &str) {
     {
         let mut h = harness(&mut f.editor);
-        let combo = h.get_by_role_and_label(egui::Role::ComboBox, "Instrument");
-        assert_eq!(combo.value().as_deref(), Some("Cello"));
+        let combo = h.get_by_role_and_label(egui::Role::ComboBox, label);
+        assert_eq!(combo.value().as_deref(), Some(before));
         combo.click();
         h.run();
-        h.get_by_label("Violin").click();
+        h.get_by_label(after).click();
         h.run();
     }
     let calls = f.recorder.calls();
-    assert_eq!(assert_one_gesture(&calls, "Instrument"), 1, "{calls:?}");
+    assert_eq!(assert_one_gesture(&calls, label), 1, "{calls:?}");
+}
+
+#[test]
+fn choosing_an_instrument_is_one_gesture() {
+    let mut f = fixture();
+    choose(&mut f, "Instrument", "Cello", "Violin");
     assert_eq!(f.params.instrument.value(), InstrumentChoice::Violin);
+}
+
+#[test]
+fn choosing_a_string_is_one_gesture() {
+    let mut f = fixture();
+    choose(&mut f, "String", "Auto", "IV (lowest)");
+    assert_eq!(f.params.string.value(), StringChoice::IV);
+}
+
+#[test]
+fn choosing_a_quality_is_one_gesture() {
+    let mut f = fixture();
+    choose(&mut f, "Quality", "Good", "Reference");
+    assert_eq!(f.params.quality.value(), QualityChoice::Reference);
 }
 
 /// Whether some label shows exactly `text`.
@@ -317,6 +341,17 @@ fn the_schelleng_numbers_follow_the_note_the_audio_thread_reports() {
     assert_shows(&h, "0.833 kg/s");
     assert_shows(&h, "G2 (last note), 98.0 Hz");
     assert_shows(&h, "G string");
+    // The player asks for the lowest string: G2 sul C (Z0 1.91 kg/s).
+    let params = f.params.clone();
+    unsafe {
+        params
+            .string
+            .as_ptr()
+            ._internal_set_normalized_value(params.string.preview_normalized(StringChoice::IV));
+    }
+    h.run();
+    assert_shows(&h, "1.910 kg/s");
+    assert_shows(&h, "C string");
 }
 
 #[test]
@@ -351,4 +386,78 @@ fn live_views_are_fed_only_while_an_open_editor_shows_them() {
     }
     drop(f.editor);
     assert!(!link.is_listening(), "a closed editor is not fed");
+}
+
+/// Pushes `periods` periods of a stick-slip train into the scope: `slips` equal slips per
+/// 327-sample period (cello D3 at 48 kHz) with friction `mu` (0: the bow is lifted).
+fn push_stick_slip(link: &EditorLink, periods: usize, slips: usize, mu: f32) {
+    let spacing = 327 / slips;
+    for i in 0..periods * 327 {
+        let slipping = (i % 327) % spacing < 30 && (i % 327) < slips * spacing;
+        link.scope.push(ContactSample {
+            string_velocity: if slipping { -0.9 } else { 0.1 },
+            relative_velocity: if slipping { -1.0 } else { 0.0 },
+            mu,
+        });
+    }
+}
+
+#[test]
+fn the_detected_regime_is_shown_beside_the_predicted_one() {
+    let mut f = fixture();
+    let link = f.link.clone();
+    let mut h = harness(&mut f.editor);
+    assert_shows(&h, "Predicted: Helmholtz motion");
+    assert_shows(&h, "Detected: (waiting for audio)");
+    push_stick_slip(&link, 10, 1, 0.3);
+    h.run();
+    assert_shows(&h, "Detected: Helmholtz motion (1 slip per period)");
+    push_stick_slip(&link, 10, 3, 0.3);
+    h.run();
+    assert_shows(&h, "Detected: multiple slips (3 per period)");
+    // The bow lifted: no friction.
+    push_stick_slip(&link, 10, 1, 0.0);
+    h.run();
+    assert_shows(&h, "Detected: silent");
+    h.get_by_role_and_label(egui::Role::CheckBox, "Live views")
+        .click();
+    h.run();
+    assert_shows(&h, "Detected: (live views off)");
+}
+
+#[test]
+fn the_thermal_bow_views_show_the_audio_threads_node_records_only_with_the_thermal_model() {
+    let mut f = fixture();
+    let link = f.link.clone();
+    let params = f.params.clone();
+    // Two records from the audio thread: 4 nodes, the second warmer and slipping more.
+    for (t, s) in [(1.0f32, 0.25f32), (4.5, 0.5)] {
+        let mut record = NodeRecord {
+            count: 4,
+            ..NodeRecord::default()
+        };
+        record.temperature_kelvin[..4].copy_from_slice(&[t - 1.0, t, t, t - 1.0]);
+        record.slip_fraction[..4].fill(s);
+        link.nodes.push(&record);
+    }
+    let mut h = harness(&mut f.editor);
+    assert!(
+        h.query_by_label(THERMAL_LABEL).is_none(),
+        "not shown with a point law"
+    );
+    unsafe {
+        params
+            .friction_model
+            .as_ptr()
+            ._internal_set_normalized_value(
+                params
+                    .friction_model
+                    .preview_normalized(FrictionChoice::Thermal),
+            );
+    }
+    h.run();
+    assert_eq!(
+        h.get_by_label(THERMAL_LABEL).value().as_deref(),
+        Some("4 nodes, hottest 4.5 K above ambient, slipping 50 % of the time")
+    );
 }

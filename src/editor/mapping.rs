@@ -26,7 +26,7 @@
 //! (Schoonderwaldt, Guettler and Askenfelt 2008). `mu_s` 0.4 and `mu_d` 0.2 are the defaults
 //! of the hyperbolic friction law (and of the bristle models).
 
-use crate::dsp::instrument::InstrumentKind;
+use crate::dsp::instrument::{InstrumentKind, STRINGS};
 use crate::params::{bow_force_range, bow_velocity_range};
 use egui::{pos2, Pos2, Rect};
 use nice_plug::prelude::FloatRange;
@@ -150,14 +150,20 @@ impl SchellengWindow {
     /// bridge resistance from the string's own `Q1` and the default friction
     /// coefficients. `None` if the instrument cannot play the note.
     pub fn for_note(kind: InstrumentKind, note: u8, beta: f64) -> Option<Self> {
-        let spec = kind.strings()[kind.string_for_note(note)?];
-        Some(Self {
+        Some(Self::for_string(kind, kind.string_for_note(note)?, beta))
+    }
+
+    /// The window of string `string` of `kind` (0 = the lowest; clamped to the highest),
+    /// as [`Self::for_note`] (a stopped note's window is its open string's).
+    pub fn for_string(kind: InstrumentKind, string: usize, beta: f64) -> Self {
+        let spec = kind.strings()[string.min(STRINGS - 1)];
+        Self {
             z0_kg_per_s: spec.z0_kg_per_s,
             bridge_r_kg_per_s: bridge_resistance(spec.z0_kg_per_s, spec.q1),
             beta,
             mu_s: MU_S,
             mu_d: MU_D,
-        })
+        }
     }
 
     /// Maximum bow force for Helmholtz motion, N: `2 Z0 |v_b| / (beta (mu_s - mu_d))`.

@@ -5,6 +5,8 @@
 //! * [`pad`]: the pad widget and its begin/set/end gestures.
 //! * [`view`]: the editor's contents, drawn into any `egui::Ui` ([`EditorUi`]).
 //! * [`live`]: the live views and the wait-free ring that feeds them from the audio thread.
+//! * [`nodes`]: the thermal bow's temperature and slip views and their wait-free ring.
+//! * [`regime`]: the regime the string is in, classified from the live samples (pure).
 //! * This file: the window glue. [`ColophonyEditor`] is the plugin's `Editor`;
 //!   [`EditorState`] is the window size saved with the plugin state
 //!   (`#[persist = "editor-state"]` in [`crate::params::ColophonyParams`]); [`EditorLink`]
@@ -20,7 +22,9 @@
 
 pub mod live;
 pub mod mapping;
+pub mod nodes;
 pub mod pad;
+pub mod regime;
 pub mod view;
 
 pub use view::EditorUi;
@@ -50,8 +54,8 @@ pub struct EditorSize {
 
 impl EditorSize {
     pub const DEFAULT: Self = Self {
-        width: 860.0,
-        height: 640.0,
+        width: 880.0,
+        height: 760.0,
     };
     pub const MIN: Self = Self {
         width: 640.0,
@@ -122,13 +126,16 @@ impl<'a> PersistentField<'a, EditorSize> for EditorState {
 }
 
 /// What the audio thread tells the editor, lock-free: the note once per block, and the
-/// live samples only while an editor showing them is open.
+/// live samples and the thermal bow's nodes only while an editor showing them is open.
 #[derive(Debug)]
 pub struct EditorLink {
     note: AtomicU8,
     listening: AtomicBool,
     /// The probed string's contact, one sample per audio sample while listening.
     pub scope: live::Scope,
+    /// The thermal bow's nodes on the probed string, one record every few ms while
+    /// listening to the thermal instrument.
+    pub nodes: nodes::NodeRing,
 }
 
 impl EditorLink {
@@ -164,6 +171,7 @@ impl Default for EditorLink {
             note: AtomicU8::new(Self::NO_NOTE),
             listening: AtomicBool::new(false),
             scope: live::Scope::default(),
+            nodes: nodes::NodeRing::default(),
         }
     }
 }

@@ -5,10 +5,12 @@
 
 use super::live::{paint_friction_loop, paint_velocity_trace, ContactSample, SCOPE_LEN};
 use super::mapping::SchellengWindow;
+use super::nodes::{paint_slip_image, paint_temperature_profile, NodeRecord, RING_LEN};
 use super::pad::{format_force, format_velocity, XyPad, MAX_FORCE_COLOUR, MIN_FORCE_COLOUR};
+use super::regime::{classify_regime, Regime};
 use super::{EditorLink, EditorSize};
 use crate::dsp::instrument::{midi_to_hz, InstrumentKind};
-use crate::params::{ColophonyParams, ResonatorChoice};
+use crate::params::{ColophonyParams, FrictionChoice, QualityChoice, ResonatorChoice};
 use egui::{vec2, Color32, Layout, RichText, Ui};
 use nice_plug::context::gui::GuiContext;
 use nice_plug::prelude::{Enum, EnumParam, ParamSetter};
@@ -21,8 +23,18 @@ use std::time::Duration;
 const SIDE_WIDTH: f32 = 290.0;
 /// Height of the live views' row, points.
 const LIVE_HEIGHT: f32 = 170.0;
+/// Height of the thermal bow's row (shown with the thermal model), points.
+const THERMAL_HEIGHT: f32 = 150.0;
+/// Node records the slip image shows (5 ms each: 0.64 s).
+const SLIP_IMAGE_RECORDS: usize = 128;
 /// Periods of the current note the velocity trace shows.
 const TRACE_PERIODS: f32 = 3.0;
+/// Periods of the current note the regime is detected from (the ring holds more than
+/// five of the lowest note at 96 kHz, and [`Scope::copy_latest`] caps the count).
+///
+/// [`Scope::copy_latest`]: super::live::Scope::copy_latest
+const REGIME_PERIODS: f32 = 8.0;
+const HELMHOLTZ_COLOUR: Color32 = Color32::from_rgb(120, 210, 120);
 /// How often the live views look for new samples.
 const LIVE_REFRESH: Duration = Duration::from_millis(33);
 
@@ -37,6 +49,10 @@ pub struct EditorUi {
     pub live: bool,
     /// The live samples copied out of the scope, reused every frame.
     samples: Vec<ContactSample>,
+    /// The regime detected from [`Self::samples`] (`None`: too few samples yet).
+    detected: Option<Regime>,
+    /// The thermal bow's node records copied out of the ring, reused every frame.
+    records: Vec<NodeRecord>,
 }
 
 impl EditorUi {
@@ -48,11 +64,19 @@ impl EditorUi {
             pad: XyPad::default(),
             live: true,
             samples: Vec::with_capacity(SCOPE_LEN),
+            detected: None,
+            records: Vec::with_capacity(RING_LEN),
         }
     }
 
     pub fn pad(&self) -> &XyPad {
         &self.pad
+    }
+
+    /// The regime detected from the live samples on the last frame (`None` while the
+    /// live views are off or hold too few samples).
+    pub fn detected_regime(&self) -> Option<Regime> {
+        self.detected
     }
 
     /// Stops the audio thread feeding the live views (the editor closing).
@@ -76,6 +100,14 @@ impl EditorUi {
             .unwrap_or(kind.open_notes()[2])
     }
 
+    /// The string (0 = the lowest) that plays `note` with the String parameter's choice.
+    /// A note keeps its string if the choice changes while it sounds; the window follows
+    /// the choice at once.
+    fn window_string(&self, kind: InstrumentKind, note: u8) -> usize {
+        kind.string_for_note_on(note, self.params.string.value().index())
+            .unwrap_or(0)
+    }
+
     /// The Schelleng window for the current note and bow position, `None` while the bow
     /// rubs a modal resonator instead of the strings.
     pub fn window(&self) -> Option<SchellengWindow> {
@@ -84,7 +116,8 @@ impl EditorUi {
         }
         let kind: InstrumentKind = self.params.instrument.value().into();
         let beta = self.params.bow_position.value() as f64;
-        SchellengWindow::for_note(kind, self.window_note(kind), beta)
+        let string = self.window_string(kind, self.window_note(kind));
+        Some(SchellengWindow::for_string(kind, string, beta))
     }
 
     /// Draws one frame.
@@ -103,19 +136,32 @@ impl EditorUi {
         let params = self.params.clone();
         let context = self.context.clone();
         let setter = context.param_setter();
-        ui.horizontal(|ui| {
+        // Wraps onto a second line in a narrow window.
+        ui.horizontal_wrapped(|ui| {
             ui.heading("Colophony");
             ui.add_space(12.0);
             enum_selector(ui, "Instrument", &params.instrument, &setter);
+            enum_selector(ui, "String", &params.string, &setter);
             enum_selector(ui, "Friction model", &params.friction_model, &setter);
+            enum_selector(ui, "Quality", &params.quality, &setter);
             enum_selector(ui, "Resonator", &params.resonator, &setter);
             ui.checkbox(&mut self.live, "Live views");
         });
         ui.separator();
 
+        if self.live {
+            self.refresh_live(ui);
+        } else {
+            self.detected = None;
+        }
         let window = self.window();
         let available = ui.available_size();
-        let live_height = if self.live { LIVE_HEIGHT } else { 0.0 };
+        let thermal_height = if self.thermal_shown() {
+            THERMAL_HEIGHT
+        } else {
+            0.0
+        };
+        let live_height = if self.live { LIVE_HEIGHT } else { 0.0 } + thermal_height;
         ui.horizontal_top(|ui| {
             let pad_size = vec2(
                 (available.x - SIDE_WIDTH - 12.0).max(200.0),
@@ -137,55 +183,109 @@ impl EditorUi {
                 Layout::top_down(egui::Align::Min),
                 |ui| {
                     ui.set_width(SIDE_WIDTH);
-                    self.side_panel(ui, &setter, window.as_ref());
+                    // Scrolls rather than spill over the live views in a short window.
+                    egui::ScrollArea::vertical()
+                        .max_height(pad_size.y)
+                        .auto_shrink([false, true])
+                        .show(ui, |ui| self.side_panel(ui, &setter, window.as_ref()));
                 },
             );
         });
         if self.live {
             self.live_views(ui, vec2(available.x, LIVE_HEIGHT - 8.0));
         }
+        if thermal_height > 0.0 {
+            self.thermal_views(ui, vec2(available.x, THERMAL_HEIGHT - 8.0));
+        }
     }
 
-    /// The velocity trace and the friction loop side by side.
-    fn live_views(&mut self, ui: &mut Ui, size: egui::Vec2) {
-        let scope = &self.link.scope;
+    /// The fundamental of the note the strings play (or the window's default note).
+    fn note_hz(&self) -> f32 {
         let kind: InstrumentKind = self.params.instrument.value().into();
-        let f0 = midi_to_hz(self.window_note(kind) as f64) as f32;
-        let sample_rate = scope.sample_rate();
-        let wanted = (TRACE_PERIODS * sample_rate / f0).ceil() as usize;
-        scope.copy_latest(wanted, &mut self.samples);
-        ui.ctx().request_repaint_after(LIVE_REFRESH);
+        midi_to_hz(self.window_note(kind) as f64) as f32
+    }
 
-        let (rect, _) = ui.allocate_exact_size(size, egui::Sense::hover());
+    /// Copies the newest samples out of the scope and detects the regime from them.
+    fn refresh_live(&mut self, ui: &Ui) {
+        let scope = &self.link.scope;
+        let f0 = self.note_hz();
+        let sample_rate = scope.sample_rate();
+        let wanted = (REGIME_PERIODS * sample_rate / f0).ceil() as usize;
+        scope.copy_latest(wanted, &mut self.samples);
+        self.detected = classify_regime(&self.samples, sample_rate, f0);
+        if self.thermal_shown() {
+            self.link
+                .nodes
+                .copy_latest(SLIP_IMAGE_RECORDS, &mut self.records);
+        }
+        ui.ctx().request_repaint_after(LIVE_REFRESH);
+    }
+
+    /// Whether the thermal bow's views are shown: live views on, the thermal model chosen
+    /// and the bow on the strings.
+    pub fn thermal_shown(&self) -> bool {
+        self.live
+            && self.params.friction_model.value() == FrictionChoice::Thermal
+            && self.params.resonator.value() == ResonatorChoice::Strings
+    }
+
+    /// Two plot areas side by side in `rect`, with room for the axis labels.
+    fn plot_pair(rect: egui::Rect) -> [egui::Rect; 2] {
         let margin_left = 52.0;
         let gap = 16.0;
         let margin_right = 8.0;
         let width = (rect.width() - 2.0 * margin_left - gap - margin_right) / 2.0;
-        let plot = |i: f32| {
+        [0.0, 1.0].map(|i| {
             let left = rect.left() + margin_left + i * (width + margin_left + gap);
             egui::Rect::from_min_size(
                 egui::pos2(left, rect.top() + 4.0),
                 vec2(width, rect.height() - 22.0),
             )
-        };
-        if self.samples.is_empty() {
-            ui.painter().text(
-                rect.center(),
-                egui::Align2::CENTER_CENTER,
-                "Live views: waiting for audio (play a note)",
-                egui::FontId::proportional(13.0),
-                ui.visuals().weak_text_color(),
+        })
+    }
+
+    /// The temperature across the bow and the slip image side by side.
+    fn thermal_views(&self, ui: &mut Ui, size: egui::Vec2) {
+        let (rect, response) = ui.allocate_exact_size(size, egui::Sense::hover());
+        // The newest record in words: the views' accessible value (the tests read it).
+        response.widget_info(|| {
+            let mut info =
+                egui::WidgetInfo::labeled(egui::Role::Image, ui.is_enabled(), THERMAL_LABEL);
+            info.current_text_value = Some(
+                self.records
+                    .last()
+                    .map_or_else(|| "waiting for audio".to_owned(), describe_record),
             );
+            info
+        });
+        if self.records.is_empty() {
+            paint_waiting(ui, rect, "Thermal bow: waiting for audio");
+            return;
+        }
+        let [left, right] = Self::plot_pair(rect);
+        paint_temperature_profile(ui, left, &self.records);
+        paint_slip_image(ui, right, &self.records);
+    }
+
+    /// The velocity trace and the friction loop side by side.
+    fn live_views(&mut self, ui: &mut Ui, size: egui::Vec2) {
+        let sample_rate = self.link.scope.sample_rate();
+        let shown = (TRACE_PERIODS * sample_rate / self.note_hz()).ceil() as usize;
+        let samples = &self.samples[self.samples.len().saturating_sub(shown)..];
+
+        let (rect, _) = ui.allocate_exact_size(size, egui::Sense::hover());
+        if samples.is_empty() {
+            paint_waiting(ui, rect, "Live views: waiting for audio (play a note)");
             return;
         }
         paint_velocity_trace(
             ui,
-            plot(0.0),
-            &self.samples,
+            Self::plot_pair(rect)[0],
+            samples,
             sample_rate,
             self.params.bow_velocity.value(),
         );
-        paint_friction_loop(ui, plot(1.0), &self.samples);
+        paint_friction_loop(ui, Self::plot_pair(rect)[1], samples);
     }
 
     fn side_panel(&self, ui: &mut Ui, setter: &ParamSetter, window: Option<&SchellengWindow>) {
@@ -193,7 +293,7 @@ impl EditorUi {
         ui.label(RichText::new("Bow").strong());
         egui::Grid::new("bow-sliders")
             .num_columns(2)
-            .spacing(vec2(8.0, 6.0))
+            .spacing(vec2(8.0, 4.0))
             .show(ui, |ui| {
                 ui.label("Velocity");
                 ui.add(ParamSlider::for_param(&p.bow_velocity, setter).with_width(100.0));
@@ -207,30 +307,39 @@ impl EditorUi {
                 ui.label("Output gain");
                 ui.add(ParamSlider::for_param(&p.gain, setter).with_width(100.0));
                 ui.end_row();
-                // The thermal bow's discretisation: shown only while that model plays.
-                if p.friction_model.value() == crate::params::FrictionChoice::Thermal {
+                // The thermal bow's discretisation: shown only while that model plays; the
+                // node count is the Quality preset's unless the quality is custom.
+                if p.friction_model.value() == FrictionChoice::Thermal {
                     ui.label("Bow nodes");
-                    ui.add(ParamSlider::for_param(&p.bow_nodes, setter).with_width(100.0));
+                    if p.quality.value() == QualityChoice::Custom {
+                        ui.add(ParamSlider::for_param(&p.bow_nodes, setter).with_width(100.0));
+                    } else {
+                        ui.label(RichText::new("set by Quality").weak());
+                    }
                     ui.end_row();
                     ui.label("Bow width");
                     ui.add(ParamSlider::for_param(&p.bow_width_mm, setter).with_width(100.0));
                     ui.end_row();
                 }
             });
-        ui.add_space(6.0);
+        ui.add_space(4.0);
         ui.separator();
-        ui.label(RichText::new("Schelleng window").strong());
         let Some(w) = window else {
+            ui.label(RichText::new("Schelleng window").strong());
             ui.label(format!(
                 "Not shown: the bow rubs the {} resonator, not a string.",
                 ResonatorChoice::variants()[p.resonator.value().to_index()].to_lowercase()
             ));
             return;
         };
+        ui.label(RichText::new("Regime").strong());
+        self.regime_lines(ui, w);
+        ui.add_space(4.0);
+        ui.separator();
+        ui.label(RichText::new("Schelleng window").strong());
         let kind: InstrumentKind = p.instrument.value().into();
         let note = self.window_note(kind);
-        let string = kind.string_for_note(note).unwrap_or(0);
-        let open = kind.open_notes()[string];
+        let open = kind.open_notes()[self.window_string(kind, note)];
         let heard = if self.link.note().is_some() {
             "last note"
         } else {
@@ -275,9 +384,49 @@ impl EditorUi {
                 ui.label(format_force(f));
                 ui.end_row();
             });
-        let (text, colour) = predicted_regime(v as f64, f as f64, f_min, f_max);
-        ui.label(RichText::new(format!("Predicted: {text}")).color(colour));
     }
+
+    /// The regime the window predicts for the bow and the one detected in the simulation.
+    fn regime_lines(&self, ui: &mut Ui, window: &SchellengWindow) {
+        let v = self.params.bow_velocity.value() as f64;
+        let f = self.params.bow_force.value() as f64;
+        let (text, colour) = predicted_regime(v, f, window.min_force_n(v), window.max_force_n(v));
+        ui.label(RichText::new(format!("Predicted: {text}")).color(colour));
+        let weak = ui.visuals().weak_text_color();
+        let (text, colour) = match (self.live, self.detected) {
+            (false, _) => ("(live views off)".to_owned(), weak),
+            (true, None) => ("(waiting for audio)".to_owned(), weak),
+            (true, Some(regime)) => (regime.describe(), regime_colour(regime)),
+        };
+        ui.label(RichText::new(format!("Detected: {text}")).color(colour));
+    }
+}
+
+/// A faint note in the middle of an empty view.
+fn paint_waiting(ui: &Ui, rect: egui::Rect, text: &str) {
+    ui.painter().text(
+        rect.center(),
+        egui::Align2::CENTER_CENTER,
+        text,
+        egui::FontId::proportional(13.0),
+        ui.visuals().weak_text_color(),
+    );
+}
+
+/// Accessible label of the thermal bow's views.
+pub const THERMAL_LABEL: &str = "Thermal bow: temperature and slipping per node";
+
+/// A node record in words: the hottest node and the share of node-samples slipping.
+pub fn describe_record(record: &NodeRecord) -> String {
+    let nodes = &record.temperature_kelvin[..record.count];
+    let hottest = nodes.iter().copied().fold(0.0f32, f32::max);
+    let slipping =
+        record.slip_fraction[..record.count].iter().sum::<f32>() / record.count.max(1) as f32;
+    format!(
+        "{} nodes, hottest {hottest:.1} K above ambient, slipping {:.0} % of the time",
+        record.count,
+        100.0 * slipping
+    )
 }
 
 /// Where the bow sits relative to the window, as Schelleng's diagram names the regions.
@@ -291,7 +440,17 @@ fn predicted_regime(v: f64, f: f64, f_min: f64, f_max: f64) -> (&'static str, Co
     } else if f < f_min {
         ("multiple slips (below F_min)", MIN_FORCE_COLOUR)
     } else {
-        ("Helmholtz motion", Color32::from_rgb(120, 210, 120))
+        ("Helmholtz motion", HELMHOLTZ_COLOUR)
+    }
+}
+
+/// The colour of the region of Schelleng's diagram a detected regime belongs to.
+fn regime_colour(regime: Regime) -> Color32 {
+    match regime {
+        Regime::Silent | Regime::Sliding => Color32::GRAY,
+        Regime::Helmholtz => HELMHOLTZ_COLOUR,
+        Regime::MultipleSlips(_) => MIN_FORCE_COLOUR,
+        Regime::Raucous => MAX_FORCE_COLOUR,
     }
 }
 
