@@ -32,6 +32,9 @@ use params::ColophonyParams;
 use quality::Quality;
 use std::sync::Arc;
 
+/// Samples between two tail estimates (see `Colophony::status`).
+const TAIL_EVERY: usize = 2048;
+
 /// What the notes play: the waveguide strings with one of paper A's laws, paper B's
 /// thermal instrument of one kind (index into [`InstrumentKind::ALL`]), or a rubbed object.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -57,6 +60,10 @@ pub struct Colophony {
     editor_link: Arc<editor::EditorLink>,
     /// The thermal node count `quality = auto` chose at the last note-on.
     auto_nodes: usize,
+    sample_rate_hz: f64,
+    /// The last tail estimate (samples left) and the samples processed since it: the
+    /// estimate walks every delay line, so it is renewed only every [`TAIL_EVERY`] samples.
+    tail: Option<(f64, usize)>,
     /// The thermal bow's nodes, summed for the editor while it listens.
     node_probe: editor::nodes::NodeProbe,
 }
@@ -74,6 +81,8 @@ impl Default for Colophony {
             last_note: None,
             editor_link: Arc::new(editor::EditorLink::default()),
             auto_nodes: quality::GOOD_NODES,
+            sample_rate_hz: 48_000.0,
+            tail: None,
             node_probe: editor::nodes::NodeProbe::default(),
             params,
         }
@@ -82,6 +91,8 @@ impl Default for Colophony {
 
 impl Colophony {
     fn note_on(&mut self, note: u8) {
+        // A bow lands: whatever tail was estimated no longer holds.
+        self.tail = None;
         match self.source {
             // Notes the instrument cannot play are ignored.
             Source::Strings => {
@@ -182,6 +193,46 @@ impl Colophony {
             nodes,
             width_m: p.bow_width_mm.value() as f64 * 1e-3,
         }
+    }
+
+    /// What the host hears about this block: `KeepAlive` while a bow is on (or a rubbed
+    /// object sounds: no estimate for those yet), the tail in samples while lifted strings
+    /// ring out (the waveguide body's last few blocks after its strings slept count as a
+    /// tail of one sample, renewed while it rings) (CLAP tail extension, VST3 `getTailSamples`; hosts may stop processing
+    /// after it), `Normal` once silent (CLAP may then stop calling `process` until input).
+    fn status(&mut self, block: usize) -> ProcessStatus {
+        if self.rubbed.is_sounding() {
+            self.tail = None;
+            return ProcessStatus::KeepAlive;
+        }
+        if let Some((left, since)) = self.tail {
+            if since + block < TAIL_EVERY {
+                let left = (left - block as f64).max(1.0);
+                self.tail = Some((left, since + block));
+                return ProcessStatus::Tail(left as u32);
+            }
+        }
+        self.tail = None;
+        let mut tail_s = 0.0f64;
+        let mut sounding = false;
+        let engines = std::iter::once(self.instrument.is_ringing().then(|| self.instrument.ring_out_s()))
+            .chain(self.thermal.iter().map(|e| e.is_sounding().then(|| e.ring_out_s())));
+        for engine in engines.flatten() {
+            sounding = true;
+            match engine {
+                Some(s) => tail_s = tail_s.max(s),
+                None => return ProcessStatus::KeepAlive,
+            }
+        }
+        if !sounding {
+            return ProcessStatus::Normal;
+        }
+        // At least one sample while anything rings; below CLAP's "infinite" (i32::MAX).
+        let samples = (tail_s * self.sample_rate_hz)
+            .ceil()
+            .clamp(1.0, (i32::MAX - 1) as f64);
+        self.tail = Some((samples, 0));
+        ProcessStatus::Tail(samples as u32)
     }
 
     /// `quality = auto`: the node count for a new note at the current bow position, kept
@@ -292,6 +343,8 @@ impl Plugin for Colophony {
         self.source = Source::Strings;
         self.held = [false; 128];
         self.editor_link.scope.set_sample_rate(fs as f32);
+        self.sample_rate_hz = fs;
+        self.tail = None;
         true
     }
 
@@ -410,14 +463,7 @@ impl Plugin for Colophony {
             next_event = context.next_event();
         }
         self.editor_link.set_note(self.last_note);
-        if self.instrument.is_sounding()
-            || self.rubbed.is_sounding()
-            || self.thermal.iter().any(|e| e.is_sounding())
-        {
-            ProcessStatus::KeepAlive
-        } else {
-            ProcessStatus::Normal
-        }
+        self.status(buffer.samples())
     }
 }
 

@@ -772,6 +772,45 @@ fn quality_and_string_switches_during_notes_keep_sounding_in_tune_without_clicks
     }
 }
 
+#[test]
+fn the_reported_tail_covers_the_ring_out_and_ends_when_the_strings_sleep() {
+    use clack_extensions::tail::TailLength;
+    for model in ["Hyperbolic", "Thermal (paper B)"] {
+        let mut plugin = active_plugin(FS, BLOCK);
+        let score = Score::new()
+            .at(0, plugin.text("Friction Model", model))
+            .at(0, Event::note_on(50));
+        plugin.render(24_000, BLOCK, &score);
+        assert_eq!(plugin.tail(), TailLength::Infinite, "{model}: bowing");
+        // Lift the bow; after the 20 ms ramp the strings only ring.
+        plugin.render(2_400, BLOCK, &Score::new().at(0, Event::note_off(50)));
+        let TailLength::Finite(told) = plugin.tail() else {
+            panic!("{model}: no finite tail while ringing");
+        };
+        // Render on until the plugin reports silence, in blocks.
+        let mut rang = 0usize;
+        while plugin.tail() != TailLength::Finite(0) {
+            let out = plugin.render(BLOCK, BLOCK, &Score::new());
+            assert!(out[0].iter().all(|v| v.is_finite()));
+            rang += BLOCK;
+            assert!(rang < 120 * FS as usize, "{model}: still ringing after 2 minutes");
+        }
+        println!(
+            "{model}: tail told {:.2} s, rang {:.2} s",
+            told as f64 / FS,
+            rang as f64 / FS
+        );
+        // The estimate lets every partial decay at the fundamental's (slowest) rate, so
+        // it is an upper bound; the higher partials and the body decay faster, and it
+        // must not be far off either (within a factor of two).
+        assert!(rang as f64 <= told as f64 + 2048.0 + BLOCK as f64, "{model}");
+        assert!(2.0 * rang as f64 >= told as f64, "{model}: {told} told, {rang} rang");
+        // Once the tail is over the output is exact zeros.
+        let out = plugin.render(4 * BLOCK, BLOCK, &Score::new());
+        assert!(out[0].iter().all(|v| *v == 0.0), "{model}");
+    }
+}
+
 /// Largest sample-to-sample step right at each switch against the largest anywhere in the
 /// 10 ms before it (the waveform's own corners).
 fn assert_no_click_at(x: &[f64], switch_at: &[u64]) {

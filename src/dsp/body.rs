@@ -56,6 +56,14 @@ impl BodyModes {
         self.filters.iter_mut().for_each(Bandpass::reset);
     }
 
+    /// Samples until every mode would ring out below `level` with no more input.
+    pub fn samples_below(&self, level: f64) -> f64 {
+        self.filters[..self.count]
+            .iter()
+            .map(|f| f.samples_below(level))
+            .fold(0.0, f64::max)
+    }
+
     /// Whether every mode has rung out below `level` (state magnitude, N-scale).
     pub fn is_quiet(&self, level: f64) -> bool {
         self.filters[..self.count]

@@ -137,6 +137,18 @@ impl Bandpass {
         self.s1.abs().max(self.s2.abs())
     }
 
+    /// Samples for the state's envelope to fall below `level` if the input stops: the
+    /// poles' radius is `sqrt(a2)`, so it falls by that factor per sample (0 if already
+    /// below).
+    pub fn samples_below(&self, level: f64) -> f64 {
+        let mag = self.state_magnitude();
+        let r = self.a2.max(0.0).sqrt();
+        if mag <= level || !(r > 0.0 && r < 1.0) {
+            return 0.0;
+        }
+        (level / mag).ln() / r.ln()
+    }
+
     pub fn new(freq_hz: f64, q: f64, sample_rate_hz: f64) -> Self {
         let w0 = 2.0 * PI * freq_hz / sample_rate_hz;
         let alpha = w0.sin() / (2.0 * q);

@@ -27,6 +27,9 @@ pub const PITCH_BEND_SEMITONES: f64 = 2.0;
 /// A lifted string whose wave energy is below this sleeps (about -130 dB below a
 /// default bowed note's few millijoules).
 pub const SLEEP_ENERGY_J: f64 = 1e-16;
+/// The body sleeps once every mode's state is below this (N-scale: output below -200 dB of
+/// a bowed note).
+const BODY_QUIET_N: f64 = 1e-12;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum InstrumentKind {
@@ -154,6 +157,18 @@ impl InstrumentKind {
     pub fn note_range(self) -> (u8, u8) {
         let open = self.open_notes();
         (open[0], open[STRINGS - 1] + MAX_STOP_SEMITONES)
+    }
+}
+
+/// Seconds for a string's energy to fall from `energy_j` to [`SLEEP_ENERGY_J`] at its
+/// fundamental's decay rate: amplitude falls as `exp(-pi f0 t / Q1)`, energy twice as fast,
+/// so `t = Q1 ln(E / E_sleep) / (2 pi f0)` (0 below the threshold or for absurd inputs).
+pub fn ring_out_s(energy_j: f64, f0_hz: f64, q1: f64) -> f64 {
+    let t = q1 * (energy_j / SLEEP_ENERGY_J).ln() / (2.0 * std::f64::consts::PI * f0_hz);
+    if t.is_finite() && t > 0.0 {
+        t
+    } else {
+        0.0
     }
 }
 
@@ -358,6 +373,38 @@ impl Instrument {
         self.voices.iter().any(|v| v.awake)
     }
 
+    /// Whether anything still rings: an awake string, or the body after the strings slept.
+    pub fn is_ringing(&self) -> bool {
+        self.is_sounding() || !self.body_asleep
+    }
+
+    /// Seconds until every string and the body would fall asleep if no bow lands again
+    /// (the host's tail), or `None` while a bow is on a string. Each awake string's energy
+    /// is taken to fall at its fundamental's rate ([`ring_out_s`]), the slowest of its
+    /// partials; the body then rings out from its present state at its modes' own rates
+    /// (an overestimate: it will have decayed while the strings did). Walks the delay
+    /// lines: call once per block.
+    pub fn ring_out_s(&self) -> Option<f64> {
+        let body_s = if self.body_asleep {
+            0.0
+        } else {
+            self.body.samples_below(BODY_QUIET_N) / self.sample_rate_hz
+        };
+        self.strings_ring_out_s().map(|s| s + body_s)
+    }
+
+    fn strings_ring_out_s(&self) -> Option<f64> {
+        let mut longest = 0.0f64;
+        for voice in self.voices.iter().filter(|v| v.awake) {
+            if voice.bowed || voice.bow_gain > 0.0 {
+                return None;
+            }
+            let s = &voice.string;
+            longest = longest.max(ring_out_s(s.energy_j(), s.fundamental_hz(), s.spec().q1));
+        }
+        Some(longest)
+    }
+
     /// Puts lifted strings whose energy fell below [`SLEEP_ENERGY_J`] to sleep. Called once
     /// per block by the plugin and the renderer (it walks the delay lines).
     pub fn update_sleep(&mut self) {
@@ -366,7 +413,8 @@ impl Instrument {
         }
         // The body sleeps too once no string is awake and its modes have rung out
         // (state below 1e-12 N: output below -200 dB of a bowed note).
-        self.body_asleep = self.voices.iter().all(|v| !v.awake) && self.body.is_quiet(1e-12);
+        self.body_asleep =
+            self.voices.iter().all(|v| !v.awake) && self.body.is_quiet(BODY_QUIET_N);
         if self.body_asleep {
             self.body.reset();
         }

@@ -778,6 +778,11 @@ impl ThermalString {
         true
     }
 
+    /// Quality factor of the fundamental.
+    pub fn q1(&self) -> f64 {
+        self.spec.q1
+    }
+
     /// Fundamental the loop is tuned to, Hz.
     pub fn fundamental_hz(&self) -> f64 {
         self.spec.f0_hz

@@ -450,6 +450,26 @@ impl ThermalInstrument {
         self.core.strings.iter().map(|s| s.energy_j()).sum()
     }
 
+    /// Seconds until the instrument would fall asleep if no bow lands again (the host's
+    /// tail), or `None` while a bow is on or a setting change is pending. Every string
+    /// counts (the bridge keeps them coupled), each at its fundamental's decay rate
+    /// ([`super::instrument::ring_out_s`]). Walks the delay lines: call once per block.
+    pub fn ring_out_s(&self) -> Option<f64> {
+        if !self.awake {
+            return Some(0.0);
+        }
+        if self.pending.is_some() || self.voices.iter().any(|v| v.bowed || v.bow_gain > 0.0) {
+            return None;
+        }
+        let longest = self
+            .core
+            .strings
+            .iter()
+            .map(|s| super::instrument::ring_out_s(s.energy_j(), s.fundamental_hz(), s.q1()))
+            .fold(0.0, f64::max);
+        Some(longest)
+    }
+
     /// Puts the instrument to sleep once every bow is lifted and the strings and the
     /// bridge have rung out (called once per block: it walks the delay lines).
     pub fn update_sleep(&mut self) {

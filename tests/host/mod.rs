@@ -22,6 +22,7 @@ use clack_extensions::audio_ports::{AudioPortInfoBuffer, PluginAudioPorts};
 use clack_extensions::note_ports::{NoteDialects, NotePortInfoBuffer, PluginNotePorts};
 use clack_extensions::params::{ParamInfoBuffer, PluginParams};
 use clack_extensions::state::PluginState;
+use clack_extensions::tail::{PluginTail, TailLength};
 use clack_host::events::event_types::{MidiEvent, NoteOffEvent, NoteOnEvent, ParamValueEvent};
 use clack_host::events::Match;
 use clack_host::prelude::*;
@@ -315,6 +316,19 @@ impl HostedPlugin {
             .get_extension::<PluginParams>()
             .expect("no params extension");
         ext.get_value(&handle, id).expect("get_value failed")
+    }
+
+    /// The tail the plugin reports now (CLAP tail extension, asked on the audio thread
+    /// between blocks, as hosts do).
+    #[allow(dead_code)]
+    pub fn tail(&mut self) -> TailLength {
+        let ext = self
+            .instance
+            .plugin_handle()
+            .get_extension::<PluginTail>()
+            .expect("no tail extension");
+        let activation = self.activation.as_mut().expect("activate first");
+        ext.get(&activation.processor.plugin_handle())
     }
 
     /// The plugin's saved state (CLAP state extension).
