@@ -403,6 +403,23 @@ impl RubbedInstrument {
         self.notes_down = 0;
     }
 
+    /// Modal energy of every object's resonator, J.
+    pub fn energy_j(&self) -> f64 {
+        self.voices
+            .iter()
+            .map(|v| v.scene.resonator_energy_j())
+            .sum()
+    }
+
+    /// Newton statistics of `preset`'s bristle contact.
+    pub fn solver_stats(&self, preset: RubbedPreset) -> SolverStats {
+        let index = RubbedPreset::ALL
+            .iter()
+            .position(|p| *p == preset)
+            .unwrap_or(0);
+        self.voices[index].scene.solver_stats()
+    }
+
     /// Once per block: an object sleeps when lifted and quiet.
     pub fn update_sleep(&mut self) {
         for (i, voice) in self.voices.iter_mut().enumerate() {

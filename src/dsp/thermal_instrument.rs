@@ -160,6 +160,8 @@ pub struct ThermalInstrument {
     /// Whether the instrument sleeps when silent (the default; off only to measure what
     /// sleeping saves: `colophony bench scenes`).
     skipping: bool,
+    /// Times the non-finite guard in [`ThermalInstrument::tick`] reset the instrument.
+    recoveries: u64,
 }
 
 impl ThermalInstrument {
@@ -231,6 +233,7 @@ impl ThermalInstrument {
             output_scale: kind.output_scale_per_n(),
             awake: false,
             skipping: true,
+            recoveries: 0,
         };
         instrument
             .apply_settings(settings)
@@ -478,6 +481,7 @@ impl ThermalInstrument {
         if !audio.is_finite() {
             // Cannot happen with finite inputs; recover to silence rather than emit garbage.
             self.reset();
+            self.recoveries += 1;
             return Frame::default();
         }
         Frame {
@@ -485,6 +489,12 @@ impl ThermalInstrument {
             bow_point_velocity_m_per_s: self.core.probe.0,
             friction_force_n: self.core.probe.1,
         }
+    }
+
+    /// How often the non-finite guard in [`ThermalInstrument::tick`] has fired (it never
+    /// should: the stress suite asserts zero).
+    pub fn recoveries(&self) -> u64 {
+        self.recoveries
     }
 
     /// Turns sleeping off (everything is computed every sample, silent or not) or on.
