@@ -72,14 +72,10 @@ const PRIME_BLOCKS: [usize; 15] = [
 /// bent down at 384 kHz), so its relative rounding error is below 6600 x 2^-53 < 1e-12;
 /// 1e-9 is rounding with a margin of 1000, and any real gain is far larger.
 const STRING_ENERGY_TOLERANCE: f64 = 1e-9;
-/// Thermal instrument: total string energy (waves, end filters and hair, as for the
-/// waveguide) averaged over successive windows of the longest string period. The strings
-/// meet at the modal bridge, whose own storage has no accessor yet: it holds a small share
-/// that moves within a period, so the windows are averaged as in
-/// `energy_never_grows_with_the_bow_lifted` (tests/paper_b.rs). The tolerance is rounding
-/// only: at most 2 x 4 x 8000 squares per sample, relative error below 1e-11.
-// TODO: count the bridge's storage (each section is a bilinear mass-spring-damper) and
-// check sample by sample as for the waveguide strings.
+/// Thermal instrument: the energy of the strings (waves, end filters, hair) and of the
+/// modal bridge (`ModalBridge::energy_j`), which with every bow lifted never grows from one
+/// internal sample to the next; checked once per period of the longest string. The sum
+/// has at most 2 x 4 x 8000 squares, relative rounding below 1e-11: 1e-9 is rounding.
 const THERMAL_ENERGY_TOLERANCE: f64 = 1e-9;
 /// Rubbed objects: the trapezoidal rule conserves `m v^2 / 2 + k x^2 / 2` (pre-warped k)
 /// exactly and damping only removes energy, so it may not grow from one sample to the
@@ -520,21 +516,20 @@ impl Rig {
     }
 }
 
-/// Watches the energy while the bow is lifted (see the tolerance constants).
+/// Watches the energy while the bow is lifted (see the tolerance constants). Each energy
+/// never grows from one sample to the next, so checking it every `stride` samples (a
+/// subsequence) is enough.
 enum EnergyWatch {
     Idle,
     /// Per string: next check frame, period, last energy.
     Strings([(usize, usize, f64); STRINGS]),
-    /// Window length, frames left in this window, running sum, previous window's mean,
-    /// windows still to check.
-    Thermal {
-        window: usize,
-        left: usize,
-        sum: f64,
-        previous: Option<f64>,
-        windows: u32,
+    /// The whole engine: next check frame, stride, last energy, tolerance.
+    Total {
+        next: usize,
+        stride: usize,
+        last: f64,
+        tolerance: f64,
     },
-    Modal(f64),
 }
 
 /// Frames after a lift before the watch starts: the bow's ramp down and a pending thermal
@@ -555,17 +550,20 @@ impl EnergyWatch {
                     .map(|s| i.string(s).loop_samples())
                     .max()
                     .unwrap_or(1) as f64;
-                let window = (longest * rate_hz / i.internal_rate_hz()).ceil() as usize + 2;
-                EnergyWatch::Thermal {
-                    window,
-                    left: window,
-                    sum: 0.0,
-                    previous: None,
-                    // A few windows per lift: each sample costs a walk of every delay line.
-                    windows: 6,
+                let stride = ((longest * rate_hz / i.internal_rate_hz()).ceil() as usize).max(1);
+                EnergyWatch::Total {
+                    next: now + stride,
+                    stride,
+                    last: i.energy_j(),
+                    tolerance: THERMAL_ENERGY_TOLERANCE,
                 }
             }
-            Rig::Rubbed(r, _) => EnergyWatch::Modal(r.energy_j()),
+            Rig::Rubbed(r, _) => EnergyWatch::Total {
+                next: now + 1,
+                stride: 1,
+                last: r.energy_j(),
+                tolerance: MODAL_ENERGY_TOLERANCE,
+            },
         }
     }
 
@@ -591,46 +589,25 @@ impl EnergyWatch {
                 Ok(checks)
             }
             (
-                EnergyWatch::Thermal {
-                    window,
-                    left,
-                    sum,
-                    previous,
-                    windows,
+                EnergyWatch::Total {
+                    next,
+                    stride,
+                    last,
+                    tolerance,
                 },
-                Rig::Thermal(i),
+                Rig::Thermal(_) | Rig::Rubbed(..),
             ) => {
-                if *windows == 0 {
+                if now != *next {
                     return Ok(0);
                 }
-                *sum += i.energy_j();
-                *left -= 1;
-                if *left > 0 {
-                    return Ok(0);
-                }
-                let mean = *sum / *window as f64;
-                *sum = 0.0;
-                *left = *window;
-                *windows -= 1;
-                if let Some(p) = *previous {
-                    if !(mean <= p * (1.0 + THERMAL_ENERGY_TOLERANCE)) {
-                        return Err(format!(
-                            "thermal: lifted energy averaged over {window} frames grew: \
-                             {p:e} -> {mean:e} J"
-                        ));
-                    }
-                }
-                *previous = Some(mean);
-                Ok(1)
-            }
-            (EnergyWatch::Modal(last), Rig::Rubbed(r, _)) => {
-                let e = r.energy_j();
-                if !(e <= *last * (1.0 + MODAL_ENERGY_TOLERANCE)) {
+                let e = rig.energy_j();
+                if !(e <= *last * (1.0 + *tolerance)) {
                     return Err(format!(
-                        "rubbed: lifted modal energy grew: {last:e} -> {e:e} J"
+                        "lifted energy grew over {stride} frames: {last:e} -> {e:e} J"
                     ));
                 }
                 *last = e;
+                *next += *stride;
                 Ok(1)
             }
             _ => Ok(0),
@@ -1071,4 +1048,44 @@ fn the_plugin_stays_finite_below_full_scale_and_deterministic_across_hosts_block
         Ok(())
     });
     totals.into_inner().finish("plugin", started, result);
+}
+
+// ---------------------------------------------------------------------------------------
+// Regression cases found by the suite
+
+/// Found by the strings suite (seed `0x5eed_0001`, shrunk): a cello's C string at 8 kHz,
+/// bowed 29 ms at C#2 and lifted, seemed to gain 0.4 % of its energy over one period.
+/// Not an instability (the nut's loss filter has `|H| <= g < 1`): the energy counted only
+/// the travelling waves, and at low rates the nut's dispersion allpasses hold a large part
+/// of the loop and hand it back. `WaveguideString::energy_j` now counts what they hold, so
+/// the energy may not grow on any sample.
+#[test]
+fn lifted_cello_c_string_at_8_khz_never_gains_energy_counting_the_nut_filters() {
+    let fs = 8_000.0;
+    let mut cello = Instrument::new(InstrumentKind::Cello, fs);
+    assert_eq!(cello.note_on(37), Some(0));
+    let bow = BowControl::default();
+    for _ in 0..(0.029 * fs) as usize {
+        cello.tick(bow);
+    }
+    cello.all_notes_off();
+    // The bow's ramp down, after which no force reaches the string.
+    for _ in 0..=(BOW_RAMP_S * fs).ceil() as usize {
+        cello.tick(bow);
+    }
+    let first = cello.string(0).energy_j();
+    let mut last = first;
+    for n in 0..fs as usize {
+        cello.tick(bow);
+        let e = cello.string(0).energy_j();
+        assert!(
+            e <= last * (1.0 + STRING_ENERGY_TOLERANCE),
+            "sample {n}: {last:e} -> {e:e} J"
+        );
+        last = e;
+    }
+    assert!(
+        last < 0.5 * first,
+        "the string did not decay: {first:e} -> {last:e} J"
+    );
 }

@@ -413,9 +413,12 @@ impl ThermalInstrument {
         &self.core.strings[i]
     }
 
-    /// Total wave and hair energy of the strings, J.
+    /// Energy of the strings (waves, end filters, hair) and the bridge, J. With every bow
+    /// lifted it never grows from one internal sample to the next: the strings lose at the
+    /// bridge what it gains ([`ModalBridge::energy_j`]), and everything else is lossless
+    /// or lossy.
     pub fn energy_j(&self) -> f64 {
-        self.core.strings.iter().map(|s| s.energy_j()).sum()
+        self.core.strings.iter().map(|s| s.energy_j()).sum::<f64>() + self.core.bridge.energy_j()
     }
 
     /// Puts the instrument to sleep once every bow is lifted and the strings and the
