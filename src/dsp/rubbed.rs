@@ -287,14 +287,18 @@ impl RubbedScene {
 
     /// One sample with an explicit exciter velocity and normal force. A modal exciter is
     /// pushed with the steady friction at its target velocity under this normal force, so
-    /// it still settles there; lifted (no normal force) it is not pushed and coasts. (A
-    /// fixed push would accelerate the free mass without bound whenever the friction
-    /// holding it back is lighter than the preset's, and it would then strike the object
-    /// at tens of m/s: found by the stress suite.)
+    /// it still settles there; lifted (no normal force) it is not pushed and coasts. The
+    /// push never exceeds what the active law holds back at high sliding speed
+    /// ([`AnyFriction::high_speed_friction_n`]): the static curves have no viscous term,
+    /// and a push above their `mu_d F_N` would never be balanced. (A fixed push
+    /// accelerated the free mass without bound under a lighter force or a static law, and
+    /// it then struck the object at tens of m/s: found by the stress suite.)
     pub fn tick_with(&mut self, bow: BowInput) -> RubbedFrame {
         let f_n = bow.normal_force_n;
         let push_n = if f_n > 0.0 && self.spec.normal_force_n > 0.0 {
-            self.push_friction_n * (f_n / self.spec.normal_force_n) + self.push_viscous_n
+            let push =
+                self.push_friction_n * (f_n / self.spec.normal_force_n) + self.push_viscous_n;
+            push.signum() * push.abs().min(self.contact.high_speed_friction_n(f_n))
         } else {
             0.0
         };
