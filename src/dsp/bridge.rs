@@ -75,9 +75,9 @@ struct Section {
     /// Transposed direct form II state per channel.
     z1: [f64; 2],
     z2: [f64; 2],
-    /// The section's stored energy is `sum_ij storage[i][j] z_i^T gain^+ z_j` (z_1, z_2
-    /// the state vectors over the channels), per second of the sample rate: see
-    /// [`ModalBridge::energy_j`].
+    /// The section's stored energy times the sample rate is
+    /// `sum_ij storage[i][j] z_i^T gain^+ z_j` (z_1, z_2 the state vectors over the
+    /// channels): see [`ModalBridge::energy_j`].
     storage: [[f64; 2]; 2],
     /// Pseudo-inverse of `gain`.
     gain_pinv: [[f64; 2]; 2],
@@ -135,32 +135,30 @@ fn psd_pinv(g: [[f64; 2]; 2]) -> [[f64; 2]; 2] {
     let mean = 0.5 * (p + r);
     let radius = (0.25 * (p - r) * (p - r) + q * q).sqrt();
     let largest = mean + radius;
-    let mut pinv = [[0.0; 2]; 2];
     if !(largest > 0.0) {
-        return pinv;
+        return [[0.0; 2]; 2];
     }
-    for lambda in [mean + radius, mean - radius] {
-        if lambda <= 1e-12 * largest {
-            continue;
-        }
-        // Eigenvector of [[p, q], [q, r]] for lambda.
-        let (x, y) = if (p - lambda).abs() + q.abs() > (r - lambda).abs() + q.abs() {
-            (q, lambda - p)
-        } else {
-            (lambda - r, q)
-        };
-        let n = x * x + y * y;
-        let (x, y) = if n > 0.0 {
-            (x / n.sqrt(), y / n.sqrt())
-        } else if p >= r {
-            (1.0, 0.0)
-        } else {
-            (0.0, 1.0)
-        };
-        let v = [x, y];
-        for i in 0..2 {
-            for j in 0..2 {
-                pinv[i][j] += v[i] * v[j] / lambda;
+    if radius <= 1e-15 * largest {
+        // A multiple of the identity.
+        return [[1.0 / mean, 0.0], [0.0, 1.0 / mean]];
+    }
+    // Eigenvector of the larger eigenvalue, from the row whose entry cannot vanish
+    // (`(l - p)(l - r) = q^2`, and one of `l - p`, `l - r` is at least `radius`); the
+    // other eigenvector is perpendicular.
+    let (x, y) = if p >= r {
+        (0.5 * (p - r) + radius, q)
+    } else {
+        (q, 0.5 * (r - p) + radius)
+    };
+    let norm = (x * x + y * y).sqrt();
+    let (x, y) = (x / norm, y / norm);
+    let mut pinv = [[0.0; 2]; 2];
+    for (lambda, v) in [(largest, [x, y]), (mean - radius, [-y, x])] {
+        if lambda > 1e-12 * largest {
+            for i in 0..2 {
+                for j in 0..2 {
+                    pinv[i][j] += v[i] * v[j] / lambda;
+                }
             }
         }
     }
@@ -443,6 +441,31 @@ mod tests {
             "lossless mode: stored minus supplied {balance:e} J of {:e} J",
             bridge.energy_j()
         );
+    }
+
+    #[test]
+    fn psd_pseudo_inverse_inverts_on_the_range_and_ignores_the_null_space() {
+        let mul = |a: [[f64; 2]; 2], b: [[f64; 2]; 2]| -> [[f64; 2]; 2] {
+            std::array::from_fn(|i| std::array::from_fn(|j| a[i][0] * b[0][j] + a[i][1] * b[1][j]))
+        };
+        for g in [
+            [[2.0, 0.0], [0.0, 2.0]],
+            [[3.0, 0.0], [0.0, 1.0]],
+            [[1.0, 0.0], [0.0, 3.0]],
+            [[0.5, 0.1], [0.1, 0.2]],
+            [[0.2, -0.1], [-0.1, 0.5]],
+            // Rank one: g = u u^T, u = (0.6, 0.8).
+            [[0.36, 0.48], [0.48, 0.64]],
+        ] {
+            let pinv = psd_pinv(g);
+            // Moore-Penrose: g pinv g = g; 1e-12 is rounding on entries of order 1.
+            let back = mul(mul(g, pinv), g);
+            for i in 0..2 {
+                for j in 0..2 {
+                    assert!((back[i][j] - g[i][j]).abs() < 1e-12, "{g:?}: {back:?}");
+                }
+            }
+        }
     }
 
     #[test]
