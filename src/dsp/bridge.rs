@@ -75,6 +75,94 @@ struct Section {
     /// Transposed direct form II state per channel.
     z1: [f64; 2],
     z2: [f64; 2],
+    /// The section's stored energy times the sample rate is
+    /// `sum_ij storage[i][j] z_i^T gain^+ z_j` (z_1, z_2 the state vectors over the
+    /// channels): see [`ModalBridge::energy_j`].
+    storage: [[f64; 2]; 2],
+    /// Pseudo-inverse of `gain`.
+    gain_pinv: [[f64; 2]; 2],
+}
+
+/// `[[s11, s12], [s12, s22]]` such that `S(z) = z^T S z` (z the section's two direct-form
+/// states) is a storage of `H(z) = (1 - z^-2) / (1 + a1 z^-1 + a2 z^-2)` for the supply
+/// `u y` (input times output, one sample): `S(n+1) - S(n) <= u(n) y(n)`.
+///
+/// `H` is `D / K` times the bilinear transform (`K = 2 fs`, `D = K^2 + bw K + w^2`) of the
+/// unit-mass admittance `s / (s^2 + bw s + w^2)`, state `x = (position, velocity)`, energy
+/// `x^T P x / 2` with `P = diag(w^2, 1)`. The bilinear transform in its Cayley form (state
+/// `x~` with `x~(n+1) = (K - A)^-1 (K + A) x~(n) + sqrt(2K) (K - A)^-1 B u(n)`) keeps the
+/// positive-real lemma with the same `P`: `x~^T P x~` grows by at most `2 u y` a sample.
+/// The trapezoidal half-state `w = x~ / sqrt(K / 2)` then stores `K w^T P w / 4` for the
+/// supply `u y`, and since both realisations are minimal, `w = O_w^-1 O_d zeta` for the
+/// observability matrices `O = [C; C A]`. The direct-form states of `H` are `D / K` times
+/// those of the unit-mass section, which gives `S = K^2 / (4 D) M^T P M`, `M = O_w^-1 O_d`.
+fn section_storage(a1: f64, k: f64, bw: f64, w: f64) -> [[f64; 2]; 2] {
+    let d = k * k + bw * k + w * w;
+    // C_w = K C (K - A)^-1 and A_w = (K - A)^-1 (K + A), A = [[0, 1], [-w^2, -bw]].
+    let c_w = [-k * w * w / d, k * k / d];
+    let a_w = [
+        [(k * k + k * bw - w * w) / d, 2.0 * k / d],
+        [-2.0 * k * w * w / d, (k * k - k * bw - w * w) / d],
+    ];
+    let o_w = [
+        c_w,
+        [
+            c_w[0] * a_w[0][0] + c_w[1] * a_w[1][0],
+            c_w[0] * a_w[0][1] + c_w[1] * a_w[1][1],
+        ],
+    ];
+    // O_d = [[1, 0], [-a1, 1]] (C_d = [1, 0], A_d = [[-a1, 1], [-a2, 0]]).
+    let o_d = [[1.0, 0.0], [-a1, 1.0]];
+    let det = o_w[0][0] * o_w[1][1] - o_w[0][1] * o_w[1][0];
+    let inv = [
+        [o_w[1][1] / det, -o_w[0][1] / det],
+        [-o_w[1][0] / det, o_w[0][0] / det],
+    ];
+    let m: [[f64; 2]; 2] = std::array::from_fn(|i| {
+        std::array::from_fn(|j| inv[i][0] * o_d[0][j] + inv[i][1] * o_d[1][j])
+    });
+    let p = [w * w, 1.0];
+    let scale = k * k / (4.0 * d);
+    std::array::from_fn(|i| {
+        std::array::from_fn(|j| scale * (p[0] * m[0][i] * m[0][j] + p[1] * m[1][i] * m[1][j]))
+    })
+}
+
+/// Pseudo-inverse of a symmetric positive semidefinite 2x2 matrix (eigenvalues below
+/// 1e-12 of the largest count as zero: the states along them are that much smaller).
+fn psd_pinv(g: [[f64; 2]; 2]) -> [[f64; 2]; 2] {
+    let (p, q, r) = (g[0][0], g[0][1], g[1][1]);
+    let mean = 0.5 * (p + r);
+    let radius = (0.25 * (p - r) * (p - r) + q * q).sqrt();
+    let largest = mean + radius;
+    if !(largest > 0.0) {
+        return [[0.0; 2]; 2];
+    }
+    if radius <= 1e-15 * largest {
+        // A multiple of the identity.
+        return [[1.0 / mean, 0.0], [0.0, 1.0 / mean]];
+    }
+    // Eigenvector of the larger eigenvalue, from the row whose entry cannot vanish
+    // (`(l - p)(l - r) = q^2`, and one of `l - p`, `l - r` is at least `radius`); the
+    // other eigenvector is perpendicular.
+    let (x, y) = if p >= r {
+        (0.5 * (p - r) + radius, q)
+    } else {
+        (q, 0.5 * (r - p) + radius)
+    };
+    let norm = (x * x + y * y).sqrt();
+    let (x, y) = (x / norm, y / norm);
+    let mut pinv = [[0.0; 2]; 2];
+    for (lambda, v) in [(largest, [x, y]), (mean - radius, [-y, x])] {
+        if lambda > 1e-12 * largest {
+            for i in 0..2 {
+                for j in 0..2 {
+                    pinv[i][j] += v[i] * v[j] / lambda;
+                }
+            }
+        }
+    }
+    pinv
 }
 
 /// `Y(z)` at one sample rate (see the module doc).
@@ -129,10 +217,13 @@ impl ModalBridge {
                     r0[i][j] += gain[i][j];
                 }
             }
+            let a1 = 2.0 * (w * w - k * k) / d;
             self.sections.push(Section {
-                a1: 2.0 * (w * w - k * k) / d,
+                a1,
                 a2: (k * k - bw * k + w * w) / d,
                 gain,
+                storage: section_storage(a1, k, bw, w),
+                gain_pinv: psd_pinv(gain),
                 ..Section::default()
             });
         }
@@ -144,6 +235,30 @@ impl ModalBridge {
         self.sections
             .iter()
             .all(|s| s.z1.iter().chain(&s.z2).all(|z| z.abs() < threshold))
+    }
+
+    /// Energy the bridge holds, J: for every section, the storage of its scalar filter
+    /// ([`section_storage`]) in the eigen-directions of its gain `R = Q L Q^T`. The input
+    /// `R F` gives the outputs `Q L H(Q^T F)` and the supply `F . v = sum_k l_k xi_k H(xi_k)`
+    /// (`xi = Q^T F`), while the states along `Q` are `l_k` times those of `H` driven by
+    /// `xi_k`; so the storage is `sum_k S(Q^T z)_k / l_k`, the quadratic form in `R^+`.
+    /// With the force on it `F` and its velocity `v`, it grows by at most `F . v / fs` a
+    /// sample: the strings around a passive bridge lose what it gains.
+    pub fn energy_j(&self) -> f64 {
+        let quad = |g: &[[f64; 2]; 2], a: [f64; 2], b: [f64; 2]| {
+            a[0] * (g[0][0] * b[0] + g[0][1] * b[1]) + a[1] * (g[1][0] * b[0] + g[1][1] * b[1])
+        };
+        let joules: f64 = self
+            .sections
+            .iter()
+            .map(|s| {
+                let g = &s.gain_pinv;
+                s.storage[0][0] * quad(g, s.z1, s.z1)
+                    + 2.0 * s.storage[0][1] * quad(g, s.z1, s.z2)
+                    + s.storage[1][1] * quad(g, s.z2, s.z2)
+            })
+            .sum();
+        joules / self.sample_rate_hz
     }
 
     pub fn mode_count(&self) -> usize {
@@ -276,6 +391,81 @@ mod tests {
             mode(2000.0, 8.0, 0.04, 0.01, 0.02),
             mode(3200.0, 8.0, 0.02, 0.005, 0.015),
         ]
+    }
+
+    #[test]
+    fn the_bridge_stores_at_most_what_the_force_puts_in_and_a_lossless_mode_all_of_it() {
+        // Broadband forces in (-0.5, 0.5) N on both axes (the logistic map).
+        let mut x = 0.123_f64;
+        let mut next = || {
+            x = 3.99 * x * (1.0 - x);
+            x - 0.5
+        };
+        for fs in [48_000.0, 541_600.0] {
+            let mut bridge = ModalBridge::new(&generic_cello_bridge(), fs).unwrap();
+            let mut put_in = 0.0;
+            for n in 0..20_000 {
+                let f = [next(), next()];
+                let before = bridge.energy_j();
+                let v = bridge.advance(f);
+                let supplied = (f[0] * v[0] + f[1] * v[1]) / fs;
+                let gained = bridge.energy_j() - before;
+                // Rounding only: a few hundred products, each within 2^-53 of the energy.
+                let rounding = 1e-12 * (before.abs() + supplied.abs());
+                assert!(
+                    gained <= supplied + rounding,
+                    "{fs} Hz, sample {n}: gained {gained:e} J, supplied {supplied:e} J"
+                );
+                put_in += supplied;
+            }
+            assert!(bridge.energy_j() > 0.0 && bridge.energy_j() < put_in);
+        }
+        // A mode with (almost) no damping stores exactly what goes in.
+        let lossless = BridgeMode {
+            freq_hz: 300.0,
+            bandwidth_hz: 1e-9,
+            gain: [[0.5, 0.1], [0.1, 0.2]],
+        };
+        let fs = 48_000.0;
+        let mut bridge = ModalBridge::new(&[lossless], fs).unwrap();
+        let mut balance = 0.0;
+        for _ in 0..5_000 {
+            let f = [next(), next()];
+            let before = bridge.energy_j();
+            let v = bridge.advance(f);
+            balance += bridge.energy_j() - before - (f[0] * v[0] + f[1] * v[1]) / fs;
+        }
+        // The 1e-9 Hz bandwidth dissipates about 2 pi 1e-9 / 300 of the energy a period.
+        assert!(
+            balance.abs() < 1e-6 * bridge.energy_j(),
+            "lossless mode: stored minus supplied {balance:e} J of {:e} J",
+            bridge.energy_j()
+        );
+    }
+
+    #[test]
+    fn psd_pseudo_inverse_inverts_on_the_range_and_ignores_the_null_space() {
+        let mul = |a: [[f64; 2]; 2], b: [[f64; 2]; 2]| -> [[f64; 2]; 2] {
+            std::array::from_fn(|i| std::array::from_fn(|j| a[i][0] * b[0][j] + a[i][1] * b[1][j]))
+        };
+        for g in [
+            [[2.0, 0.0], [0.0, 2.0]],
+            [[3.0, 0.0], [0.0, 1.0]],
+            [[1.0, 0.0], [0.0, 3.0]],
+            [[0.5, 0.1], [0.1, 0.2]],
+            [[0.2, -0.1], [-0.1, 0.5]],
+            // Rank one: g = u u^T, u = (0.6, 0.8).
+            [[0.36, 0.48], [0.48, 0.64]],
+        ] {
+            let pinv = psd_pinv(g);
+            // Moore-Penrose: g pinv g = g; 1e-12 is rounding on entries of order 1.
+            let back = mul(mul(g, pinv), g);
+            for i in 0..2 {
+                for j in 0..2 {
+                    assert!((back[i][j] - g[i][j]).abs() < 1e-12, "{g:?}: {back:?}");
+                }
+            }
+        }
     }
 
     #[test]

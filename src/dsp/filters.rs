@@ -40,6 +40,15 @@ impl Allpass1 {
         self.y1 = 0.0;
     }
 
+    /// Energy the section holds, in squared signal units: `s^2 / (1 - a^2)` for its state
+    /// `s = x1 - a y1` (the transposed-direct-form state, `y = a x + s`). The section is
+    /// lossless, and this is exactly what has gone in and not yet come out:
+    /// `S(n+1) - S(n) = x^2 - y^2` on every sample (expand `s' = (1 - a^2) x - a s`).
+    pub fn stored_energy(&self) -> f64 {
+        let s = self.x1 - self.a * self.y1;
+        s * s / (1.0 - self.a * self.a)
+    }
+
     /// Phase delay in samples at `w` rad/sample (`w` in (0, pi)).
     pub fn phase_delay(a: f64, w: f64) -> f64 {
         1.0 - 2.0 * (a * w.sin()).atan2(1.0 + a * w.cos()) / w
@@ -114,6 +123,23 @@ impl OnePoleLoss {
     pub fn tick(&mut self, x: f64) -> f64 {
         self.y1 = self.g * (1.0 - self.p) * x + self.p * self.y1;
         self.y1
+    }
+
+    /// Energy the filter holds, in squared signal units: the smallest storage `c y1^2` for
+    /// which `S(n+1) - S(n) <= x^2 - y^2` on every sample (the filter is passive, `|H| <= g
+    /// <= 1`), so a loop through it with lossless parts has a total energy that never grows.
+    ///
+    /// With `b = g (1 - p)` and `y = b x + p y1`, the inequality is a quadratic form in
+    /// `(x, y1)` that is negative semidefinite exactly when `u = c + 1` lies between the
+    /// roots of `b^2 u^2 - (1 + b^2 - p^2) u + 1 = 0`; the smaller root, written without
+    /// cancellation, is `2 / (1 + b^2 - p^2 + sqrt(((1 - b)^2 - p^2) ((1 + b)^2 - p^2)))`
+    /// (it is at least `1 / (1 - p^2)`, which the form's `y1^2` term needs). `p = 0` gives
+    /// `c = 0`: a plain gain holds nothing.
+    pub fn stored_energy(&self) -> f64 {
+        let (b, p) = (self.g * (1.0 - self.p), self.p);
+        let d = (((1.0 - b).powi(2) - p * p) * ((1.0 + b).powi(2) - p * p)).max(0.0);
+        let u = 2.0 / (1.0 + b * b - p * p + d.sqrt());
+        (u - 1.0).max(0.0) * self.y1 * self.y1
     }
 
     pub fn reset(&mut self) {
@@ -207,6 +233,56 @@ pub fn safety_limit(x: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A deterministic, broadband test signal in (-0.5, 0.5) (the logistic map).
+    fn chaotic(n: usize) -> impl Iterator<Item = f64> {
+        (0..n).scan(0.123_f64, |x, _| {
+            *x = 3.99 * *x * (1.0 - *x);
+            Some(*x - 0.5)
+        })
+    }
+
+    #[test]
+    fn allpass_storage_changes_by_exactly_what_goes_in_minus_what_comes_out() {
+        for a in [-0.95, -0.6, 0.0, 0.4, 0.95] {
+            let mut ap = Allpass1::new(a);
+            for x in chaotic(2000) {
+                let before = ap.stored_energy();
+                let y = ap.tick(x);
+                let balance = ap.stored_energy() - before - (x * x - y * y);
+                // Rounding only: a few products of size up to 1 / (1 - a^2) ~ 10, each
+                // within 2^-53 relative.
+                assert!(balance.abs() < 1e-13, "a {a}: balance {balance:e}");
+            }
+        }
+    }
+
+    #[test]
+    fn loss_filter_storage_grows_by_at_most_what_goes_in_minus_what_comes_out() {
+        for (g, p) in [
+            (0.99995, 0.0),
+            (0.99995, 0.3),
+            (0.999, 0.9),
+            (0.9, 0.99),
+            (1.0, 0.999),
+        ] {
+            let mut loss = OnePoleLoss { g, p, y1: 0.0 };
+            let mut dissipated = 0.0;
+            for x in chaotic(20_000) {
+                let before = loss.stored_energy();
+                let y = loss.tick(x);
+                let supplied = x * x - y * y;
+                let gained = loss.stored_energy() - before;
+                // Rounding only, as above (the storage factor is at most 1 / (1 - p^2)).
+                assert!(
+                    gained <= supplied + 1e-12,
+                    "g {g}, p {p}: {gained:e} > {supplied:e}"
+                );
+                dissipated += supplied - gained;
+            }
+            assert!(dissipated >= 0.0);
+        }
+    }
 
     #[test]
     fn the_safety_limiter_is_transparent_below_its_knee_and_never_reaches_full_scale() {

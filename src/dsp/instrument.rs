@@ -233,6 +233,8 @@ pub struct Instrument {
     skipping: bool,
     /// No string awake and the body rung out: a sample costs nothing.
     body_asleep: bool,
+    /// Times the non-finite guard in [`Instrument::tick`] reset the instrument.
+    recoveries: u64,
 }
 
 impl Instrument {
@@ -266,6 +268,7 @@ impl Instrument {
             output_scale: kind.output_scale_per_n(),
             skipping: true,
             body_asleep: true,
+            recoveries: 0,
         }
     }
 
@@ -469,6 +472,7 @@ impl Instrument {
             // Cannot happen with finite inputs; if it ever does, recover to silence rather
             // than emit garbage.
             self.reset();
+            self.recoveries += 1;
             frame = Frame::default();
         }
         frame
@@ -528,6 +532,18 @@ impl Instrument {
     /// Newton statistics of the probed string's bristle contact.
     pub fn probed_solver_stats(&self) -> SolverStats {
         self.voices[self.probed].contact.bristle().stats
+    }
+
+    /// Newton statistics of string `index`'s bristle contact (the stress suite checks
+    /// every string's).
+    pub fn solver_stats(&self, index: usize) -> SolverStats {
+        self.voices[index].contact.bristle().stats
+    }
+
+    /// How often the non-finite guard in [`Instrument::tick`] has fired (it never should:
+    /// the stress suite asserts zero, since the guard would otherwise hide a NaN).
+    pub fn recoveries(&self) -> u64 {
+        self.recoveries
     }
 
     /// Whether the contact of the probed string is sticking (for analysis).

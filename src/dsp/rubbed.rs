@@ -215,7 +215,11 @@ pub struct RubbedScene {
     pub spec: RubbedSpec,
     pair: FrictionPair,
     contact: AnyFriction,
-    push_n: f64,
+    /// A modal exciter's push at the preset's normal force: the steady sliding friction
+    /// at the target velocity (Stribeck part, scales with the normal force) and its
+    /// viscous part `sigma2 v` (only while in contact).
+    push_friction_n: f64,
+    push_viscous_n: f64,
 }
 
 impl RubbedScene {
@@ -241,13 +245,14 @@ impl RubbedScene {
         let v = spec.velocity_m_per_s;
         let f_c = p.mu_d * spec.normal_force_n;
         let f_s = p.mu_s * spec.normal_force_n;
-        let push_n = v.signum() * (f_c + (f_s - f_c) * (-(v / p.stribeck_m_per_s).powi(2)).exp())
-            + p.sigma2_kg_per_s * v;
+        let push_friction_n =
+            v.signum() * (f_c + (f_s - f_c) * (-(v / p.stribeck_m_per_s).powi(2)).exp());
         Ok(Self {
             spec,
             pair: FrictionPair { resonator, exciter },
             contact,
-            push_n,
+            push_friction_n,
+            push_viscous_n: p.sigma2_kg_per_s * v,
         })
     }
 
@@ -280,9 +285,24 @@ impl RubbedScene {
         self.tick_with(bow)
     }
 
-    /// One sample with an explicit exciter velocity and normal force.
+    /// One sample with an explicit exciter velocity and normal force. A modal exciter is
+    /// pushed with the steady friction at its target velocity under this normal force, so
+    /// it still settles there; lifted (no normal force) it is not pushed and coasts. The
+    /// push never exceeds what the active law holds back at high sliding speed
+    /// ([`AnyFriction::high_speed_friction_n`]): the static curves have no viscous term,
+    /// and a push above their `mu_d F_N` would never be balanced. (A fixed push
+    /// accelerated the free mass without bound under a lighter force or a static law, and
+    /// it then struck the object at tens of m/s: found by the stress suite.)
     pub fn tick_with(&mut self, bow: BowInput) -> RubbedFrame {
-        let out = self.pair.tick(&mut self.contact, bow, self.push_n);
+        let f_n = bow.normal_force_n;
+        let push_n = if f_n > 0.0 && self.spec.normal_force_n > 0.0 {
+            let push =
+                self.push_friction_n * (f_n / self.spec.normal_force_n) + self.push_viscous_n;
+            push.signum() * push.abs().min(self.contact.high_speed_friction_n(f_n))
+        } else {
+            0.0
+        };
+        let out = self.pair.tick(&mut self.contact, bow, push_n);
         let audio =
             super::filters::flush_tiny(self.spec.output_gain * out.resonator_velocity_m_per_s);
         RubbedFrame {
@@ -312,7 +332,8 @@ const RUB_SLEEP_ENERGY_J: f64 = 1e-16;
 /// The rubbed presets as a playable instrument: note on presses the exciter onto the
 /// active object (force ramps over 20 ms), note off lifts it and the object rings on. The
 /// bow controls scale the preset's own velocity and force: 1.0 at the plugin's defaults
-/// (0.1 m/s, 1 N); a modal exciter (paper-modal) keeps its own push. Every preset is built
+/// (0.1 m/s, 1 N); a modal exciter (paper-modal) keeps its own target velocity, pushed in
+/// proportion to the force (see [`RubbedScene::tick_with`]). Every preset is built
 /// when the instrument is made, so switching never allocates; an object switched away from
 /// is lifted and rings on (no click) until it falls asleep.
 #[derive(Debug, Clone)]
@@ -408,6 +429,23 @@ impl RubbedInstrument {
             voice.awake = false;
         }
         self.notes_down = 0;
+    }
+
+    /// Modal energy of every object's resonator, J.
+    pub fn energy_j(&self) -> f64 {
+        self.voices
+            .iter()
+            .map(|v| v.scene.resonator_energy_j())
+            .sum()
+    }
+
+    /// Newton statistics of `preset`'s bristle contact.
+    pub fn solver_stats(&self, preset: RubbedPreset) -> SolverStats {
+        let index = RubbedPreset::ALL
+            .iter()
+            .position(|p| *p == preset)
+            .unwrap_or(0);
+        self.voices[index].scene.solver_stats()
     }
 
     /// Once per block: an object sleeps when lifted and quiet.

@@ -846,7 +846,9 @@ impl ThermalString {
         &self.nodes.v_delta
     }
 
-    /// Wave energy of both polarisations plus the hair's stored energy, J.
+    /// Wave energy of both polarisations, what the loss and Thiran filters at the ends
+    /// hold (see [`OnePoleLoss::stored_energy`], [`Allpass1::stored_energy`]) and the
+    /// hair's stored energy, J.
     pub fn energy_j(&self) -> f64 {
         let z = self.spec.z0_kg_per_s;
         let fs = self.internal_rate_hz;
@@ -858,6 +860,7 @@ impl ThermalString {
                 let b = self.left[p][self.t.wrapping_sub(self.m - 1 - x) & mask];
                 sum += a * a + b * b;
             }
+            sum += self.loss[p].stored_energy() + self.fraction[p].stored_energy();
         }
         let dx = self.dx_m;
         let hair: f64 = (0..self.nodes_count)

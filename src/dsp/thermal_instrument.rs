@@ -186,6 +186,8 @@ pub struct ThermalInstrument {
     skipping: bool,
     /// AVX2 detected at run time ([`run_core`]).
     wide_simd: bool,
+    /// Times the non-finite guard in [`ThermalInstrument::tick`] reset the instrument.
+    recoveries: u64,
 }
 
 impl ThermalInstrument {
@@ -259,6 +261,7 @@ impl ThermalInstrument {
             awake: false,
             skipping: true,
             wide_simd: super::thermal::detect_wide_simd(),
+            recoveries: 0,
         };
         instrument
             .apply_settings(settings)
@@ -445,9 +448,12 @@ impl ThermalInstrument {
         &self.core.strings[i]
     }
 
-    /// Total wave and hair energy of the strings, J.
+    /// Energy of the strings (waves, end filters, hair) and the bridge, J. With every bow
+    /// lifted it never grows from one internal sample to the next: the strings lose at the
+    /// bridge what it gains ([`ModalBridge::energy_j`]), and everything else is lossless
+    /// or lossy.
     pub fn energy_j(&self) -> f64 {
-        self.core.strings.iter().map(|s| s.energy_j()).sum()
+        self.core.strings.iter().map(|s| s.energy_j()).sum::<f64>() + self.core.bridge.energy_j()
     }
 
     /// Seconds until the instrument would fall asleep if no bow lands again (the host's
@@ -532,6 +538,7 @@ impl ThermalInstrument {
         if !audio.is_finite() {
             // Cannot happen with finite inputs; recover to silence rather than emit garbage.
             self.reset();
+            self.recoveries += 1;
             return Frame::default();
         }
         Frame {
@@ -539,6 +546,12 @@ impl ThermalInstrument {
             bow_point_velocity_m_per_s: self.core.probe.0,
             friction_force_n: self.core.probe.1,
         }
+    }
+
+    /// How often the non-finite guard in [`ThermalInstrument::tick`] has fired (it never
+    /// should: the stress suite asserts zero).
+    pub fn recoveries(&self) -> u64 {
+        self.recoveries
     }
 
     /// Turns sleeping off (everything is computed every sample, silent or not) or on.

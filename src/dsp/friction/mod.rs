@@ -242,6 +242,27 @@ impl AnyFriction {
         &mut self.bristle
     }
 
+    /// The friction force this law tends to as the sliding speed grows, N, under
+    /// `normal_force_n`: `mu_d F_N` for the static curves (hyperbolic, Stribeck), which
+    /// fall toward it from above; unbounded for the bristle laws with viscous friction
+    /// (`sigma2 > 0`, steady force `h(v) + sigma2 v`), `mu_d F_N` without. A body pushed
+    /// with more than this against the contact runs away.
+    pub fn high_speed_friction_n(&self, normal_force_n: f64) -> f64 {
+        let f_n = normal_force_n.max(0.0);
+        match self.model {
+            FrictionModel::Hyperbolic => self.hyperbolic.mu_d * f_n,
+            FrictionModel::Stribeck => self.stribeck.mu_d * f_n,
+            FrictionModel::LuGre | FrictionModel::ElastoPlastic => {
+                let p = self.bristle.params();
+                if p.sigma2_kg_per_s > 0.0 && f_n > 0.0 {
+                    f64::INFINITY
+                } else {
+                    p.mu_d * f_n
+                }
+            }
+        }
+    }
+
     /// Switches the law, handing over the current force and stick state.
     pub fn set_model(&mut self, model: FrictionModel) {
         if model == self.model {
