@@ -215,8 +215,16 @@ impl Colophony {
         self.tail = None;
         let mut tail_s = 0.0f64;
         let mut sounding = false;
-        let engines = std::iter::once(self.instrument.is_ringing().then(|| self.instrument.ring_out_s()))
-            .chain(self.thermal.iter().map(|e| e.is_sounding().then(|| e.ring_out_s())));
+        let engines = std::iter::once(
+            self.instrument
+                .is_ringing()
+                .then(|| self.instrument.ring_out_s()),
+        )
+        .chain(
+            self.thermal
+                .iter()
+                .map(|e| e.is_sounding().then(|| e.ring_out_s())),
+        );
         for engine in engines.flatten() {
             sounding = true;
             match engine {

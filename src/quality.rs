@@ -76,13 +76,7 @@ impl Quality {
 
     /// Thermal nodes on the lowest string for a note at `f0_hz` bowed at `beta` with a
     /// bow `width_m` wide.
-    pub fn thermal_nodes(
-        self,
-        kind: InstrumentKind,
-        f0_hz: f64,
-        beta: f64,
-        width_m: f64,
-    ) -> usize {
+    pub fn thermal_nodes(self, kind: InstrumentKind, f0_hz: f64, beta: f64, width_m: f64) -> usize {
         match self {
             Self::Draft => DRAFT_NODES,
             Self::Good => GOOD_NODES,
@@ -204,7 +198,12 @@ mod tests {
     #[test]
     fn absurd_bow_settings_give_the_good_node_count() {
         let c = InstrumentKind::Cello;
-        for (f0, beta) in [(0.0, 0.1), (65.0, 0.0), (f64::NAN, 0.1), (65.0, f64::INFINITY)] {
+        for (f0, beta) in [
+            (0.0, 0.1),
+            (65.0, 0.0),
+            (f64::NAN, 0.1),
+            (65.0, f64::INFINITY),
+        ] {
             assert_eq!(auto_nodes(c, f0, beta, 0.01), GOOD_NODES);
         }
     }

@@ -793,7 +793,10 @@ fn the_reported_tail_covers_the_ring_out_and_ends_when_the_strings_sleep() {
             let out = plugin.render(BLOCK, BLOCK, &Score::new());
             assert!(out[0].iter().all(|v| v.is_finite()));
             rang += BLOCK;
-            assert!(rang < 120 * FS as usize, "{model}: still ringing after 2 minutes");
+            assert!(
+                rang < 120 * FS as usize,
+                "{model}: still ringing after 2 minutes"
+            );
         }
         println!(
             "{model}: tail told {:.2} s, rang {:.2} s",
@@ -803,8 +806,14 @@ fn the_reported_tail_covers_the_ring_out_and_ends_when_the_strings_sleep() {
         // The estimate lets every partial decay at the fundamental's (slowest) rate, so
         // it is an upper bound; the higher partials and the body decay faster, and it
         // must not be far off either (within a factor of two).
-        assert!(rang as f64 <= told as f64 + 2048.0 + BLOCK as f64, "{model}");
-        assert!(2.0 * rang as f64 >= told as f64, "{model}: {told} told, {rang} rang");
+        assert!(
+            rang as f64 <= told as f64 + 2048.0 + BLOCK as f64,
+            "{model}"
+        );
+        assert!(
+            2.0 * rang as f64 >= told as f64,
+            "{model}: {told} told, {rang} rang"
+        );
         // Once the tail is over the output is exact zeros.
         let out = plugin.render(4 * BLOCK, BLOCK, &Score::new());
         assert!(out[0].iter().all(|v| *v == 0.0), "{model}");

@@ -416,8 +416,7 @@ impl Instrument {
         }
         // The body sleeps too once no string is awake and its modes have rung out
         // (state below 1e-12 N: output below -200 dB of a bowed note).
-        self.body_asleep =
-            self.voices.iter().all(|v| !v.awake) && self.body.is_quiet(BODY_QUIET_N);
+        self.body_asleep = self.voices.iter().all(|v| !v.awake) && self.body.is_quiet(BODY_QUIET_N);
         if self.body_asleep {
             self.body.reset();
         }
@@ -576,10 +575,19 @@ mod tests {
         // G2 cannot be played on the D string: it goes to the G string as usual.
         assert_eq!(cello.string_for_note_on(43, Some(2)), Some(1));
         // Beyond the stop range of the C string: the usual string.
-        assert_eq!(cello.string_for_note_on(36 + MAX_STOP_SEMITONES + 1, Some(0)), Some(3));
+        assert_eq!(
+            cello.string_for_note_on(36 + MAX_STOP_SEMITONES + 1, Some(0)),
+            Some(3)
+        );
         // No preference, or a string that does not exist: the usual choice.
-        assert_eq!(cello.string_for_note_on(57, None), cello.string_for_note(57));
-        assert_eq!(cello.string_for_note_on(57, Some(7)), cello.string_for_note(57));
+        assert_eq!(
+            cello.string_for_note_on(57, None),
+            cello.string_for_note(57)
+        );
+        assert_eq!(
+            cello.string_for_note_on(57, Some(7)),
+            cello.string_for_note(57)
+        );
         // Unplayable notes stay unplayable.
         assert_eq!(cello.string_for_note_on(35, Some(0)), None);
     }

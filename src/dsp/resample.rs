@@ -509,7 +509,10 @@ mod tests {
             if fs_in > 2.0 * fs_out {
                 // Tones that would fold into the pass band: just past the sinc's transition,
                 // and near the first multiple of the stage-1 output rate.
-                for alias in [0.45 * 1.5 * fs_out, fs_in / (fs_in / (2.0 * fs_out)).floor()] {
+                for alias in [
+                    0.45 * 1.5 * fs_out,
+                    fs_in / (fs_in / (2.0 * fs_out)).floor(),
+                ] {
                     if alias < fs_in / 2.0 {
                         let db = 20.0 * tone_through(fs_in, fs_out, alias).log10();
                         println!("  {alias:.0} Hz would alias: {db:.1} dB");

@@ -533,7 +533,12 @@ impl ThermalInstrument {
             };
         }
         let mut out = [0.0];
-        run_core(self.wide_simd, &mut self.resampler, &mut self.core, &mut out);
+        run_core(
+            self.wide_simd,
+            &mut self.resampler,
+            &mut self.core,
+            &mut out,
+        );
         let audio = flush_tiny(out[0] * self.output_scale * self.fade);
         if !audio.is_finite() {
             // Cannot happen with finite inputs; recover to silence rather than emit garbage.
