@@ -186,8 +186,7 @@ impl Colophony {
         let nodes = match p.quality.value().preset() {
             None => p.bow_nodes.value().max(1) as usize,
             Some(Quality::Auto) => self.auto_nodes,
-            // The fixed presets do not depend on the note.
-            Some(q) => q.thermal_nodes(p.instrument.value().into(), 1.0, 1.0, 0.01),
+            Some(q) => q.fixed_thermal_nodes().unwrap_or(quality::GOOD_NODES),
         };
         ThermalSettings {
             nodes,
@@ -195,11 +194,12 @@ impl Colophony {
         }
     }
 
-    /// What the host hears about this block: `KeepAlive` while a bow is on (or a rubbed
-    /// object sounds: no estimate for those yet), the tail in samples while lifted strings
-    /// ring out (the waveguide body's last few blocks after its strings slept count as a
-    /// tail of one sample, renewed while it rings) (CLAP tail extension, VST3 `getTailSamples`; hosts may stop processing
-    /// after it), `Normal` once silent (CLAP may then stop calling `process` until input).
+    /// What the host hears about this block (CLAP process status and tail extension, VST3
+    /// `getTailSamples`):
+    /// - `KeepAlive` while a bow is on, or while a rubbed object sounds (no estimate yet);
+    /// - `Tail(samples)` while lifted strings ring out (the waveguide body's last blocks
+    ///   after its strings slept count as one sample, renewed while it rings);
+    /// - `Normal` once silent, so a CLAP host may stop calling `process` until input.
     fn status(&mut self, block: usize) -> ProcessStatus {
         if self.rubbed.is_sounding() {
             self.tail = None;

@@ -185,7 +185,9 @@ fn main() -> ExitCode {
                     bow_position,
                     bow_width,
                 ),
-                (Some(q), _) => q.thermal_nodes(instrument, 1.0, 1.0, bow_width),
+                (Some(q), _) => q
+                    .fixed_thermal_nodes()
+                    .unwrap_or(colophony::quality::GOOD_NODES),
                 (None, _) => nodes,
             };
             let thermal = friction == FrictionArg::Thermal;

@@ -77,11 +77,17 @@ impl Quality {
     /// Thermal nodes on the lowest string for a note at `f0_hz` bowed at `beta` with a
     /// bow `width_m` wide.
     pub fn thermal_nodes(self, kind: InstrumentKind, f0_hz: f64, beta: f64, width_m: f64) -> usize {
+        self.fixed_thermal_nodes()
+            .unwrap_or_else(|| auto_nodes(kind, f0_hz, beta, width_m))
+    }
+
+    /// The node count of a preset that does not depend on the note (`None` for auto).
+    pub fn fixed_thermal_nodes(self) -> Option<usize> {
         match self {
-            Self::Draft => DRAFT_NODES,
-            Self::Good => GOOD_NODES,
-            Self::Reference => REFERENCE_NODES,
-            Self::Auto => auto_nodes(kind, f0_hz, beta, width_m),
+            Self::Draft => Some(DRAFT_NODES),
+            Self::Good => Some(GOOD_NODES),
+            Self::Reference => Some(REFERENCE_NODES),
+            Self::Auto => None,
         }
     }
 }
