@@ -17,8 +17,8 @@
 //! band starts where a component would fold back into it, `fs_in / D - 1.25 fc`; 90 dB),
 //! computed only once per `D` input samples, so the sinc above runs at `fs_in / D`,
 //! between 2 and 4 times the output rate, with about a fifth of the taps. From 541.6 kHz to
-//! 48 kHz: 58 FIR taps per 108.3 kHz sample and 50 sinc taps per output sample, against 250
-//! sinc taps in one stage.
+//! 48 kHz: 59 FIR taps per 108.3 kHz sample (about 133 multiply-adds per output sample) and
+//! 50 sinc taps per output sample, against 250 sinc taps in one stage.
 //! Measured: aliasing and pass-band error in `tests` below.
 
 use std::f64::consts::PI;
