@@ -196,15 +196,12 @@ impl Colophony {
 
     /// What the host hears about this block (CLAP process status and tail extension, VST3
     /// `getTailSamples`):
-    /// - `KeepAlive` while a bow is on, or while a rubbed object sounds (no estimate yet);
-    /// - `Tail(samples)` while lifted strings ring out (the waveguide body's last blocks
-    ///   after its strings slept count as one sample, renewed while it rings);
+    /// - `KeepAlive` while a bow or an exciter is on;
+    /// - `Tail(samples)` while lifted strings or rubbed objects ring out (the waveguide
+    ///   body's last blocks after its strings slept count as one sample, renewed while it
+    ///   rings);
     /// - `Normal` once silent, so a CLAP host may stop calling `process` until input.
     fn status(&mut self, block: usize) -> ProcessStatus {
-        if self.rubbed.is_sounding() {
-            self.tail = None;
-            return ProcessStatus::KeepAlive;
-        }
         if let Some((left, since)) = self.tail {
             if since + block < TAIL_EVERY {
                 let left = (left - block as f64).max(1.0);
@@ -215,6 +212,13 @@ impl Colophony {
         self.tail = None;
         let mut tail_s = 0.0f64;
         let mut sounding = false;
+        if self.rubbed.is_sounding() {
+            sounding = true;
+            match self.rubbed.ring_out_samples() {
+                Some(n) => tail_s = n / self.sample_rate_hz,
+                None => return ProcessStatus::KeepAlive,
+            }
+        }
         let engines = std::iter::once(
             self.instrument
                 .is_ringing()

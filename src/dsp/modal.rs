@@ -56,6 +56,13 @@ struct Mode {
     v_prev: f64,
     mass: f64,
     k: f64,
+    /// Energy decay per sample of the free mode, `-2 ln |z|` for its slower discrete pole
+    /// (0 for an undamped or free mode: it never rings out).
+    decay_per_sample: f64,
+    /// How far the energy of the free mode can rise above its envelope `E0 |z|^2n`:
+    /// `(1 + zeta) / (1 - zeta)`, `zeta = r / (2 sqrt(k m))`; infinite from critical
+    /// damping on (no finite bound claimed there).
+    envelope_factor: f64,
 }
 
 /// A bank of modes (see the module doc).
@@ -108,6 +115,15 @@ impl ModalObject {
                 weight: spec.weight,
                 mass: m,
                 k,
+                decay_per_sample: discrete_decay_per_sample(m, r, k, t),
+                envelope_factor: {
+                    let zeta = r / (2.0 * (k * m).sqrt());
+                    if zeta < 1.0 {
+                        (1.0 + zeta) / (1.0 - zeta)
+                    } else {
+                        f64::INFINITY
+                    }
+                },
                 ..Mode::default()
             };
             object.admittance_s_per_kg += spec.weight * spec.weight * object.modes[object.count].b;
@@ -187,6 +203,52 @@ impl ModalObject {
             .map(|m| 0.5 * m.mass * m.v * m.v + 0.5 * m.k * m.x * m.x)
             .sum()
     }
+
+    /// Samples until the energy falls below `threshold_j` if nothing drives the object, or
+    /// `None` if a mode holding energy has no finite bound (undamped, a free mass, or
+    /// damped critically or more). An upper bound: a free under-damped mode's energy stays
+    /// below `(1 + zeta) / (1 - zeta)` times its envelope `E0 |z|^2n` (the continuous
+    /// oscillator's exact worst case over initial states; `zeta = 1 / 2Q`), each mode must
+    /// fall below `threshold / modes`, and the modes are independent once nothing drives
+    /// them.
+    pub fn ring_out_samples(&self, threshold_j: f64) -> Option<f64> {
+        let target = threshold_j / self.count.max(1) as f64;
+        let mut longest = 0.0f64;
+        for m in &self.modes[..self.count] {
+            let e = 0.5 * m.mass * m.v * m.v + 0.5 * m.k * m.x * m.x;
+            if e <= 0.0 {
+                continue;
+            }
+            if m.decay_per_sample <= 0.0 || !m.envelope_factor.is_finite() {
+                return None;
+            }
+            let peak = m.envelope_factor * e;
+            if peak > target {
+                longest = longest.max((peak / target).ln() / m.decay_per_sample);
+            }
+        }
+        Some(longest)
+    }
+}
+
+/// `-2 ln |z|` for the slower of a mode's two discrete poles: the trapezoidal rule maps
+/// each continuous pole `s` of `m s^2 + r s + k` to `z = (1 + sT/2) / (1 - sT/2)`.
+fn discrete_decay_per_sample(m: f64, r: f64, k: f64, t: f64) -> f64 {
+    let sigma = -r / (2.0 * m);
+    let disc = sigma * sigma - k / m;
+    // |z|^2 for a pole s = a + jb.
+    let z2 = |a: f64, b: f64| {
+        let (nr, ni) = (1.0 + 0.5 * t * a, 0.5 * t * b);
+        let (dr, di) = (1.0 - 0.5 * t * a, -0.5 * t * b);
+        (nr * nr + ni * ni) / (dr * dr + di * di)
+    };
+    let slowest = if disc >= 0.0 {
+        // Over-damped: two real poles; the one nearer zero decays slower.
+        z2(sigma + disc.sqrt(), 0.0)
+    } else {
+        z2(sigma, (-disc).sqrt())
+    };
+    (-slowest.ln()).max(0.0)
 }
 
 /// What drives the rubbing object.
@@ -269,6 +331,64 @@ impl FrictionPair {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_ring_out_estimate_bounds_the_free_decay_to_the_threshold_and_is_not_far_off() {
+        let fs = 48_000.0;
+        // A low-Q mode (large envelope ripple), a high-Q one and a free mass.
+        let mode = |freq_hz: f64, q: f64| ModeSpec {
+            freq_hz,
+            q,
+            mass_kg: 1e-3,
+            weight: 1.0,
+        };
+        let threshold = 1e-16;
+        for modes in [
+            vec![mode(500.0, 2.0), mode(1300.0, 80.0)],
+            vec![mode(660.0, 3000.0), mode(1780.0, 2000.0)],
+            vec![mode(300.0, 0.7)],
+        ] {
+            let mut object = ModalObject::new(&modes, fs).unwrap();
+            // Struck over a few samples (some in x, some in v), then free.
+            for n in 0..7 {
+                object.begin(0.0);
+                object.finish(if n % 3 == 0 { 0.2 } else { -0.05 });
+            }
+            let told = object.ring_out_samples(threshold).unwrap();
+            let mut rang = 0.0;
+            let mut last_above = 0.0;
+            while rang < told * 3.0 + 1000.0 {
+                object.begin(0.0);
+                object.finish(0.0);
+                rang += 1.0;
+                if object.energy_j() >= threshold {
+                    last_above = rang;
+                }
+            }
+            assert!(
+                last_above <= told,
+                "{modes:?}: above at {last_above}, told {told}"
+            );
+            assert!(
+                told <= 1.5 * last_above,
+                "{modes:?}: told {told}, rang {last_above}"
+            );
+        }
+        let mass = ModeSpec {
+            freq_hz: 0.0,
+            q: 1e5,
+            mass_kg: 0.05,
+            weight: 1.0,
+        };
+        let mut free = ModalObject::new(&[mass], fs).unwrap();
+        free.begin(0.0);
+        free.finish(1.0);
+        assert_eq!(
+            free.ring_out_samples(threshold),
+            None,
+            "a free mass never rings out"
+        );
+    }
 
     #[test]
     fn a_struck_mode_rings_at_its_frequency_and_decays_at_its_q() {

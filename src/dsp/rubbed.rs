@@ -322,6 +322,12 @@ impl RubbedScene {
     pub fn resonator_energy_j(&self) -> f64 {
         self.pair.resonator.energy_j()
     }
+
+    /// Samples until the lifted resonator's energy falls below `threshold_j`
+    /// ([`ModalObject::ring_out_samples`]).
+    pub fn ring_out_samples(&self, threshold_j: f64) -> Option<f64> {
+        self.pair.resonator.ring_out_samples(threshold_j)
+    }
 }
 
 /// Bow landing/lifting time on a rubbed object, s (as on the strings).
@@ -446,6 +452,22 @@ impl RubbedInstrument {
             .position(|p| *p == preset)
             .unwrap_or(0);
         self.voices[index].scene.solver_stats()
+    }
+
+    /// Samples until every object would fall asleep if no note comes (the host's tail), or
+    /// `None` while the exciter touches one (or a mode can not be bounded).
+    pub fn ring_out_samples(&self) -> Option<f64> {
+        let mut longest = 0.0f64;
+        for (i, voice) in self.voices.iter().enumerate() {
+            if !voice.awake {
+                continue;
+            }
+            if (i == self.active && self.notes_down > 0) || voice.bow_gain > 0.0 {
+                return None;
+            }
+            longest = longest.max(voice.scene.ring_out_samples(RUB_SLEEP_ENERGY_J)?);
+        }
+        Some(longest)
     }
 
     /// Once per block: an object sleeps when lifted and quiet.
