@@ -491,6 +491,15 @@ pub struct ThermalString {
     fraction: [Allpass1; 2],
     nut_reflection: [[f64; 2]; 2],
     bridge_reflection: [[f64; 2]; 2],
+    /// Polarisations put to sleep ([`ThermalString::sleep_quiet_polarisations`]): their
+    /// lines and filters hold zeros and are not computed.
+    asleep: [bool; 2],
+    /// Sum of the squared waves a sleeping polarisation was offered and dropped (at the
+    /// bridge and from the other polarisation at the nut), m^2/s^2.
+    dropped: [f64; 2],
+    /// Energy of dropped waves that wakes a sleeping polarisation, in the same units
+    /// (`threshold fs / Z`).
+    wake_sum: f64,
 }
 
 /// `R = -(I + Z Y)^-1 (I - Z Y)` for a real 2x2 `Y`.
@@ -651,6 +660,9 @@ impl ThermalString {
             fraction: [Allpass1::new(0.0); 2],
             nut_reflection: reflection(spec.z0_kg_per_s, spec.nut_admittance),
             bridge_reflection: reflection(spec.z0_kg_per_s, spec.bridge_admittance),
+            asleep: [false; 2],
+            dropped: [0.0; 2],
+            wake_sum: f64::INFINITY,
         })
     }
 
@@ -850,18 +862,33 @@ impl ThermalString {
     /// hold (see [`OnePoleLoss::stored_energy`], [`Allpass1::stored_energy`]) and the
     /// hair's stored energy, J.
     pub fn energy_j(&self) -> f64 {
+        let [h, v] = self.wave_energies_j();
+        h + v + self.hair_energy_j()
+    }
+
+    /// Energy of each polarisation's waves and end filters, `[h, v]`, J.
+    fn wave_energies_j(&self) -> [f64; 2] {
         let z = self.spec.z0_kg_per_s;
         let fs = self.internal_rate_hz;
         let mask = self.mask;
-        let mut sum = 0.0;
-        for p in 0..2 {
+        let mut out = [0.0; 2];
+        for (p, out) in out.iter_mut().enumerate() {
+            if self.asleep[p] {
+                continue;
+            }
+            let mut sum = 0.0;
             for x in 0..self.m {
                 let a = self.right[p][x.wrapping_sub(self.t) & mask];
                 let b = self.left[p][self.t.wrapping_sub(self.m - 1 - x) & mask];
                 sum += a * a + b * b;
             }
             sum += self.loss[p].stored_energy() + self.fraction[p].stored_energy();
+            *out = z / fs * sum;
         }
+        out
+    }
+
+    fn hair_energy_j(&self) -> f64 {
         let dx = self.dx_m;
         let hair: f64 = (0..self.nodes_count)
             .map(|i| {
@@ -870,7 +897,43 @@ impl ThermalString {
                     + 0.5 * self.hair.vertical_k_n_per_m_per_m * dx * self.nodes.y[i].powi(2)
             })
             .sum();
-        z / fs * sum + hair
+        hair
+    }
+
+    /// Puts each polarisation whose waves hold less than `threshold_j / 2` to sleep: its
+    /// lines and filters are cleared and no longer computed. A sleeping polarisation
+    /// drops the waves the bridge (and the other polarisation, at the nut) send into it
+    /// and wakes, exactly where it left off (zeros), once they add up to `threshold_j /
+    /// 2`; a bow landing wakes both. So a polarisation that sleeps and wakes loses less
+    /// than `threshold_j`. Only with the bow off this string (else nothing happens).
+    /// Walks the delay lines: once per block.
+    pub fn sleep_quiet_polarisations(&mut self, threshold_j: f64) {
+        if self.contact_active {
+            return;
+        }
+        let energies = self.wave_energies_j();
+        self.wake_sum = 0.5 * threshold_j * self.internal_rate_hz / self.spec.z0_kg_per_s;
+        for (p, energy) in energies.iter().enumerate() {
+            if !self.asleep[p] && *energy < 0.5 * threshold_j {
+                self.right[p].fill(0.0);
+                self.left[p].fill(0.0);
+                self.loss[p].reset();
+                self.fraction[p].reset();
+                self.asleep[p] = true;
+                self.dropped[p] = 0.0;
+            }
+        }
+    }
+
+    /// `[h, v]`: which polarisations sleep.
+    pub fn asleep(&self) -> [bool; 2] {
+        self.asleep
+    }
+
+    /// Whether both polarisations sleep (the string costs only its ring index).
+    #[inline(always)]
+    pub fn is_asleep(&self) -> bool {
+        self.asleep[0] & self.asleep[1]
     }
 
     pub fn reset(&mut self) {
@@ -894,6 +957,8 @@ impl ThermalString {
         }
         n.slipping.fill(false);
         self.temperature.fill(0.0);
+        self.asleep = [false; 2];
+        self.dropped = [0.0; 2];
     }
 
     /// One sample at the internal rate with the string's own (2x2 admittance) bridge. A bow
@@ -918,6 +983,10 @@ impl ThermalString {
         let dx = self.dx_m;
         let f_b = bow.force_per_m.max(0.0) * dx;
         let on = f_b > 0.0;
+        if on {
+            // A landing bow wakes the string (its sleeping lines hold zeros).
+            self.asleep = [false; 2];
+        }
         let mut frame = ThermalFrame::default();
         let mid = n_b / 2;
         let (dt, half_y) = (self.consts.dt, self.consts.half_y);
@@ -1058,10 +1127,13 @@ impl ThermalString {
     #[inline(always)]
     pub fn arriving_at_bridge(&mut self) -> [f64; 2] {
         let i = self.t.wrapping_sub(self.m - 1) & self.mask;
-        [
-            self.loss[0].tick(self.left[0][i]),
-            self.loss[1].tick(self.left[1][i]),
-        ]
+        let mut out = [0.0; 2];
+        for (p, out) in out.iter_mut().enumerate() {
+            if !self.asleep[p] {
+                *out = self.loss[p].tick(self.left[p][i]);
+            }
+        }
+        out
     }
 
     /// Ends the sample: writes the waves leaving the bridge, reflects at the nut, and
@@ -1076,14 +1148,27 @@ impl ThermalString {
         let j = (self.m - 1).wrapping_sub(self.t) & self.mask;
         let mut at_nut = [0.0; 2];
         for p in 0..2 {
-            at_nut[p] = self.fraction[p].tick(self.right[p][j]);
+            if !self.asleep[p] {
+                at_nut[p] = self.fraction[p].tick(self.right[p][j]);
+            }
         }
         let rn = self.nut_reflection;
         let next = (self.t + 1) & self.mask;
         let bridge_end = 0usize.wrapping_sub(next) & self.mask;
         for p in 0..2 {
-            self.right[p][bridge_end] = flush_tiny(leaving_bridge[p]);
-            self.left[p][next] = flush_tiny(rn[p][0] * at_nut[0] + rn[p][1] * at_nut[1]);
+            let from_bridge = flush_tiny(leaving_bridge[p]);
+            let from_nut = flush_tiny(rn[p][0] * at_nut[0] + rn[p][1] * at_nut[1]);
+            if self.asleep[p] {
+                // Dropped (the lines stay zero) until the dropped waves add up to the
+                // wake threshold; this sample's waves then go in.
+                self.dropped[p] += from_bridge * from_bridge + from_nut * from_nut;
+                if self.dropped[p] < self.wake_sum {
+                    continue;
+                }
+                self.asleep[p] = false;
+            }
+            self.right[p][bridge_end] = from_bridge;
+            self.left[p][next] = from_nut;
         }
         self.t = next;
     }

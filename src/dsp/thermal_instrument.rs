@@ -22,10 +22,13 @@
 //! frequency (a coarse bow is a low rate: `N_B = 1` over 1 cm on the cello is 9 kHz).
 //!
 //! **Skipping.** A lifted bow costs no contact or thermal work (see
-//! [`super::thermal::ThermalString::tick_contact`]). While any string sounds, all four run,
-//! so the open strings ring in sympathy through the bridge; once every bow is lifted and
-//! every string and the bridge have rung out, the whole instrument sleeps at no cost and
-//! wakes exactly.
+//! [`super::thermal::ThermalString::tick_contact`]). A polarisation of a lifted string
+//! whose waves hold less than half of [`SLEEP_ENERGY_J`] sleeps (its waves and end filters
+//! are not computed) until the waves the bridge and the nut send it add up to as much: so
+//! the open strings still ring in sympathy through the bridge (their wake threshold is
+//! reached within a few samples while another string sounds), and a polarisation loses
+//! less than [`SLEEP_ENERGY_J`] per sleep. Once every polarisation sleeps and the bridge
+//! has rung out, the whole instrument sleeps at no cost and wakes exactly.
 //!
 //! ```
 //! use colophony::dsp::instrument::{BowControl, InstrumentKind};
@@ -120,6 +123,15 @@ impl Core {
     #[inline(always)]
     fn tick(&mut self) -> f64 {
         for (i, string) in self.strings.iter_mut().enumerate() {
+            // A sleeping string with no bow landing has nothing to send (its lines hold
+            // zeros); it still takes (or drops) what the bridge sends back.
+            if string.is_asleep() && self.bows[i].force_per_m <= 0.0 {
+                self.arriving[i] = [0.0; 2];
+                if i == self.probed {
+                    self.probe = (0.0, 0.0);
+                }
+                continue;
+            }
             let f = string.tick_contact(self.bows[i]);
             if i == self.probed {
                 self.probe = (f.string_velocity_m_per_s, f.friction_force_n);
@@ -476,21 +488,23 @@ impl ThermalInstrument {
         Some(longest)
     }
 
-    /// Puts the instrument to sleep once every bow is lifted and the strings and the
-    /// bridge have rung out (called once per block: it walks the delay lines).
+    /// Called once per block (it walks the lifted strings' delay lines). Each polarisation
+    /// of a lifted string whose waves fall below half of [`SLEEP_ENERGY_J`] sleeps until
+    /// what the bridge sends it adds up to as much
+    /// ([`ThermalString::sleep_quiet_polarisations`]); once every polarisation sleeps and
+    /// the bridge has rung out, the whole instrument sleeps.
     pub fn update_sleep(&mut self) {
         if !self.skipping || !self.awake || self.pending.is_some() {
             return;
         }
-        let lifted = self.voices.iter().all(|v| !v.bowed && v.bow_gain == 0.0);
-        if lifted
-            && self.core.bridge.is_quiet(1e-12)
-            && self
-                .core
-                .strings
-                .iter()
-                .all(|s| s.energy_j() < SLEEP_ENERGY_J)
-        {
+        let mut all_asleep = true;
+        for (voice, string) in self.voices.iter().zip(&mut self.core.strings) {
+            if !voice.bowed && voice.bow_gain == 0.0 {
+                string.sleep_quiet_polarisations(SLEEP_ENERGY_J);
+            }
+            all_asleep &= string.is_asleep();
+        }
+        if all_asleep && self.core.bridge.is_quiet(1e-12) {
             for s in &mut self.core.strings {
                 s.reset();
             }
@@ -557,6 +571,18 @@ impl ThermalInstrument {
     /// should: the stress suite asserts zero).
     pub fn recoveries(&self) -> u64 {
         self.recoveries
+    }
+
+    /// Polarisations asleep now, of eight (all eight while the whole instrument sleeps).
+    pub fn asleep_polarisations(&self) -> usize {
+        if !self.awake {
+            return 2 * STRINGS;
+        }
+        self.core
+            .strings
+            .iter()
+            .map(|s| s.asleep().iter().filter(|a| **a).count())
+            .sum()
     }
 
     /// Turns sleeping off (everything is computed every sample, silent or not) or on.
