@@ -41,6 +41,7 @@ use crate::dsp::friction::FrictionModel;
 use crate::dsp::instrument::{midi_to_hz, BowControl, InstrumentKind};
 use crate::dsp::resample::{resample_whole_from, Resampler};
 use crate::dsp::rubbed::RubbedPreset;
+use crate::dsp::waveguide::MAX_DISPERSION_STAGES;
 use crate::render::{
     render_rubbed_with, render_thermal, render_with, thermal_string, RenderSettings, Rendered,
 };
@@ -70,6 +71,8 @@ pub enum Series {
     Rate,
     Tolerance,
     Nodes,
+    /// The waveguide's dispersion allpass sections.
+    Dispersion,
 }
 
 impl Series {
@@ -78,6 +81,7 @@ impl Series {
             Series::Rate => "rate",
             Series::Tolerance => "newton-tolerance",
             Series::Nodes => "nodes",
+            Series::Dispersion => "dispersion-sections",
         }
     }
 }
@@ -86,10 +90,11 @@ impl Series {
 #[derive(Debug, Clone, PartialEq)]
 pub enum Model {
     /// A waveguide string at `settings.sample_rate_hz`, with a Newton tolerance for the
-    /// bristle laws (`None`: the default).
+    /// bristle laws and a cap on the dispersion allpass sections (`None`: the defaults).
     String {
         settings: RenderSettings,
         tolerance_m_per_s: Option<f64>,
+        dispersion_stages: Option<usize>,
     },
     /// Paper B's thermal string with `nodes` hair nodes, resampled to the host rate.
     Thermal {
@@ -112,6 +117,7 @@ impl Model {
             Model::String {
                 settings,
                 tolerance_m_per_s,
+                dispersion_stages,
             } => render_with(
                 &RenderSettings {
                     seconds,
@@ -120,6 +126,9 @@ impl Model {
                 |i| {
                     if let Some(t) = tolerance_m_per_s {
                         i.set_newton_tolerance(*t);
+                    }
+                    if let Some(n) = dispersion_stages {
+                        i.set_dispersion_cap(*n);
                     }
                 },
             ),
@@ -185,7 +194,13 @@ impl Model {
             Model::String {
                 settings,
                 tolerance_m_per_s,
-            } => format!("{}{}", khz(settings.sample_rate_hz), tol(tolerance_m_per_s)),
+                dispersion_stages,
+            } => format!(
+                "{}{}{}",
+                khz(settings.sample_rate_hz),
+                tol(tolerance_m_per_s),
+                dispersion_stages.map_or(String::new(), |n| format!(", {n} dispersion sections"))
+            ),
             Model::Thermal { nodes, .. } => format!("N_B {nodes}"),
             Model::Rubbed {
                 sample_rate_hz,
@@ -238,6 +253,10 @@ const RATES_HZ: [f64; 6] = [22_050.0, 44_100.0, 48_000.0, 96_000.0, 192_000.0, 3
 const REFERENCE_RATE_HZ: f64 = 768_000.0;
 const TOLERANCES_M_PER_S: [f64; 5] = [1e-2, 1e-4, 1e-6, 1e-8, 1e-10];
 const NODES: [usize; 8] = [3, 6, 10, 15, 20, 30, 40, 60];
+/// The waveguide's filter-order series: dispersion allpass sections at 48 kHz (the default
+/// is [`crate::dsp::waveguide::DEFAULT_DISPERSION_STAGES`], the references use
+/// [`MAX_DISPERSION_STAGES`]).
+const DISPERSION_STAGES: [usize; 5] = [2, 4, 8, 16, 32];
 const REFERENCE_NODES: usize = 120;
 const FIG6_WIDTH_M: f64 = 0.01;
 
@@ -251,26 +270,40 @@ fn string_group(
     rates: &[f64],
     reference_rate: f64,
     tolerances: &[f64],
+    dispersion_stages: &[usize],
 ) -> Group {
     let bristle = is_bristle(settings.friction);
-    let at = |fs: f64, tolerance_m_per_s: Option<f64>| Model::String {
-        settings: RenderSettings {
-            sample_rate_hz: fs,
-            ..settings
-        },
-        tolerance_m_per_s,
-    };
+    let with =
+        |fs: f64, tolerance_m_per_s: Option<f64>, dispersion_stages: Option<usize>| Model::String {
+            settings: RenderSettings {
+                sample_rate_hz: fs,
+                ..settings
+            },
+            tolerance_m_per_s,
+            dispersion_stages,
+        };
+    let at = |fs: f64, tolerance_m_per_s: Option<f64>| with(fs, tolerance_m_per_s, None);
     let tight = bristle.then_some(TIGHT_TOLERANCE_M_PER_S);
     let tolerances = if bristle { tolerances } else { &[] };
+    let mut configs = rate_and_tolerance_configs(at, rates, tolerances);
+    // The filter order: the dispersion sections at the analysis rate (the reference
+    // uses all of them).
+    for &n in dispersion_stages {
+        configs.push(Config {
+            series: Series::Dispersion,
+            step: 1.0 / n as f64,
+            model: with(ANALYSIS_RATE_HZ, None, Some(n)),
+        });
+    }
     Group {
         scenario,
         model: settings.friction.name().into(),
         reference: Config {
             series: Series::Rate,
             step: 1.0 / reference_rate,
-            model: at(reference_rate, tight),
+            model: with(reference_rate, tight, Some(MAX_DISPERSION_STAGES)),
         },
-        configs: rate_and_tolerance_configs(at, rates, tolerances),
+        configs,
     }
 }
 
@@ -422,6 +455,7 @@ impl Plan {
                 &RATES_HZ,
                 REFERENCE_RATE_HZ,
                 &TOLERANCES_M_PER_S,
+                &DISPERSION_STAGES,
             ));
         }
         for law in FrictionModel::ALL {
@@ -432,6 +466,7 @@ impl Plan {
                 &RATES_HZ,
                 REFERENCE_RATE_HZ,
                 &[],
+                &DISPERSION_STAGES,
             ));
         }
         groups.push(thermal_group(FIG6, 0.07, &NODES, REFERENCE_NODES));
@@ -463,6 +498,7 @@ impl Plan {
                 &rates,
                 reference_rate,
                 &[1e-3, 1e-6],
+                &[4],
             ));
         }
         let (scenario, settings) = violin_a(FrictionModel::Hyperbolic);
@@ -471,6 +507,7 @@ impl Plan {
             settings,
             &rates,
             reference_rate,
+            &[],
             &[],
         ));
         groups.push(thermal_group(FIG6_BETA_01, 0.1, &[6, 12], 24));
@@ -745,7 +782,12 @@ pub fn compute(plan: &Plan, mut progress: impl FnMut(&str)) -> Result<Report, St
                 note: notes.join("; "),
             });
         }
-        for series in [Series::Rate, Series::Tolerance, Series::Nodes] {
+        for series in [
+            Series::Rate,
+            Series::Tolerance,
+            Series::Nodes,
+            Series::Dispersion,
+        ] {
             let mut members: Vec<&Done> = done
                 .iter()
                 .chain([&reference])

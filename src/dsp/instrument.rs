@@ -524,6 +524,15 @@ impl Instrument {
         }
     }
 
+    /// Most dispersion allpass sections each string's fit may use (refits the strings;
+    /// see [`super::waveguide::WaveguideString::set_dispersion_cap`]). For the
+    /// work-precision bench, not the audio thread.
+    pub fn set_dispersion_cap(&mut self, stages: usize) {
+        for voice in &mut self.voices {
+            voice.string.set_dispersion_cap(stages);
+        }
+    }
+
     pub fn friction_model(&self) -> FrictionModel {
         self.voices[0].contact.model()
     }

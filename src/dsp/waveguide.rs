@@ -38,8 +38,18 @@ use super::filters::{Allpass1, OnePoleLoss};
 use super::friction::{BowInput, FrictionContact, LoadLine};
 use std::f64::consts::PI;
 
-/// Most first-order allpass sections the dispersion fit may use.
-pub const MAX_DISPERSION_STAGES: usize = 8;
+/// Most first-order allpass sections a string can hold for its dispersion (the
+/// work-precision bench's refined reference uses them all).
+pub const MAX_DISPERSION_STAGES: usize = 32;
+/// Most sections the dispersion fit may use unless told otherwise
+/// ([`WaveguideString::set_dispersion_cap`]): the fit's search runs on the audio thread at
+/// each note, and its cost grows with the cap.
+pub const DEFAULT_DISPERSION_STAGES: usize = 8;
+/// Most negative allpass coefficient the dispersion fit may choose: a first-order section
+/// disperses only below about `fs (1 + a) / 2 pi`, so the coefficient must approach -1 as
+/// the rate rises (at 768 kHz the cello D string needs -0.976). (A clamp at -0.95 made
+/// the 768 kHz string nearly harmonic: a different string from the lower rates'.)
+const MOST_NEGATIVE_ALLPASS: f64 = -0.999;
 /// Most partials the dispersion fit looks at.
 const MAX_FIT_PARTIALS: usize = 24;
 /// Highest partial frequency the dispersion fit looks at.
@@ -87,6 +97,8 @@ pub struct WaveguideString {
     loss: OnePoleLoss,
     dispersion: [Allpass1; MAX_DISPERSION_STAGES],
     dispersion_stages: usize,
+    /// Most dispersion sections the fit may use.
+    dispersion_cap: usize,
     fraction: Allpass1,
 }
 
@@ -109,6 +121,7 @@ impl WaveguideString {
             loss: OnePoleLoss::default(),
             dispersion: [Allpass1::default(); MAX_DISPERSION_STAGES],
             dispersion_stages: 0,
+            dispersion_cap: DEFAULT_DISPERSION_STAGES,
             fraction: Allpass1::default(),
         };
         s.stop_at(spec.open_hz);
@@ -168,13 +181,29 @@ impl WaveguideString {
         self.loss = OnePoleLoss::fit(w1, gain1, 2.0 * PI * f2 / fs, gain2);
         let b = self.spec.inharmonicity_open * (f1_hz / self.spec.open_hz).powi(2);
         let budget = n - 2.0 * 2.0 - 0.5 - self.loss.phase_delay(w1);
-        let (stages, a) = fit_dispersion(f1_hz, b, fs, &self.loss, budget);
+        let (stages, a) = fit_dispersion(f1_hz, b, fs, &self.loss, budget, self.dispersion_cap);
         self.dispersion_stages = stages;
         for ap in &mut self.dispersion[..stages] {
             ap.a = a;
         }
         self.playable = true;
         self.bend_to(f1_hz);
+    }
+
+    /// Lets the dispersion fit use up to `stages` allpass sections (at most
+    /// [`MAX_DISPERSION_STAGES`]; 0 turns the dispersion off) and refits the string at its
+    /// present pitch. The fit's cost grows with the cap: for the work-precision bench's
+    /// filter-order series, not for the audio thread.
+    pub fn set_dispersion_cap(&mut self, stages: usize) {
+        self.dispersion_cap = stages.min(MAX_DISPERSION_STAGES);
+        if self.fundamental_hz > 0.0 {
+            self.stop_at(self.fundamental_hz);
+        }
+    }
+
+    /// Dispersion allpass sections in use.
+    pub fn dispersion_stages(&self) -> usize {
+        self.dispersion_stages
     }
 
     /// Retunes the loop to `f1_hz` keeping the loss and dispersion filters (pitch bend,
@@ -301,8 +330,16 @@ fn flush(x: f64) -> f64 {
 /// Chooses the number of first-order allpass sections and their common coefficient so that
 /// the loop's partials follow `f_n = n F sqrt(1 + B n^2)` (least squares in cents over the
 /// partials below `FIT_MAX_HZ` and 0.4 fs), with the fundamental tuned exactly afterwards.
-/// `budget` is the most phase delay (samples) the sections may take at the fundamental.
-fn fit_dispersion(f1: f64, b: f64, fs: f64, loss: &OnePoleLoss, budget: f64) -> (usize, f64) {
+/// `budget` is the most phase delay (samples) the sections may take at the fundamental,
+/// `cap` the most sections.
+fn fit_dispersion(
+    f1: f64,
+    b: f64,
+    fs: f64,
+    loss: &OnePoleLoss,
+    budget: f64,
+    cap: usize,
+) -> (usize, f64) {
     let big_f = f1 / (1.0 + b).sqrt();
     let mut partials = [0.0f64; MAX_FIT_PARTIALS];
     let mut count = 0;
@@ -333,13 +370,13 @@ fn fit_dispersion(f1: f64, b: f64, fs: f64, loss: &OnePoleLoss, budget: f64) -> 
             .sum()
     };
     let mut best = (0usize, 0.0f64, cost(0, 0.0));
-    for stages in 1..=MAX_DISPERSION_STAGES {
+    for stages in 1..=cap.min(MAX_DISPERSION_STAGES) {
         // Most negative coefficient the delay budget allows: DC delay (1-a)/(1+a) per stage.
         let per_stage = budget / stages as f64;
         if per_stage <= 1.0 {
             break;
         }
-        let a_min = ((1.0 - per_stage) / (1.0 + per_stage)).max(-0.95);
+        let a_min = ((1.0 - per_stage) / (1.0 + per_stage)).max(MOST_NEGATIVE_ALLPASS);
         // golden-section search over a in [a_min, 0]
         let (mut lo, mut hi) = (a_min, 0.0);
         let r = 0.5 * (5f64.sqrt() - 1.0);
@@ -426,8 +463,51 @@ mod tests {
         let f1 = 146.83;
         let b = 1.5e-4;
         let loss = OnePoleLoss::fit(2.0 * PI * f1 / fs, 0.99, 2.0 * PI * 1468.3 / fs, 0.88);
-        let (stages, a) = fit_dispersion(f1, b, fs, &loss, 100.0);
+        let (stages, a) = fit_dispersion(f1, b, fs, &loss, 100.0, DEFAULT_DISPERSION_STAGES);
         assert!(stages > 0 && a < 0.0);
+    }
+
+    /// Partials `k` of the fitted loop against the stiff-string series, cents.
+    fn fitted_partial_errors(fs: f64, cap: usize) -> Vec<f64> {
+        let (f1, b) = (146.83f64, 1.5e-4f64);
+        let mut s = WaveguideString::new(cello_d(), fs, 60.0);
+        s.set_dispersion_cap(cap);
+        let stages = s.dispersion_stages();
+        let a = s.dispersion[0].a;
+        let g = |f: f64| {
+            let w = 2.0 * PI * f / fs;
+            stages as f64 * Allpass1::phase_delay(a, w) + s.loss.phase_delay(w)
+        };
+        let big_f = f1 / (1.0 + b).sqrt();
+        [2usize, 5, 10, 20]
+            .iter()
+            .map(|&k| {
+                let f_n = k as f64 * big_f * (1.0 + b * (k * k) as f64).sqrt();
+                let heard = k as f64 * fs / (fs / f1 + g(f_n) - g(f1));
+                1200.0 * (heard / f_n).log2()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_dispersion_fit_makes_the_same_stiff_string_at_every_rate_and_improves_with_order() {
+        // Found by the work-precision bench: with the allpass coefficient clamped at
+        // -0.95 the 768 kHz string came out nearly harmonic (partial 10 at -9.8 cents
+        // instead of +3.7), so the reference rate was a different string.
+        let at_48k = fitted_partial_errors(48_000.0, DEFAULT_DISPERSION_STAGES);
+        for fs in [22_050.0, 96_000.0, 192_000.0, 384_000.0, 768_000.0] {
+            let here = fitted_partial_errors(fs, DEFAULT_DISPERSION_STAGES);
+            println!("{fs} Hz: partials 2, 5, 10, 20 off by {here:.2?} cents");
+            for (a, b) in here.iter().zip(&at_48k) {
+                assert!((a - b).abs() < 0.1, "{fs} Hz: {here:?} against {at_48k:?}");
+            }
+        }
+        // More sections fit the series better (the refined reference uses them all).
+        let worst = |e: &[f64]| e.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let fine = fitted_partial_errors(48_000.0, MAX_DISPERSION_STAGES);
+        let none = fitted_partial_errors(48_000.0, 0);
+        println!("48 kHz: no dispersion {none:.2?}, 8 sections {at_48k:.2?}, 32 {fine:.2?}");
+        assert!(worst(&fine) < worst(&at_48k) && worst(&at_48k) < worst(&none));
     }
 
     #[test]
