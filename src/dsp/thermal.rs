@@ -200,9 +200,12 @@ impl ThermalStringSpec {
             z0_kg_per_s: 1.88,
             length_m: 0.69,
             q1: 500.0,
-            // Small resistive terminations with polarisation coupling (eigenvalues > 0).
-            nut_admittance: [[2e-3, 5e-4], [5e-4, 3e-3]],
-            bridge_admittance: [[1e-2, 3e-3], [3e-3, 2e-2]],
+            // Small resistive terminations with polarisation coupling (eigenvalues > 0),
+            // losing less per round trip than Q1 allows (C string, horizontal: 0.5 % of
+            // the amplitude against exp(-pi / 500) = 0.6 %), so the loop's loss filter
+            // makes up the rest and the fundamental decays at Q1.
+            nut_admittance: [[2e-4, 5e-5], [5e-5, 3e-4]],
+            bridge_admittance: [[1e-3, 3e-4], [3e-4, 2e-3]],
         }
     }
 }
@@ -494,6 +497,8 @@ pub struct ThermalString {
     /// Polarisations put to sleep ([`ThermalString::sleep_quiet_polarisations`]): their
     /// lines and filters hold zeros and are not computed.
     asleep: [bool; 2],
+    /// Terminated by a modal bridge, not its own `bridge_admittance`.
+    modal_bridge: bool,
     /// Sum of the squared waves a sleeping polarisation was offered and dropped (at the
     /// bridge and from the other polarisation at the nut), m^2/s^2.
     dropped: [f64; 2],
@@ -542,15 +547,25 @@ fn check_psd(name: &str, y: [[f64; 2]; 2]) -> Result<(), String> {
 }
 
 /// The loop at `fs` for a fundamental `f0`: loss filter (the fundamental decays at `Q1`,
-/// twenty times its frequency at `Q1 / 2`), integer half-loop `m` and the Thiran
-/// coefficient of the remaining delay `d` in `[0.5, 2.5)`:
+/// twenty times its frequency at `Q1 / 2`, counting the real terminations' own loss
+/// `termination_gain`, the horizontal wave's amplitude kept per round trip), integer
+/// half-loop `m` and the Thiran coefficient of the remaining delay `d` in `[0.5, 2.5)`:
 /// `2 m + d = fs / f0 - loss delay - extra`, `extra` being a termination's phase delay at
 /// `f0` in samples (a modal bridge's; 0 for the real 2x2 terminations).
-fn loop_tuning(fs: f64, f0: f64, q1: f64, extra_delay: f64) -> (OnePoleLoss, usize, f64) {
+fn loop_tuning(
+    fs: f64,
+    f0: f64,
+    q1: f64,
+    extra_delay: f64,
+    termination_gain: f64,
+) -> (OnePoleLoss, usize, f64) {
     let w1 = 2.0 * PI * f0 / fs;
     let w2 = (20.0 * w1).min(0.4 * PI);
-    let g1 = (-PI / q1).exp();
-    let g2 = (-PI * (w2 / w1) / (0.5 * q1)).exp();
+    // The terminations are real (frequency-independent): the filter supplies the rest, and
+    // nothing if they alone lose more.
+    let t = termination_gain.clamp(1e-3, 1.0);
+    let g1 = ((-PI / q1).exp() / t).min(1.0);
+    let g2 = ((-PI * (w2 / w1) / (0.5 * q1)).exp() / t).min(g1);
     let loss = OnePoleLoss::fit(w1, g1, w2, g2);
     let remainder = fs / f0 - loss.phase_delay(w1) - extra_delay;
     let m = ((remainder - 0.5) / 2.0).floor().max(0.0) as usize;
@@ -661,6 +676,7 @@ impl ThermalString {
             nut_reflection: reflection(spec.z0_kg_per_s, spec.nut_admittance),
             bridge_reflection: reflection(spec.z0_kg_per_s, spec.bridge_admittance),
             asleep: [false; 2],
+            modal_bridge: false,
             dropped: [0.0; 2],
             wake_sum: f64::INFINITY,
         })
@@ -696,7 +712,13 @@ impl ThermalString {
         if nodes > self.nodes.hair_x.capacity() || grid > self.grid_capacity {
             return Err(ThermalConfigError::Capacity);
         }
-        let (loss, m, a) = loop_tuning(fs, self.spec.f0_hz, self.spec.q1, 0.0);
+        let (loss, m, a) = loop_tuning(
+            fs,
+            self.spec.f0_hz,
+            self.spec.q1,
+            0.0,
+            self.termination_gain(),
+        );
         if m + 4 > self.mask {
             return Err(ThermalConfigError::Capacity);
         }
@@ -775,7 +797,13 @@ impl ThermalString {
         if !(f0_hz.is_finite() && f0_hz > 0.0 && extra_delay.is_finite()) {
             return false;
         }
-        let (loss, m, a) = loop_tuning(self.internal_rate_hz, f0_hz, self.spec.q1, extra_delay);
+        let (loss, m, a) = loop_tuning(
+            self.internal_rate_hz,
+            f0_hz,
+            self.spec.q1,
+            extra_delay,
+            self.termination_gain(),
+        );
         if m + 4 > self.mask || m < self.nodes_count + 4 {
             return false;
         }
@@ -788,6 +816,25 @@ impl ThermalString {
             self.fraction[p].a = a;
         }
         true
+    }
+
+    /// The horizontal wave's amplitude kept per round trip by the string's real
+    /// terminations: the nut's, and its own bridge's unless a modal bridge terminates it
+    /// ([`ThermalString::use_modal_bridge`], whose loss is the body's, on top of `Q1`).
+    fn termination_gain(&self) -> f64 {
+        let rn = self.nut_reflection;
+        if self.modal_bridge {
+            return rn[0][0].abs();
+        }
+        let rb = self.bridge_reflection;
+        (rb[0][0] * rn[0][0] + rb[0][1] * rn[1][0]).abs()
+    }
+
+    /// Marks the string as terminated by a modal bridge (four strings at one bridge,
+    /// [`super::thermal_instrument`]): its own bridge admittance is unused, and the loop
+    /// loss no longer makes up for it. Takes effect at the next tuning.
+    pub fn use_modal_bridge(&mut self) {
+        self.modal_bridge = true;
     }
 
     /// Quality factor of the fundamental.

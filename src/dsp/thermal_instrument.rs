@@ -239,6 +239,10 @@ impl ThermalInstrument {
                         lowest_hz,
                     },
                 )
+                .map(|mut string| {
+                    string.use_modal_bridge();
+                    string
+                })
             })
             .collect::<Result<Vec<_>, _>>()?;
         let settings = settings.clamped();
