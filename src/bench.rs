@@ -203,8 +203,9 @@ pub fn scenes() -> Result<String, String> {
                 off(s(2.2), 62),
             ],
         ),
-        // Longer: the A string bowed briefly and rung out to silence (the thermal cello
-        // sounds to about 10 s: the last polarisations fall asleep one by one).
+        // Longer: the A string bowed briefly and rung out (the point-bow cello falls
+        // silent within the 12 s; the thermal cello's polarisations start falling asleep
+        // one by one near the end, and it sounds to about 20 s).
         (
             "a note rung out to silence",
             12.0,
