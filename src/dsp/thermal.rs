@@ -249,10 +249,9 @@ struct Nodes {
     v_delta: Vec<f64>,
     normal: Vec<f64>,
     slipping: Vec<bool>,
-    /// The waves under the bow `[right h, left h, right v, left v]`, copied out and back
-    /// only on the samples where a ring wraps under the bow (else the node loop works on
-    /// the rings in place).
-    wrapped: [Vec<f64>; 4],
+    /// Incoming horizontal and vertical velocity per node (gathered each sample).
+    vp: Vec<f64>,
+    vp_y: Vec<f64>,
 }
 
 impl Nodes {
@@ -268,7 +267,8 @@ impl Nodes {
             v_delta: v(),
             normal: v(),
             slipping: Vec::with_capacity(n),
-            wrapped: [v(), v(), v(), v()],
+            vp: v(),
+            vp_y: v(),
         }
     }
 
@@ -283,16 +283,14 @@ impl Nodes {
             &mut self.force,
             &mut self.v_delta,
             &mut self.normal,
+            &mut self.vp,
+            &mut self.vp_y,
         ] {
             v.clear();
             v.resize(n, 0.0);
         }
         self.slipping.clear();
         self.slipping.resize(n, false);
-        for w in &mut self.wrapped {
-            w.clear();
-            w.resize(n, 0.0);
-        }
     }
 }
 
@@ -362,26 +360,16 @@ struct NodeConsts {
     mu_hi: f64,
 }
 
-/// The travelling waves under the bow, one slice per line, node `i` at index `i`:
-/// `[right h, left h, right v, left v]`.
-type Waves<'a> = [&'a mut [f64]; 4];
-
-/// Every node's vertical junction and horizontal stick/slip solve for one sample, in one
-/// pass over the waves under the bow: gather the incoming waves (`v^p = right + left`),
-/// solve, and add the outgoing `F / 2Z` to both lines. The nodes are independent within a
-/// sample, so the loop runs over equal-length slices, branch-free, and vectorises.
+/// Every node's vertical junction and horizontal stick/slip solve for one sample: the
+/// nodes are independent within a sample, so the loop runs over equal-length slices,
+/// branch-free, and vectorises.
 #[inline(always)]
-fn solve_nodes_body(k: NodeConsts, nodes: &mut Nodes, temps: &[f64], n_b: usize, w: Waves) {
-    let [r0, l0, r1, l1] = w;
-    let (r0, l0, r1, l1) = (
-        &mut r0[..n_b],
-        &mut l0[..n_b],
-        &mut r1[..n_b],
-        &mut l1[..n_b],
-    );
+fn solve_nodes_body(k: NodeConsts, nodes: &mut Nodes, temps: &[f64], n_b: usize) {
     let fy_s = &mut nodes.fy[..n_b];
     let vy_s = &mut nodes.vy[..n_b];
     let y_s = &mut nodes.y[..n_b];
+    let vp_y = &nodes.vp_y[..n_b];
+    let vp = &nodes.vp[..n_b];
     let hx = &mut nodes.hair_x[..n_b];
     let hv = &mut nodes.hair_v[..n_b];
     let force_s = &mut nodes.force[..n_b];
@@ -389,12 +377,10 @@ fn solve_nodes_body(k: NodeConsts, nodes: &mut Nodes, temps: &[f64], n_b: usize,
     let vd_s = &mut nodes.v_delta[..n_b];
     let temps = &temps[..n_b];
     for i in 0..n_b {
-        let vp = r0[i] + l0[i];
-        let vp_y = r1[i] + l1[i];
         // Vertical junction: the string and the hair mass move together.
         let rhs = -0.5 * fy_s[i] + k.e_y * vy_s[i] - k.k_y * y_s[i];
-        let fy = (rhs * k.inv_d_y - vp_y) * k.inv_y_load;
-        let vy = vp_y + fy * k.half_y;
+        let fy = (rhs * k.inv_d_y - vp_y[i]) * k.inv_y_load;
+        let vy = vp_y[i] + fy * k.half_y;
         y_s[i] += 0.5 * k.dt * (vy + vy_s[i]);
         vy_s[i] = vy;
         fy_s[i] = fy;
@@ -407,7 +393,7 @@ fn solve_nodes_body(k: NodeConsts, nodes: &mut Nodes, temps: &[f64], n_b: usize,
             .max(k.mu_lo)
             .min(k.mu_hi);
         let limit = mu * f_n;
-        let f_stick = (k.v_b + b - vp) * k.inv_x_load;
+        let f_stick = (k.v_b + b - vp[i]) * k.inv_x_load;
         let force = f_stick.max(-limit).min(limit);
         let v_h = -k.a * force + b;
         hx[i] += 0.5 * k.dt * (v_h + hv[i]);
@@ -416,12 +402,6 @@ fn solve_nodes_body(k: NodeConsts, nodes: &mut Nodes, temps: &[f64], n_b: usize,
         normal_s[i] = f_n;
         // v_s - (v_b + v_h) = (F - F_stick)(1 / 2Z + a): exactly 0 while sticking.
         vd_s[i] = (force - f_stick) * (k.half_y + k.a);
-        let dv = force * k.half_y;
-        r0[i] += dv;
-        l0[i] += dv;
-        let dv_y = fy * k.half_y;
-        r1[i] += dv_y;
-        l1[i] += dv_y;
     }
 }
 
@@ -430,27 +410,20 @@ fn solve_nodes_body(k: NodeConsts, nodes: &mut Nodes, temps: &[f64], n_b: usize,
 /// paths give bit-identical results.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn solve_nodes_avx2(k: NodeConsts, nodes: &mut Nodes, temps: &[f64], n_b: usize, w: Waves) {
-    solve_nodes_body(k, nodes, temps, n_b, w)
+fn solve_nodes_avx2(k: NodeConsts, nodes: &mut Nodes, temps: &[f64], n_b: usize) {
+    solve_nodes_body(k, nodes, temps, n_b)
 }
 
 #[inline]
-fn solve_nodes(
-    wide_simd: bool,
-    k: NodeConsts,
-    nodes: &mut Nodes,
-    temps: &[f64],
-    n_b: usize,
-    w: Waves,
-) {
+fn solve_nodes(wide_simd: bool, k: NodeConsts, nodes: &mut Nodes, temps: &[f64], n_b: usize) {
     #[cfg(target_arch = "x86_64")]
     if wide_simd {
         // SAFETY: `wide_simd` is true only where AVX2 was detected at run time.
-        unsafe { solve_nodes_avx2(k, nodes, temps, n_b, w) };
+        unsafe { solve_nodes_avx2(k, nodes, temps, n_b) };
         return;
     }
     let _ = wide_simd;
-    solve_nodes_body(k, nodes, temps, n_b, w)
+    solve_nodes_body(k, nodes, temps, n_b)
 }
 
 /// A sum in four interleaved partial sums (independent chains, so it vectorises instead
@@ -1093,61 +1066,73 @@ impl ThermalString {
             }
         } else {
             self.contact_active = true;
+            // Gather the incoming waves, solve every node (independent within a sample,
+            // branch-free so it vectorises), scatter the outgoing waves.
+            if contiguous {
+                let (r0, r1) = (
+                    &self.right[0][ir0..ir0 + n_b],
+                    &self.right[1][ir0..ir0 + n_b],
+                );
+                let (l0, l1) = (&self.left[0][il0..il0 + n_b], &self.left[1][il0..il0 + n_b]);
+                for (((v, a), b), (vy, (c, d))) in nodes.vp[..n_b]
+                    .iter_mut()
+                    .zip(r0)
+                    .zip(l0)
+                    .zip(nodes.vp_y[..n_b].iter_mut().zip(r1.iter().zip(l1)))
+                {
+                    *v = a + b;
+                    *vy = c + d;
+                }
+            } else {
+                let (mut ir, mut il) = (ir0, il0);
+                for i in 0..n_b {
+                    nodes.vp[i] = self.right[0][ir] + self.left[0][il];
+                    nodes.vp_y[i] = self.right[1][ir] + self.left[1][il];
+                    ir = step(ir);
+                    il = step(il);
+                }
+            }
             let temps = &self.temperature[self.margin_nodes..self.margin_nodes + n_b];
             let k = NodeConsts {
                 f_b,
                 v_b: bow.velocity_m_per_s,
                 ..self.consts
             };
-            let [right_h, right_v] = &mut self.right;
-            let [left_h, left_v] = &mut self.left;
-            // The incoming horizontal wave at the middle node (for the frame).
-            let vp_mid = right_h[(ir0 + mid) & mask] + left_h[(il0 + mid) & mask];
-            // Gather, solve every node and scatter in one pass, on the rings in place
-            // unless one wraps under the bow (then on copies, written back).
-            if contiguous {
-                let waves = [
-                    &mut right_h[ir0..ir0 + n_b],
-                    &mut left_h[il0..il0 + n_b],
-                    &mut right_v[ir0..ir0 + n_b],
-                    &mut left_v[il0..il0 + n_b],
-                ];
-                solve_nodes(self.wide_simd, k, nodes, temps, n_b, waves);
-            } else {
-                let mut wrapped = std::mem::take(&mut nodes.wrapped);
-                let (mut ir, mut il) = (ir0, il0);
-                for i in 0..n_b {
-                    wrapped[0][i] = right_h[ir];
-                    wrapped[1][i] = left_h[il];
-                    wrapped[2][i] = right_v[ir];
-                    wrapped[3][i] = left_v[il];
-                    ir = step(ir);
-                    il = step(il);
-                }
-                {
-                    let [a, b, c, d] = &mut wrapped;
-                    solve_nodes(self.wide_simd, k, nodes, temps, n_b, [a, b, c, d]);
-                }
-                let (mut ir, mut il) = (ir0, il0);
-                for i in 0..n_b {
-                    right_h[ir] = wrapped[0][i];
-                    left_h[il] = wrapped[1][i];
-                    right_v[ir] = wrapped[2][i];
-                    left_v[il] = wrapped[3][i];
-                    ir = step(ir);
-                    il = step(il);
-                }
-                nodes.wrapped = wrapped;
-            }
+            solve_nodes(self.wide_simd, k, nodes, temps, n_b);
             let slip_s = &mut nodes.slipping[..n_b];
             let vd_s = &nodes.v_delta[..n_b];
             for (slip, vd) in slip_s.iter_mut().zip(vd_s.iter()) {
                 *slip = *vd != 0.0;
             }
+            if contiguous {
+                let [r0, r1] = &mut self.right;
+                let [l0, l1] = &mut self.left;
+                for (forces, r, l) in [(&nodes.force, r0, l0), (&nodes.fy, r1, l1)] {
+                    let r = &mut r[ir0..ir0 + n_b];
+                    let l = &mut l[il0..il0 + n_b];
+                    for ((f, a), b) in forces[..n_b].iter().zip(r).zip(l) {
+                        let dv = f * half_y;
+                        *a += dv;
+                        *b += dv;
+                    }
+                }
+            } else {
+                let (mut ir, mut il) = (ir0, il0);
+                for i in 0..n_b {
+                    let dv = nodes.force[i] * half_y;
+                    let dv_y = nodes.fy[i] * half_y;
+                    self.right[0][ir] += dv;
+                    self.left[0][il] += dv;
+                    self.right[1][ir] += dv_y;
+                    self.left[1][il] += dv_y;
+                    ir = step(ir);
+                    il = step(il);
+                }
+            }
             frame.friction_force_n = sum_lanes(&nodes.force);
             frame.normal_force_n = sum_lanes(&nodes.normal);
             frame.slipping_nodes = nodes.slipping.iter().map(|s| *s as usize).sum();
-            frame.string_velocity_m_per_s = vp_mid + nodes.force[mid] * half_y;
+            frame.string_velocity_m_per_s = nodes.vp[mid] + nodes.force[mid] * half_y;
             frame.hair_velocity_m_per_s = nodes.hair_v[mid];
         }
         if !on {
