@@ -935,16 +935,16 @@ impl ThermalString {
         out
     }
 
+    /// Energy the hair holds (horizontal spring, vertical mass and spring), J.
     fn hair_energy_j(&self) -> f64 {
         let dx = self.dx_m;
-        let hair: f64 = (0..self.nodes_count)
+        (0..self.nodes_count)
             .map(|i| {
                 0.5 * self.hair.k_n_per_m_per_m * dx * self.nodes.hair_x[i].powi(2)
                     + 0.5 * self.hair.vertical_mass_kg_per_m * dx * self.nodes.vy[i].powi(2)
                     + 0.5 * self.hair.vertical_k_n_per_m_per_m * dx * self.nodes.y[i].powi(2)
             })
-            .sum();
-        hair
+            .sum()
     }
 
     /// Puts each polarisation whose waves hold less than `threshold_j / 2` to sleep: its
@@ -977,10 +977,11 @@ impl ThermalString {
         self.asleep
     }
 
-    /// Whether both polarisations sleep (the string costs only its ring index).
+    /// Whether both polarisations sleep and the temperature grid has cooled (the string
+    /// then costs only its ring index).
     #[inline(always)]
     pub fn is_asleep(&self) -> bool {
-        self.asleep[0] & self.asleep[1]
+        self.asleep[0] & self.asleep[1] & !self.thermal_active
     }
 
     pub fn reset(&mut self) {

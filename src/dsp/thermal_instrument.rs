@@ -25,9 +25,9 @@
 //! [`super::thermal::ThermalString::tick_contact`]). A polarisation of a lifted string
 //! whose waves hold less than half of [`SLEEP_ENERGY_J`] sleeps (its waves and end filters
 //! are not computed) until the waves the bridge and the nut send it add up to as much: so
-//! the open strings still ring in sympathy through the bridge (their wake threshold is
-//! reached within a few samples while another string sounds), and a polarisation loses
-//! less than [`SLEEP_ENERGY_J`] per sleep. Once every polarisation sleeps and the bridge
+//! the open strings still ring in sympathy through the bridge (while another string
+//! sounds on the generic bridges they do not fall asleep at all: `bench scenes`), and a
+//! polarisation loses less than [`SLEEP_ENERGY_J`] per sleep. Once every polarisation sleeps and the bridge
 //! has rung out, the whole instrument sleeps at no cost and wakes exactly.
 //!
 //! ```
