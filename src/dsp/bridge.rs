@@ -24,7 +24,7 @@
 //! | `R_m` | modal gain (`[[hh, hv], [hv, vv]]`) | s/kg |
 //! | `v_B` | bridge velocity `[h, v]` | m/s |
 
-use super::filters::flush_tiny;
+use super::filters::{flush_tiny, FLUSH_BELOW};
 use std::f64::consts::PI;
 
 /// One bridge mode as data (the format `colophony fit-bridge` writes): `gain` is the
@@ -67,20 +67,58 @@ impl BridgeMode {
     }
 }
 
+/// One mode's coefficients and energy data (its state is in [`Lanes`]).
 #[derive(Debug, Clone, Copy, Default)]
 struct Section {
     a1: f64,
     a2: f64,
     gain: [[f64; 2]; 2],
-    /// Transposed direct form II state per channel.
-    z1: [f64; 2],
-    z2: [f64; 2],
     /// The section's stored energy times the sample rate is
     /// `sum_ij storage[i][j] z_i^T gain^+ z_j` (z_1, z_2 the state vectors over the
     /// channels): see [`ModalBridge::energy_j`].
     storage: [[f64; 2]; 2],
     /// Pseudo-inverse of `gain`.
     gain_pinv: [[f64; 2]; 2],
+}
+
+/// Whether this CPU runs the bridge's vector path.
+fn detect_avx() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::is_x86_feature_detected!("avx")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// Sections per [`Lanes`] block.
+const LANES: usize = 4;
+
+/// Four `f64` lanes, one per section of a [`Lanes`] block (aligned for vector loads).
+#[derive(Debug, Clone, Copy, Default)]
+#[repr(C, align(32))]
+struct F4([f64; LANES]);
+
+/// `(a + b) + (c + d)`: how both paths of [`ModalBridge::advance`] end their lane sums.
+#[inline(always)]
+fn sum4(x: [f64; LANES]) -> f64 {
+    (x[0] + x[1]) + (x[2] + x[3])
+}
+
+/// Four sections side by side (structure of arrays): what the per-sample loop reads and
+/// writes, so that it runs on vector registers and its sums run as four independent
+/// chains. Unused lanes have zero gains and states and stay zero.
+#[derive(Debug, Clone, Copy, Default)]
+struct Lanes {
+    a1: F4,
+    a2: F4,
+    /// `gain[c][d]` of each section.
+    gain: [[F4; 2]; 2],
+    /// Transposed direct form II state per channel.
+    z1: [F4; 2],
+    z2: [F4; 2],
 }
 
 /// `[[s11, s12], [s12, s22]]` such that `S(z) = z^T S z` (z the section's two direct-form
@@ -171,6 +209,13 @@ pub struct ModalBridge {
     /// The continuous-time modes, validated (kept to rebuild the sections at a new rate).
     modes: Vec<BridgeMode>,
     sections: Vec<Section>,
+    /// The sections' coefficients and states, four to a block (section `i` in block
+    /// `i / 4`, lane `i % 4`).
+    lanes: Vec<Lanes>,
+    /// `v_hist`: the sum of the sections' `z1`, kept by [`ModalBridge::advance`].
+    hist: [f64; 2],
+    /// AVX available (detected once, at construction).
+    wide_simd: bool,
     r0: [[f64; 2]; 2],
     sample_rate_hz: f64,
 }
@@ -186,6 +231,9 @@ impl ModalBridge {
         let mut bridge = Self {
             modes: modes.to_vec(),
             sections: Vec::with_capacity(modes.len()),
+            lanes: Vec::with_capacity(modes.len().div_ceil(LANES)),
+            hist: [0.0; 2],
+            wide_simd: detect_avx(),
             r0: [[0.0; 2]; 2],
             sample_rate_hz,
         };
@@ -224,17 +272,40 @@ impl ModalBridge {
                 gain,
                 storage: section_storage(a1, k, bw, w),
                 gain_pinv: psd_pinv(gain),
-                ..Section::default()
             });
         }
         self.r0 = r0;
+        self.lanes.clear();
+        for block in self.sections.chunks(LANES) {
+            let mut lanes = Lanes::default();
+            for (l, s) in block.iter().enumerate() {
+                lanes.a1.0[l] = s.a1;
+                lanes.a2.0[l] = s.a2;
+                for c in 0..2 {
+                    for d in 0..2 {
+                        lanes.gain[c][d].0[l] = s.gain[c][d];
+                    }
+                }
+            }
+            self.lanes.push(lanes);
+        }
+        self.hist = [0.0; 2];
+    }
+
+    /// Section `i`'s states `(z1, z2)`, each over the two channels.
+    fn state(&self, i: usize) -> ([f64; 2], [f64; 2]) {
+        let (b, l) = (&self.lanes[i / LANES], i % LANES);
+        ([b.z1[0].0[l], b.z1[1].0[l]], [b.z2[0].0[l], b.z2[1].0[l]])
     }
 
     /// Whether every section's state is below `threshold` (m/s): the bridge has rung out.
     pub fn is_quiet(&self, threshold: f64) -> bool {
-        self.sections
-            .iter()
-            .all(|s| s.z1.iter().chain(&s.z2).all(|z| z.abs() < threshold))
+        self.lanes.iter().all(|b| {
+            b.z1.iter()
+                .chain(&b.z2)
+                .flat_map(|z| z.0)
+                .all(|z| z.abs() < threshold)
+        })
     }
 
     /// Energy the bridge holds, J: for every section, the storage of its scalar filter
@@ -251,11 +322,13 @@ impl ModalBridge {
         let joules: f64 = self
             .sections
             .iter()
-            .map(|s| {
+            .enumerate()
+            .map(|(i, s)| {
                 let g = &s.gain_pinv;
-                s.storage[0][0] * quad(g, s.z1, s.z1)
-                    + 2.0 * s.storage[0][1] * quad(g, s.z1, s.z2)
-                    + s.storage[1][1] * quad(g, s.z2, s.z2)
+                let (z1, z2) = self.state(i);
+                s.storage[0][0] * quad(g, z1, z1)
+                    + 2.0 * s.storage[0][1] * quad(g, z1, z2)
+                    + s.storage[1][1] * quad(g, z2, z2)
             })
             .sum();
         joules / self.sample_rate_hz
@@ -266,10 +339,11 @@ impl ModalBridge {
     }
 
     pub fn reset(&mut self) {
-        for s in &mut self.sections {
-            s.z1 = [0.0; 2];
-            s.z2 = [0.0; 2];
+        for b in &mut self.lanes {
+            b.z1 = [F4::default(); 2];
+            b.z2 = [F4::default(); 2];
         }
+        self.hist = [0.0; 2];
     }
 
     /// `Y(e^jw)` at `freq_hz` as a complex 2x2 matrix `[(re, im); 4]` in the order hh, hv,
@@ -301,33 +375,89 @@ impl ModalBridge {
     /// The part of this sample's bridge velocity that does not depend on this sample's
     /// force (the sections' states), `v_hist`.
     fn history(&self) -> [f64; 2] {
-        let mut v = [0.0; 2];
-        for s in &self.sections {
-            v[0] += s.z1[0];
-            v[1] += s.z1[1];
-        }
-        v
+        self.hist
     }
 
-    /// Advances every section with this sample's total force; returns `v_B`.
+    /// Advances every section with this sample's total force; returns `v_B` (and keeps
+    /// the next sample's `v_hist`). The sections run four to a block, each lane with its
+    /// own sums; with AVX the four lanes are one vector (the same bits as the scalar path:
+    /// the same operations in the same order, no FMA).
+    #[inline(always)]
     fn advance(&mut self, force: [f64; 2]) -> [f64; 2] {
-        let mut v = [0.0; 2];
-        for s in &mut self.sections {
-            for c in 0..2 {
-                let u = s.gain[c][0] * force[0] + s.gain[c][1] * force[1];
-                let y = u + s.z1[c];
-                s.z1[c] = flush_tiny(-s.a1 * y + s.z2[c]);
-                s.z2[c] = flush_tiny(-u - s.a2 * y);
-                v[c] += y;
+        #[cfg(target_arch = "x86_64")]
+        if self.wide_simd {
+            // SAFETY: `wide_simd` is true only where AVX was detected at run time.
+            return unsafe { self.advance_avx(force) };
+        }
+        let mut v = [[0.0; LANES]; 2];
+        let mut hist = [[0.0; LANES]; 2];
+        for c in 0..2 {
+            for b in &mut self.lanes {
+                for l in 0..LANES {
+                    let u = b.gain[c][0].0[l] * force[0] + b.gain[c][1].0[l] * force[1];
+                    let y = u + b.z1[c].0[l];
+                    let z1 = flush_tiny(-b.a1.0[l] * y + b.z2[c].0[l]);
+                    b.z2[c].0[l] = flush_tiny(-u - b.a2.0[l] * y);
+                    b.z1[c].0[l] = z1;
+                    v[c][l] += y;
+                    hist[c][l] += z1;
+                }
             }
         }
-        v
+        self.hist = [sum4(hist[0]), sum4(hist[1])];
+        [sum4(v[0]), sum4(v[1])]
+    }
+
+    /// [`ModalBridge::advance`] on AVX vectors, lane for lane the scalar path's arithmetic.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    fn advance_avx(&mut self, force: [f64; 2]) -> [f64; 2] {
+        use std::arch::x86_64::*;
+        let f = [_mm256_set1_pd(force[0]), _mm256_set1_pd(force[1])];
+        let sign = _mm256_set1_pd(-0.0);
+        let tiny = _mm256_set1_pd(FLUSH_BELOW);
+        // flush_tiny: zero where |x| < FLUSH_BELOW (NaN compares false and stays).
+        let flush = |x: __m256d| {
+            let small = _mm256_cmp_pd::<_CMP_LT_OQ>(_mm256_andnot_pd(sign, x), tiny);
+            _mm256_andnot_pd(small, x)
+        };
+        // SAFETY: `F4` is 32-byte aligned and four f64 long.
+        let load = |x: &F4| unsafe { _mm256_load_pd(x.0.as_ptr()) };
+        let store = |x: &mut F4, v: __m256d| unsafe { _mm256_store_pd(x.0.as_mut_ptr(), v) };
+        let mut out = [0.0; 2];
+        for c in 0..2 {
+            let mut v = _mm256_setzero_pd();
+            let mut h = _mm256_setzero_pd();
+            for b in &mut self.lanes {
+                let u = _mm256_add_pd(
+                    _mm256_mul_pd(load(&b.gain[c][0]), f[0]),
+                    _mm256_mul_pd(load(&b.gain[c][1]), f[1]),
+                );
+                let y = _mm256_add_pd(u, load(&b.z1[c]));
+                let neg_a1 = _mm256_xor_pd(load(&b.a1), sign);
+                let z1 = flush(_mm256_add_pd(_mm256_mul_pd(neg_a1, y), load(&b.z2[c])));
+                let neg_u = _mm256_xor_pd(u, sign);
+                let z2 = flush(_mm256_sub_pd(neg_u, _mm256_mul_pd(load(&b.a2), y)));
+                store(&mut b.z1[c], z1);
+                store(&mut b.z2[c], z2);
+                v = _mm256_add_pd(v, y);
+                h = _mm256_add_pd(h, z1);
+            }
+            let (mut vs, mut hs) = (F4::default(), F4::default());
+            store(&mut vs, v);
+            store(&mut hs, h);
+            out[c] = sum4(vs.0);
+            self.hist[c] = sum4(hs.0);
+        }
+        out
     }
 }
 
 /// Solves the bridge junction for strings whose arriving waves are `arriving[i]` and
 /// impedances `z[i]`; writes the leaving waves into `leaving` and returns the bridge
-/// velocity and the total force on the bridge `[h, v]`.
+/// velocity and the total force on the bridge `[h, v]`. Inlined, so that it runs with the
+/// caller's instruction set (the thermal instrument's AVX2 sample).
+#[inline(always)]
 pub fn solve_junction(
     bridge: &mut ModalBridge,
     arriving: &[[f64; 2]],
@@ -391,6 +521,37 @@ mod tests {
             mode(2000.0, 8.0, 0.04, 0.01, 0.02),
             mode(3200.0, 8.0, 0.02, 0.005, 0.015),
         ]
+    }
+
+    #[test]
+    fn the_vector_bridge_gives_the_same_bits_as_the_scalar_one() {
+        // 14 modes: three full blocks of four and a half-empty one.
+        let mut modes = generic_cello_bridge();
+        modes.extend(generic_cello_bridge().iter().take(6).map(|m| BridgeMode {
+            freq_hz: m.freq_hz * 1.37,
+            ..*m
+        }));
+        assert_eq!(modes.len(), 14);
+        let mut scalar = ModalBridge::new(&modes, 541_600.0).unwrap();
+        scalar.wide_simd = false;
+        let mut vector = ModalBridge::new(&modes, 541_600.0).unwrap();
+        let mut x = 0.321_f64;
+        for n in 0..50_000 {
+            // Broadband forces for 20 000 samples, then none: the ring-out flushes to zero.
+            x = 3.99 * x * (1.0 - x);
+            let f = if n < 20_000 {
+                [x - 0.5, 0.3 - x]
+            } else {
+                [0.0; 2]
+            };
+            let (a, b) = (scalar.advance(f), vector.advance(f));
+            assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits), "sample {n}");
+            assert_eq!(
+                scalar.history().map(f64::to_bits),
+                vector.history().map(f64::to_bits)
+            );
+        }
+        assert_eq!(scalar.energy_j().to_bits(), vector.energy_j().to_bits());
     }
 
     #[test]

@@ -203,10 +203,13 @@ impl Bandpass {
     }
 }
 
+/// Magnitude below which [`flush_tiny`] gives zero.
+pub const FLUSH_BELOW: f64 = 1e-30;
+
 /// Flushes values too small to matter (and subnormal) to exact zero.
 #[inline]
 pub fn flush_tiny(x: f64) -> f64 {
-    if x.abs() < 1e-30 {
+    if x.abs() < FLUSH_BELOW {
         0.0
     } else {
         x

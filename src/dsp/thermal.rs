@@ -360,22 +360,93 @@ struct NodeConsts {
     mu_hi: f64,
 }
 
+/// `a > b ? a : b`: one `maxpd` (`f64::max` adds NaN handling the solve does not need: its
+/// inputs are finite, and a NaN would already have broken the string).
+#[inline(always)]
+fn max_fast(a: f64, b: f64) -> f64 {
+    if a > b {
+        a
+    } else {
+        b
+    }
+}
+
+/// `a < b ? a : b`: one `minpd` (see [`max_fast`]).
+#[inline(always)]
+fn min_fast(a: f64, b: f64) -> f64 {
+    if a < b {
+        a
+    } else {
+        b
+    }
+}
+
+/// The node state [`solve_nodes_body`] reads and writes, as separate slices: passed as
+/// function arguments they are known not to overlap, so the vectorised loop needs no
+/// run-time overlap checks before it starts.
+#[inline(always)]
+fn node_slices(nodes: &mut Nodes, n_b: usize) -> NodeSlices<'_> {
+    NodeSlices {
+        fy: &mut nodes.fy[..n_b],
+        vy: &mut nodes.vy[..n_b],
+        y: &mut nodes.y[..n_b],
+        vp_y: &nodes.vp_y[..n_b],
+        vp: &nodes.vp[..n_b],
+        hair_x: &mut nodes.hair_x[..n_b],
+        hair_v: &mut nodes.hair_v[..n_b],
+        force: &mut nodes.force[..n_b],
+        normal: &mut nodes.normal[..n_b],
+        v_delta: &mut nodes.v_delta[..n_b],
+    }
+}
+
+struct NodeSlices<'a> {
+    fy: &'a mut [f64],
+    vy: &'a mut [f64],
+    y: &'a mut [f64],
+    vp_y: &'a [f64],
+    vp: &'a [f64],
+    hair_x: &'a mut [f64],
+    hair_v: &'a mut [f64],
+    force: &'a mut [f64],
+    normal: &'a mut [f64],
+    v_delta: &'a mut [f64],
+}
+
 /// Every node's vertical junction and horizontal stick/slip solve for one sample: the
 /// nodes are independent within a sample, so the loop runs over equal-length slices,
 /// branch-free, and vectorises.
 #[inline(always)]
-fn solve_nodes_body(k: NodeConsts, nodes: &mut Nodes, temps: &[f64], n_b: usize) {
-    let fy_s = &mut nodes.fy[..n_b];
-    let vy_s = &mut nodes.vy[..n_b];
-    let y_s = &mut nodes.y[..n_b];
-    let vp_y = &nodes.vp_y[..n_b];
-    let vp = &nodes.vp[..n_b];
-    let hx = &mut nodes.hair_x[..n_b];
-    let hv = &mut nodes.hair_v[..n_b];
-    let force_s = &mut nodes.force[..n_b];
-    let normal_s = &mut nodes.normal[..n_b];
-    let vd_s = &mut nodes.v_delta[..n_b];
-    let temps = &temps[..n_b];
+#[allow(clippy::too_many_arguments)]
+fn solve_nodes_body(
+    k: NodeConsts,
+    fy_s: &mut [f64],
+    vy_s: &mut [f64],
+    y_s: &mut [f64],
+    vp_y: &[f64],
+    vp: &[f64],
+    hx: &mut [f64],
+    hv: &mut [f64],
+    force_s: &mut [f64],
+    normal_s: &mut [f64],
+    vd_s: &mut [f64],
+    temps: &[f64],
+) {
+    let n_b = temps.len();
+    let (fy_s, vy_s, y_s, vp_y, vp) = (
+        &mut fy_s[..n_b],
+        &mut vy_s[..n_b],
+        &mut y_s[..n_b],
+        &vp_y[..n_b],
+        &vp[..n_b],
+    );
+    let (hx, hv, force_s, normal_s, vd_s) = (
+        &mut hx[..n_b],
+        &mut hv[..n_b],
+        &mut force_s[..n_b],
+        &mut normal_s[..n_b],
+        &mut vd_s[..n_b],
+    );
     for i in 0..n_b {
         // Vertical junction: the string and the hair mass move together.
         let rhs = -0.5 * fy_s[i] + k.e_y * vy_s[i] - k.k_y * y_s[i];
@@ -384,17 +455,18 @@ fn solve_nodes_body(k: NodeConsts, nodes: &mut Nodes, temps: &[f64], n_b: usize)
         y_s[i] += 0.5 * k.dt * (vy + vy_s[i]);
         vy_s[i] = vy;
         fy_s[i] = fy;
-        let f_n = (k.f_b + fy).max(0.0);
+        let f_n = max_fast(k.f_b + fy, 0.0);
         // Horizontal: Friedlander with the hair's compliance; the clamp is the stick/slip
         // decision (slip exactly when |F_stick| > mu F_N). mu(T) is ThermalParams::mu
         // written out with min/max.
         let b = -k.a * k.k_h * (hx[i] + 0.5 * k.dt * hv[i]);
-        let mu = (k.mu_cold + k.mu_slope * (temps[i] - k.t_cold))
-            .max(k.mu_lo)
-            .min(k.mu_hi);
+        let mu = min_fast(
+            max_fast(k.mu_cold + k.mu_slope * (temps[i] - k.t_cold), k.mu_lo),
+            k.mu_hi,
+        );
         let limit = mu * f_n;
         let f_stick = (k.v_b + b - vp[i]) * k.inv_x_load;
-        let force = f_stick.max(-limit).min(limit);
+        let force = min_fast(max_fast(f_stick, -limit), limit);
         let v_h = -k.a * force + b;
         hx[i] += 0.5 * k.dt * (v_h + hv[i]);
         hv[i] = v_h;
@@ -410,20 +482,26 @@ fn solve_nodes_body(k: NodeConsts, nodes: &mut Nodes, temps: &[f64], n_b: usize)
 /// paths give bit-identical results.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn solve_nodes_avx2(k: NodeConsts, nodes: &mut Nodes, temps: &[f64], n_b: usize) {
-    solve_nodes_body(k, nodes, temps, n_b)
+fn solve_nodes_avx2(k: NodeConsts, s: NodeSlices<'_>, temps: &[f64]) {
+    solve_nodes_body(
+        k, s.fy, s.vy, s.y, s.vp_y, s.vp, s.hair_x, s.hair_v, s.force, s.normal, s.v_delta, temps,
+    )
 }
 
 #[inline]
 fn solve_nodes(wide_simd: bool, k: NodeConsts, nodes: &mut Nodes, temps: &[f64], n_b: usize) {
+    let s = node_slices(nodes, n_b);
+    let temps = &temps[..n_b];
     #[cfg(target_arch = "x86_64")]
     if wide_simd {
         // SAFETY: `wide_simd` is true only where AVX2 was detected at run time.
-        unsafe { solve_nodes_avx2(k, nodes, temps, n_b) };
+        unsafe { solve_nodes_avx2(k, s, temps) };
         return;
     }
     let _ = wide_simd;
-    solve_nodes_body(k, nodes, temps, n_b)
+    solve_nodes_body(
+        k, s.fy, s.vy, s.y, s.vp_y, s.vp, s.hair_x, s.hair_v, s.force, s.normal, s.v_delta, temps,
+    )
 }
 
 /// A sum in four interleaved partial sums (independent chains, so it vectorises instead
@@ -460,6 +538,8 @@ pub struct ThermalString {
     wide_simd: bool,
     /// The node solve's constants for the current configuration.
     consts: NodeConsts,
+    /// Eq. (1)'s constants for the current configuration.
+    ftcs: FtcsConsts,
     spec: ThermalStringSpec,
     thermal: ThermalParams,
     hair: HairParams,
@@ -649,6 +729,7 @@ impl ThermalString {
         Ok(Self {
             wide_simd: detect_wide_simd(),
             consts: NodeConsts::default(),
+            ftcs: FtcsConsts::default(),
             spec,
             thermal,
             hair,
@@ -740,8 +821,21 @@ impl ThermalString {
         self.loss = [loss; 2];
         self.fraction = [Allpass1::new(a); 2];
         self.consts = self.node_consts();
+        self.ftcs = self.ftcs_consts();
         self.reset();
         Ok(())
+    }
+
+    /// Eq. (1)'s sub-step constants at the current rate, spacing and sub-step count.
+    fn ftcs_consts(&self) -> FtcsConsts {
+        let p = self.thermal;
+        let dx = self.dx_m;
+        let h = self.consts.dt / self.substeps as f64;
+        FtcsConsts {
+            r: p.diffusivity_m2_per_s * h / (dx * dx),
+            heat: h * p.c_h_kelvin_m_per_j / dx,
+            cool: h * p.c_c_per_m,
+        }
     }
 
     /// The node solve's constants at the current rate and spacing (divisions done once
@@ -1017,6 +1111,13 @@ impl ThermalString {
         frame
     }
 
+    /// Whether [`ThermalString::tick_contact`] with the bow lifted would do nothing but
+    /// report the string's velocity: the contact is cleared and the grid has cooled.
+    #[inline(always)]
+    pub fn contact_idle(&self) -> bool {
+        !self.contact_active && !self.thermal_active
+    }
+
     /// The bow contact and thermal update of one sample (no terminations).
     #[inline(always)]
     pub fn tick_contact(&mut self, bow: ThermalBowControl) -> ThermalFrame {
@@ -1037,7 +1138,7 @@ impl ThermalString {
         }
         let mut frame = ThermalFrame::default();
         let mid = n_b / 2;
-        let (dt, half_y) = (self.consts.dt, self.consts.half_y);
+        let half_y = self.consts.half_y;
 
         // Consecutive nodes sit at consecutive ring indices in both lines (see the layout
         // note in `finish_sample`): contiguous slices unless a ring wraps under the bow.
@@ -1143,7 +1244,7 @@ impl ThermalString {
         }
         // The grid idles once the bow is off and the contact has cooled to nothing.
         if on || self.thermal_active {
-            self.update_temperature(dt, dx);
+            self.update_temperature();
             if !on {
                 self.thermal_active = self.temperature.iter().any(|t| *t != 0.0);
             }
@@ -1228,60 +1329,74 @@ impl ThermalString {
     /// Eq. (1) by FTCS with the sub-steps the stability bound asks for: diffusion over
     /// the whole grid (branch-free interior), then the friction source and convective loss
     /// on the bow's nodes.
-    fn update_temperature(&mut self, dt: f64, dx: f64) {
+    fn update_temperature(&mut self) {
         #[cfg(target_arch = "x86_64")]
         if self.wide_simd {
             // SAFETY: `wide_simd` is true only where AVX2 was detected at run time.
-            unsafe { self.update_temperature_avx2(dt, dx) };
+            unsafe { self.update_temperature_avx2() };
             return;
         }
-        self.update_temperature_body(dt, dx)
+        self.update_temperature_body()
     }
 
     /// [`ThermalString::update_temperature`] compiled for AVX2 (bit-identical: no FMA).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn update_temperature_avx2(&mut self, dt: f64, dx: f64) {
-        self.update_temperature_body(dt, dx)
+    fn update_temperature_avx2(&mut self) {
+        self.update_temperature_body()
     }
 
     #[inline(always)]
-    fn update_temperature_body(&mut self, dt: f64, dx: f64) {
-        let p = self.thermal;
-        let h = dt / self.substeps as f64;
-        let r = p.diffusivity_m2_per_s * h / (dx * dx);
-        let n = self.temperature.len();
-        let heat = h * p.c_h_kelvin_m_per_j / dx;
-        let cool = h * p.c_c_per_m;
+    fn update_temperature_body(&mut self) {
+        let n_b = self.nodes_count;
         let off = self.margin_nodes;
         for _ in 0..self.substeps {
-            let t = &self.temperature;
-            let next = &mut self.temperature_next;
-            if n == 1 {
-                next[0] = flush_tiny(t[0] * (1.0 - 2.0 * r));
-            } else {
-                next[0] = flush_tiny(t[0] + r * (t[1] - 2.0 * t[0]));
-                // Tiny values are flushed to zero inside the loop (a select, which
-                // vectorises), so no later step computes with subnormals.
-                for (out, w) in next[1..n - 1].iter_mut().zip(t.windows(3)) {
-                    *out = flush_tiny(w[1] + r * (w[0] - 2.0 * w[1] + w[2]));
-                }
-                next[n - 1] = flush_tiny(t[n - 1] + r * (t[n - 2] - 2.0 * t[n - 1]));
-            }
-            let n_b = self.nodes_count;
-            let bow = &mut next[off..off + n_b];
-            let t_bow = &t[off..off + n_b];
-            for (((out, tj), vd), f) in bow
-                .iter_mut()
-                .zip(t_bow)
-                .zip(&self.nodes.v_delta[..n_b])
-                .zip(&self.nodes.force[..n_b])
-            {
-                let v = vd.abs();
-                *out = flush_tiny(*out + heat * f.abs() * v - cool * tj * v);
-            }
+            ftcs_step(
+                self.ftcs,
+                &self.temperature,
+                &mut self.temperature_next,
+                off,
+                &self.nodes.v_delta[..n_b],
+                &self.nodes.force[..n_b],
+            );
             std::mem::swap(&mut self.temperature, &mut self.temperature_next);
         }
+    }
+}
+
+/// The per-sub-step constants of eq. (1) (set with the configuration): the FTCS ratio
+/// `r = alpha h / dx^2`, the heating `h C_H / dx` and the cooling `h C_C`, `h` the sub-step.
+#[derive(Debug, Clone, Copy, Default)]
+struct FtcsConsts {
+    r: f64,
+    heat: f64,
+    cool: f64,
+}
+
+/// One FTCS sub-step from `t` into `next` (the grid and the bow's `n_b` nodes from `off`);
+/// slices as arguments, so the vectorised loops need no overlap checks.
+#[inline(always)]
+fn ftcs_step(k: FtcsConsts, t: &[f64], next: &mut [f64], off: usize, vd: &[f64], force: &[f64]) {
+    let FtcsConsts { r, heat, cool } = k;
+    let n = t.len();
+    let next = &mut next[..n];
+    if n == 1 {
+        next[0] = flush_tiny(t[0] * (1.0 - 2.0 * r));
+    } else {
+        next[0] = flush_tiny(t[0] + r * (t[1] - 2.0 * t[0]));
+        // Tiny values are flushed to zero inside the loop (a select, which vectorises),
+        // so no later step computes with subnormals.
+        for (out, w) in next[1..n - 1].iter_mut().zip(t.windows(3)) {
+            *out = flush_tiny(w[1] + r * (w[0] - 2.0 * w[1] + w[2]));
+        }
+        next[n - 1] = flush_tiny(t[n - 1] + r * (t[n - 2] - 2.0 * t[n - 1]));
+    }
+    let n_b = vd.len();
+    let bow = &mut next[off..off + n_b];
+    let t_bow = &t[off..off + n_b];
+    for (((out, tj), vd), f) in bow.iter_mut().zip(t_bow).zip(vd).zip(&force[..n_b]) {
+        let v = vd.abs();
+        *out = flush_tiny(*out + heat * f.abs() * v - cool * tj * v);
     }
 }
 
@@ -1304,5 +1419,50 @@ mod tests {
         }
         // Rigid: -I.
         assert_eq!(reflection(1.0, [[0.0; 2]; 2]), [[-1.0, 0.0], [0.0, -1.0]]);
+    }
+
+    #[test]
+    fn the_avx2_string_gives_the_same_bits_as_the_portable_one() {
+        // Paper B's Figure 6 bow on 60 nodes for 0.1 s, then lifted while the grid
+        // cools: every path of the node solve and the FTCS update, in both builds.
+        let make = |wide_simd: bool| {
+            let mut s = ThermalString::new(
+                ThermalStringSpec::cello_c(),
+                60,
+                0.01,
+                ThermalParams::default(),
+                HairParams::default(),
+            )
+            .unwrap();
+            s.wide_simd = wide_simd;
+            s
+        };
+        let (mut portable, mut wide) = (make(false), make(detect_wide_simd()));
+        let fs = portable.internal_rate_hz();
+        for n in 0..(0.15 * fs) as usize {
+            let bow = ThermalBowControl {
+                velocity_m_per_s: 0.15,
+                force_per_m: if n < (0.1 * fs) as usize { 300.0 } else { 0.0 },
+                position_beta: 0.07,
+            };
+            let (a, b) = (portable.tick(bow), wide.tick(bow));
+            assert_eq!(
+                a.bridge_force_n.to_bits(),
+                b.bridge_force_n.to_bits(),
+                "sample {n}"
+            );
+            assert_eq!(a.friction_force_n.to_bits(), b.friction_force_n.to_bits());
+        }
+        let bits = |s: &ThermalString| {
+            s.temperature_grid()
+                .iter()
+                .map(|t| t.to_bits())
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(bits(&portable), bits(&wide));
+        assert!(
+            portable.temperature_grid().iter().any(|t| *t > 0.0),
+            "the grid was heated"
+        );
     }
 }

@@ -132,6 +132,12 @@ impl Core {
                 }
                 continue;
             }
+            if i != self.probed && self.bows[i].force_per_m <= 0.0 && string.contact_idle() {
+                // Lifted, cleared and cooled: the contact has nothing to compute, and
+                // only the probed string's velocity is read.
+                self.arriving[i] = string.arriving_at_bridge();
+                continue;
+            }
             let f = string.tick_contact(self.bows[i]);
             if i == self.probed {
                 self.probe = (f.string_velocity_m_per_s, f.friction_force_n);
