@@ -262,11 +262,16 @@ pub fn maestre_fig6(out: &Path) -> Result<String, String> {
         fnn.push(f.normal_force_n);
         if k % every == 0 {
             slip_map.push(s.slipping().to_vec());
-            temp_map.push(s.node_temperatures().to_vec());
+            temp_map.push(
+                s.node_temperatures()
+                    .iter()
+                    .map(|t| f64::from(*t))
+                    .collect(),
+            );
             // Nut-side half of the contact: higher node indices are nearer the nut.
             for i in nodes / 2..nodes {
-                let dv = s.node_sliding_velocities()[i];
-                let f = s.node_forces()[i] / (300.0 * 0.01 / nodes as f64);
+                let dv = f64::from(s.node_sliding_velocities()[i]);
+                let f = f64::from(s.node_forces()[i]) / (300.0 * 0.01 / nodes as f64);
                 loop_pts.push((dv, f, i));
             }
         }
@@ -417,7 +422,7 @@ pub fn maestre_fig6(out: &Path) -> Result<String, String> {
         }))
         .map_err(err)?;
     // Temperature profile across the grid at the end.
-    let grid = s.temperature_grid().to_vec();
+    let grid: Vec<f64> = s.temperature_grid().iter().map(|t| f64::from(*t)).collect();
     let (lo, hi) = range(grid.iter().copied());
     let mut chart = ChartBuilder::on(&panels[7])
         .margin(10)

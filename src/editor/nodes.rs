@@ -188,7 +188,13 @@ impl NodeProbe {
     /// publishes their means into `ring` and starts again. A change of node count drops
     /// the partial sums.
     #[inline]
-    pub fn add(&mut self, temperatures: &[f64], slipping: &[bool], interval: u32, ring: &NodeRing) {
+    pub fn add<T: Copy + Into<f64>>(
+        &mut self,
+        temperatures: &[T],
+        slipping: &[bool],
+        interval: u32,
+        ring: &NodeRing,
+    ) {
         let count = temperatures.len().min(slipping.len()).min(MAX_NODES);
         if count != self.count {
             *self = Self {
@@ -197,7 +203,7 @@ impl NodeProbe {
             };
         }
         for i in 0..count {
-            self.temperature_sum[i] += temperatures[i];
+            self.temperature_sum[i] += temperatures[i].into();
             self.slipping[i] += slipping[i] as u32;
         }
         self.samples += 1;
