@@ -81,18 +81,6 @@ struct Section {
     gain_pinv: [[f64; 2]; 2],
 }
 
-/// Whether this CPU runs the bridge's vector path.
-fn detect_avx() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::is_x86_feature_detected!("avx")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
-}
-
 /// Sections per [`Lanes`] block.
 const LANES: usize = 4;
 
@@ -214,7 +202,7 @@ pub struct ModalBridge {
     lanes: Vec<Lanes>,
     /// `v_hist`: the sum of the sections' `z1`, kept by [`ModalBridge::advance`].
     hist: [f64; 2],
-    /// AVX available (detected once, at construction).
+    /// AVX2 (hence AVX) available ([`super::detect_wide_simd`], once, at construction).
     wide_simd: bool,
     r0: [[f64; 2]; 2],
     sample_rate_hz: f64,
@@ -233,7 +221,7 @@ impl ModalBridge {
             sections: Vec::with_capacity(modes.len()),
             lanes: Vec::with_capacity(modes.len().div_ceil(LANES)),
             hist: [0.0; 2],
-            wide_simd: detect_avx(),
+            wide_simd: super::detect_wide_simd(),
             r0: [[0.0; 2]; 2],
             sample_rate_hz,
         };
@@ -386,7 +374,7 @@ impl ModalBridge {
     fn advance(&mut self, force: [f64; 2]) -> [f64; 2] {
         #[cfg(target_arch = "x86_64")]
         if self.wide_simd {
-            // SAFETY: `wide_simd` is true only where AVX was detected at run time.
+            // SAFETY: `wide_simd` is true only where AVX2 (a superset of AVX) was detected.
             return unsafe { self.advance_avx(force) };
         }
         let mut v = [[0.0; LANES]; 2];

@@ -15,3 +15,17 @@ pub mod rubbed;
 pub mod thermal;
 pub mod thermal_instrument;
 pub mod waveguide;
+
+/// Whether this CPU runs the vector paths (AVX2, detected at run time; the thermal
+/// string's node and grid loops, the thermal instrument's sample and the modal bridge
+/// choose their AVX code by it, each giving the same bits as its portable path).
+pub(crate) fn detect_wide_simd() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}

@@ -65,6 +65,13 @@ struct Mode {
     envelope_factor: f64,
 }
 
+impl Mode {
+    /// Kinetic plus potential energy, J.
+    fn energy_j(&self) -> f64 {
+        0.5 * self.mass * self.v * self.v + 0.5 * self.k * self.x * self.x
+    }
+}
+
 /// A bank of modes (see the module doc).
 #[derive(Debug, Clone)]
 pub struct ModalObject {
@@ -198,10 +205,7 @@ impl ModalObject {
 
     /// Kinetic plus potential energy of the modes, J (with the pre-warped stiffness).
     pub fn energy_j(&self) -> f64 {
-        self.modes[..self.count]
-            .iter()
-            .map(|m| 0.5 * m.mass * m.v * m.v + 0.5 * m.k * m.x * m.x)
-            .sum()
+        self.modes[..self.count].iter().map(Mode::energy_j).sum()
     }
 
     /// Samples until the energy falls below `threshold_j` if nothing drives the object, or
@@ -215,7 +219,7 @@ impl ModalObject {
         let target = threshold_j / self.count.max(1) as f64;
         let mut longest = 0.0f64;
         for m in &self.modes[..self.count] {
-            let e = 0.5 * m.mass * m.v * m.v + 0.5 * m.k * m.x * m.x;
+            let e = m.energy_j();
             if e <= 0.0 {
                 continue;
             }

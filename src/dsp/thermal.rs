@@ -46,7 +46,7 @@
 //! | `C_H` | heating per unit frictional power per length | K m/J |
 //! | `F_b` | bow force per unit length | N/m |
 
-use super::filters::{flush_tiny, Allpass1, OnePoleLoss};
+use super::filters::{flush_tiny, Allpass1, OnePoleLoss, FLUSH_BELOW};
 use std::f64::consts::PI;
 
 /// Largest `alpha dt / dx^2` used per thermal sub-step (the bound is 1/2).
@@ -528,18 +528,6 @@ fn sum_lanes(x: &[NodeReal]) -> f64 {
     (acc[0] + acc[1]) + (acc[2] + acc[3]) + rest
 }
 
-/// Whether this CPU runs the AVX2 node loop.
-pub(crate) fn detect_wide_simd() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::is_x86_feature_detected!("avx2")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
-}
-
 /// A string with a finite-width thermal bow (see the module doc).
 #[derive(Debug, Clone)]
 pub struct ThermalString {
@@ -549,6 +537,8 @@ pub struct ThermalString {
     consts: NodeConsts,
     /// Eq. (1)'s constants for the current configuration.
     ftcs: FtcsConsts,
+    /// `1 / 2Z`: the velocity a node's force adds to each travelling wave, m/s per N.
+    half_y: f64,
     spec: ThermalStringSpec,
     thermal: ThermalParams,
     hair: HairParams,
@@ -736,7 +726,7 @@ impl ThermalString {
         let grid_capacity = max_nodes + 2 * ((thermal.margin_m / dx_min).round() as usize + 1);
         let zeros = |n: usize| vec![0.0; n];
         Ok(Self {
-            wide_simd: detect_wide_simd(),
+            wide_simd: super::detect_wide_simd(),
             consts: NodeConsts::default(),
             ftcs: FtcsConsts::default(),
             spec,
@@ -763,6 +753,7 @@ impl ThermalString {
             thermal_active: true,
             loss: [OnePoleLoss::default(); 2],
             fraction: [Allpass1::new(0.0); 2],
+            half_y: 0.5 / spec.z0_kg_per_s,
             nut_reflection: reflection(spec.z0_kg_per_s, spec.nut_admittance),
             bridge_reflection: reflection(spec.z0_kg_per_s, spec.bridge_admittance),
             asleep: [false; 2],
@@ -853,7 +844,7 @@ impl ThermalString {
     fn node_consts(&self) -> NodeConsts {
         let dt = 1.0 / self.internal_rate_hz;
         let dx = self.dx_m;
-        let half_y = 0.5 / self.spec.z0_kg_per_s;
+        let half_y = self.half_y;
         // Hair constants per node (trapezoid).
         let k_h = self.hair.k_n_per_m_per_m * dx;
         let c_h = self.hair.c_kg_per_s_per_m * dx;
@@ -1154,7 +1145,7 @@ impl ThermalString {
         }
         let mut frame = ThermalFrame::default();
         let mid = n_b / 2;
-        let half_y = 0.5 / self.spec.z0_kg_per_s;
+        let half_y = self.half_y;
 
         // Consecutive nodes sit at consecutive ring indices in both lines (see the layout
         // note in `finish_sample`): contiguous slices unless a ring wraps under the bow.
@@ -1390,10 +1381,10 @@ struct FtcsConsts {
     cool: NodeReal,
 }
 
-/// [`flush_tiny`] for the grid's float type.
+/// [`flush_tiny`] (same threshold) for the grid's float type.
 #[inline(always)]
-fn flush_tiny32(x: NodeReal) -> NodeReal {
-    if x.abs() < 1e-30 {
+fn flush_tiny_node(x: NodeReal) -> NodeReal {
+    if x.abs() < FLUSH_BELOW as NodeReal {
         0.0
     } else {
         x
@@ -1415,22 +1406,22 @@ fn ftcs_step(
     let n = t.len();
     let next = &mut next[..n];
     if n == 1 {
-        next[0] = flush_tiny32(t[0] * (1.0 - 2.0 * r));
+        next[0] = flush_tiny_node(t[0] * (1.0 - 2.0 * r));
     } else {
-        next[0] = flush_tiny32(t[0] + r * (t[1] - 2.0 * t[0]));
+        next[0] = flush_tiny_node(t[0] + r * (t[1] - 2.0 * t[0]));
         // Tiny values are flushed to zero inside the loop (a select, which vectorises),
         // so no later step computes with subnormals.
         for (out, w) in next[1..n - 1].iter_mut().zip(t.windows(3)) {
-            *out = flush_tiny32(w[1] + r * (w[0] - 2.0 * w[1] + w[2]));
+            *out = flush_tiny_node(w[1] + r * (w[0] - 2.0 * w[1] + w[2]));
         }
-        next[n - 1] = flush_tiny32(t[n - 1] + r * (t[n - 2] - 2.0 * t[n - 1]));
+        next[n - 1] = flush_tiny_node(t[n - 1] + r * (t[n - 2] - 2.0 * t[n - 1]));
     }
     let n_b = vd.len();
     let bow = &mut next[off..off + n_b];
     let t_bow = &t[off..off + n_b];
     for (((out, tj), vd), f) in bow.iter_mut().zip(t_bow).zip(vd).zip(&force[..n_b]) {
         let v = vd.abs();
-        *out = flush_tiny32(*out + heat * f.abs() * v - cool * tj * v);
+        *out = flush_tiny_node(*out + heat * f.abs() * v - cool * tj * v);
     }
 }
 
@@ -1471,7 +1462,7 @@ mod tests {
             s.wide_simd = wide_simd;
             s
         };
-        let (mut portable, mut wide) = (make(false), make(detect_wide_simd()));
+        let (mut portable, mut wide) = (make(false), make(crate::dsp::detect_wide_simd()));
         let fs = portable.internal_rate_hz();
         for n in 0..(0.15 * fs) as usize {
             let bow = ThermalBowControl {

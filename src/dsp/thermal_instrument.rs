@@ -27,8 +27,9 @@
 //! are not computed) until the waves the bridge and the nut send it add up to as much: so
 //! the open strings still ring in sympathy through the bridge (while another string
 //! sounds on the generic bridges they do not fall asleep at all: `bench scenes`), and a
-//! polarisation loses less than [`SLEEP_ENERGY_J`] per sleep. Once every polarisation sleeps and the bridge
-//! has rung out, the whole instrument sleeps at no cost and wakes exactly.
+//! polarisation loses less than [`SLEEP_ENERGY_J`] per sleep. Once every polarisation
+//! sleeps and the bridge has rung out, the whole instrument sleeps at no cost and wakes
+//! exactly.
 //!
 //! ```
 //! use colophony::dsp::instrument::{BowControl, InstrumentKind};
@@ -123,19 +124,17 @@ impl Core {
     #[inline(always)]
     fn tick(&mut self) -> f64 {
         for (i, string) in self.strings.iter_mut().enumerate() {
-            // A sleeping string with no bow landing has nothing to send (its lines hold
-            // zeros); it still takes (or drops) what the bridge sends back.
-            if string.is_asleep() && self.bows[i].force_per_m <= 0.0 {
-                self.arriving[i] = [0.0; 2];
+            // Lifted, cleared and cooled: the contact has nothing to compute. Only the
+            // probed string's velocity is read, and a sleeping one's is zero (its lines
+            // hold zeros; it still takes, or drops, what the bridge sends back).
+            if self.bows[i].force_per_m <= 0.0
+                && string.contact_idle()
+                && (i != self.probed || string.is_asleep())
+            {
+                self.arriving[i] = string.arriving_at_bridge();
                 if i == self.probed {
                     self.probe = (0.0, 0.0);
                 }
-                continue;
-            }
-            if i != self.probed && self.bows[i].force_per_m <= 0.0 && string.contact_idle() {
-                // Lifted, cleared and cooled: the contact has nothing to compute, and
-                // only the probed string's velocity is read.
-                self.arriving[i] = string.arriving_at_bridge();
                 continue;
             }
             let f = string.tick_contact(self.bows[i]);
@@ -282,7 +281,7 @@ impl ThermalInstrument {
             output_scale: kind.output_scale_per_n(),
             awake: false,
             skipping: true,
-            wide_simd: super::thermal::detect_wide_simd(),
+            wide_simd: super::detect_wide_simd(),
             recoveries: 0,
         };
         instrument
