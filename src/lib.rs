@@ -12,6 +12,8 @@ pub mod dsp;
 pub mod editor;
 pub mod figures;
 pub mod params;
+pub mod playing_space;
+pub mod playing_space_figure;
 pub mod precision;
 pub mod quality;
 pub mod render;

@@ -280,8 +280,12 @@ fn main() -> ExitCode {
                 Some(dir) => colophony::precision::run(&dir, quick),
                 None => Err("bench precision needs --out DIR".into()),
             },
+            "playing-space" => match out {
+                Some(dir) => colophony::playing_space::run(&dir, quick),
+                None => Err("bench playing-space needs --out DIR".into()),
+            },
             other => Err(format!(
-                "unknown bench '{other}': choose friction, table1, scenes or precision"
+                "unknown bench '{other}': choose friction, table1, scenes, precision or playing-space"
             )),
         }),
         Command::FitBridge { input, modes, out } => {

@@ -1,0 +1,579 @@
+//! The playing-space map: every friction model, instrument and note bowed across
+//! Schelleng's window and the host rates, through the engines the plugin plays
+//! (`colophony bench playing-space --out DIR [--quick]`).
+//!
+//! **Cells.** For each model (the four point laws on the waveguide instrument, paper B's
+//! thermal instrument with its modal bridge), instrument, note (from the lowest open string
+//! to two octaves above the highest) and host rate, the note is bowed with:
+//! - `defaults`: the plugin's default bow (0.1 m/s, 1 N, beta 0.1);
+//! - `middle`: beta 0.1 and the geometric middle `sqrt(F_min F_max)` of the note's window;
+//! - the grid: beta 0.05, 0.08, 0.12, 0.18, each at `2 F_min`, `sqrt(F_min F_max)` and
+//!   `F_max / 2`.
+//!
+//! The window is [`SchellengWindow`] for the string that plays the note, with the model's
+//! own static and sliding friction coefficients ([`Model::friction_coefficients`]). The bow
+//! velocity is 0.1 m/s, lowered (not below 0.05 m/s) where `F_max / 2` would exceed the
+//! plugin's 10 N.
+//!
+//! **Measured** on the contact probe after [`SETTLE_S`] (Helmholtz motion must be
+//! established by then): the regime by the editor's own classifier
+//! ([`classify_regime`], so the map and the editor's display agree by construction), the
+//! corner-to-corner slip fraction, slips per period and sticking velocity
+//! ([`slip_stats`]), and the bowed pitch (the strongest peak within 100 cents of the note,
+//! [`peak_frequency_hz`]) in cents from equal temperament at A4 = 440 Hz. A cell is
+//! **Helmholtz** when the classifier says one slip per period, the slip fraction is within
+//! 15 % of beta and the string sticks at the bow velocity (within 10 %).
+
+use crate::analysis::{cents, peak_frequency_hz, slip_stats};
+use crate::dsp::friction::FrictionModel;
+use crate::dsp::instrument::{midi_to_hz, BowControl, Frame, Instrument, InstrumentKind, STRINGS};
+use crate::dsp::thermal::ThermalParams;
+use crate::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
+use crate::editor::live::ContactSample;
+use crate::editor::mapping::SchellengWindow;
+use crate::editor::regime::{classify_regime, Regime};
+use crate::quality::{Quality, GOOD_NODES};
+use rayon::prelude::*;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// Seconds a note has to settle before it is measured (issue 16: Helmholtz motion within
+/// 0.3 s of the bow landing).
+pub const SETTLE_S: f64 = 0.3;
+/// Bow positions of the grid.
+pub const GRID_BETAS: [f64; 4] = [0.05, 0.08, 0.12, 0.18];
+/// Helmholtz: slip fraction within this fraction of beta (Raman: slip fraction = beta).
+pub const SLIP_FRACTION_TOLERANCE: f64 = 0.15;
+/// Helmholtz: the string sticks at the bow velocity within this fraction of it.
+pub const STICK_TOLERANCE: f64 = 0.1;
+/// In tune at nominal bowing, cents (issue 16, item 1).
+pub const NOMINAL_CENTS: f64 = 3.0;
+/// In tune anywhere inside the window, cents (issue 16, item 6).
+pub const WINDOW_CENTS: f64 = 10.0;
+/// Highest bow force of the plugin's range, N.
+const MAX_FORCE_N: f64 = 10.0;
+
+/// A friction model as the plugin offers it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Model {
+    Point(FrictionModel),
+    Thermal,
+}
+
+impl Model {
+    pub const ALL: [Model; 5] = [
+        Model::Point(FrictionModel::Hyperbolic),
+        Model::Point(FrictionModel::Stribeck),
+        Model::Point(FrictionModel::LuGre),
+        Model::Point(FrictionModel::ElastoPlastic),
+        Model::Thermal,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Model::Point(m) => m.name(),
+            Model::Thermal => "thermal",
+        }
+    }
+
+    /// Static and sliding friction coefficients: 0.4 / 0.2 for paper A's laws, the
+    /// thermal law's cool and hot ends for paper B's.
+    pub fn friction_coefficients(self) -> (f64, f64) {
+        match self {
+            Model::Point(_) => (0.4, 0.2),
+            Model::Thermal => {
+                let p = ThermalParams::default();
+                (p.mu_cold, p.mu_hot)
+            }
+        }
+    }
+}
+
+/// How a cell bows its note.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Bowing {
+    /// The plugin's defaults.
+    Defaults,
+    /// beta 0.1, the geometric middle of the window.
+    Middle,
+    /// `2 F_min` at this beta.
+    TwiceMin(f64),
+    /// `sqrt(F_min F_max)` at this beta.
+    Centre(f64),
+    /// `F_max / 2` at this beta.
+    HalfMax(f64),
+}
+
+impl Bowing {
+    pub fn label(self) -> String {
+        match self {
+            Bowing::Defaults => "defaults".into(),
+            Bowing::Middle => "middle".into(),
+            Bowing::TwiceMin(b) => format!("2Fmin@{b}"),
+            Bowing::Centre(b) => format!("mid@{b}"),
+            Bowing::HalfMax(b) => format!("Fmax/2@{b}"),
+        }
+    }
+
+    /// Nominal bowing (issue 16, item 1): the defaults and the window's middle.
+    pub fn is_nominal(self) -> bool {
+        matches!(self, Bowing::Defaults | Bowing::Middle)
+    }
+
+    /// Every bowing of a full map, or of a quick one (`2 F_min` and `F_max / 2` dropped
+    /// but for beta 0.12: two forces).
+    pub fn all(quick: bool) -> Vec<Bowing> {
+        let mut v = vec![Bowing::Defaults, Bowing::Middle];
+        for b in GRID_BETAS {
+            if quick {
+                if b == 0.12 {
+                    v.push(Bowing::TwiceMin(b));
+                    v.push(Bowing::HalfMax(b));
+                }
+            } else {
+                v.extend([Bowing::TwiceMin(b), Bowing::Centre(b), Bowing::HalfMax(b)]);
+            }
+        }
+        v
+    }
+}
+
+/// One note bowed one way at one rate.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cell {
+    pub model: Model,
+    pub kind: InstrumentKind,
+    pub note: u8,
+    pub rate_hz: f64,
+    pub bowing: Bowing,
+    pub bow: BowControl,
+    /// The window's limits at this velocity and beta, N.
+    pub f_min_n: f64,
+    pub f_max_n: f64,
+    pub seconds: f64,
+}
+
+impl Cell {
+    pub fn new(
+        model: Model,
+        kind: InstrumentKind,
+        note: u8,
+        rate_hz: f64,
+        bowing: Bowing,
+        seconds: f64,
+    ) -> Self {
+        let beta = match bowing {
+            Bowing::Defaults | Bowing::Middle => 0.1,
+            Bowing::TwiceMin(b) | Bowing::Centre(b) | Bowing::HalfMax(b) => b,
+        };
+        let (mu_s, mu_d) = model.friction_coefficients();
+        let window = SchellengWindow {
+            mu_s,
+            mu_d,
+            ..SchellengWindow::for_note(kind, note, beta)
+                .unwrap_or_else(|| SchellengWindow::for_string(kind, 0, beta))
+        };
+        let mut v = 0.1;
+        if !matches!(bowing, Bowing::Defaults) {
+            let half_max = 0.5 * window.max_force_n(v);
+            if half_max > MAX_FORCE_N {
+                v = (v * MAX_FORCE_N / half_max).max(0.05);
+            }
+        }
+        let (f_min, f_max) = (window.min_force_n(v), window.max_force_n(v));
+        let force = match bowing {
+            Bowing::Defaults => 1.0,
+            Bowing::Middle | Bowing::Centre(_) => (f_min * f_max).sqrt(),
+            Bowing::TwiceMin(_) => 2.0 * f_min,
+            Bowing::HalfMax(_) => 0.5 * f_max,
+        };
+        Self {
+            model,
+            kind,
+            note,
+            rate_hz,
+            bowing,
+            bow: BowControl {
+                velocity_m_per_s: v,
+                force_n: force,
+                position_beta: beta,
+            },
+            f_min_n: f_min,
+            f_max_n: f_max,
+            seconds,
+        }
+    }
+
+    /// Whether the bow force lies inside the window (the defaults may not).
+    pub fn inside_window(&self) -> bool {
+        self.bow.force_n >= self.f_min_n && self.bow.force_n <= self.f_max_n
+    }
+
+    /// The note's equal-tempered frequency, A4 = 440 Hz.
+    pub fn nominal_hz(&self) -> f64 {
+        midi_to_hz(self.note as f64)
+    }
+}
+
+/// What one cell did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Measured {
+    /// The editor's classification of the probe after [`SETTLE_S`]; `None` if the note was
+    /// refused (no sound at all).
+    pub regime: Option<Regime>,
+    pub slips_per_period: f64,
+    pub slip_fraction: f64,
+    pub stick_velocity_m_per_s: f64,
+    /// Bowed pitch against equal temperament, cents.
+    pub cents: f64,
+    /// Helmholtz motion by the full criterion (see the module doc).
+    pub helmholtz: bool,
+    /// Peak output sample (the plugin's scale).
+    pub peak: f64,
+}
+
+/// Renders `cell` through the engine the plugin plays and returns (audio, probe), both at
+/// the host rate.
+pub fn render_cell(cell: &Cell) -> Result<(Vec<f64>, Vec<ContactSample>), String> {
+    let n = (cell.seconds * cell.rate_hz).round() as usize;
+    let mut audio = Vec::with_capacity(n);
+    let mut probe = Vec::with_capacity(n);
+    let mut push = |frame: Frame| {
+        audio.push(frame.audio);
+        probe.push(ContactSample::new(&frame, &cell.bow));
+    };
+    // The plugin calls `update_sleep` at each block; 256-sample blocks here.
+    const BLOCK: usize = 256;
+    match cell.model {
+        Model::Point(law) => {
+            let mut engine = Instrument::new(cell.kind, cell.rate_hz);
+            engine.set_friction_model(law);
+            engine.set_newton_tolerance(Quality::Good.newton_tolerance_m_per_s());
+            engine.note_on(cell.note);
+            for i in 0..n {
+                if i % BLOCK == 0 {
+                    engine.update_sleep();
+                }
+                push(engine.tick(cell.bow));
+            }
+        }
+        Model::Thermal => {
+            let bridge = thermal_bridge(cell.kind);
+            let settings = ThermalSettings {
+                nodes: GOOD_NODES,
+                width_m: 0.01,
+            };
+            let mut engine = ThermalInstrument::new(cell.kind, &bridge.modes, cell.rate_hz, settings)?;
+            engine.note_on(cell.note);
+            for i in 0..n {
+                if i % BLOCK == 0 {
+                    engine.update_sleep();
+                }
+                push(engine.tick(cell.bow));
+            }
+        }
+    }
+    Ok((audio, probe))
+}
+
+/// The modal bridge the plugin gives each instrument's thermal model.
+fn thermal_bridge(kind: InstrumentKind) -> crate::admittance_fit::BridgeModes {
+    match kind {
+        InstrumentKind::Cello => crate::admittance_fit::shipped_cello_bridge(),
+        // The viola borrows the violin's generic bridge, as in the plugin.
+        InstrumentKind::Violin | InstrumentKind::Viola => {
+            crate::admittance_fit::shipped_violin_bridge()
+        }
+    }
+}
+
+/// Renders and measures one cell.
+pub fn measure(cell: &Cell) -> Result<Measured, String> {
+    let (audio, probe) = render_cell(cell)?;
+    let fs = cell.rate_hz;
+    let f0 = cell.nominal_hz();
+    let start = ((SETTLE_S * fs) as usize).min(audio.len());
+    let period = fs / f0;
+    // Whole periods of the note for the slip statistics.
+    let periods = ((audio.len() - start) as f64 / period).floor();
+    let end = start + (periods * period) as usize;
+    let steady = &probe[start..end.max(start)];
+    let peak = audio.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let regime = classify_regime(steady, fs as f32, f0 as f32);
+    let v: Vec<f64> = steady.iter().map(|s| s.string_velocity as f64).collect();
+    let v_b = cell.bow.velocity_m_per_s;
+    let stats = slip_stats(&v, v_b, fs, f0, 0.05 * v_b.abs());
+    let bowed = peak_frequency_hz(&audio[start..], fs, f0, 100.0);
+    let beta = cell.bow.position_beta;
+    let helmholtz = regime == Some(Regime::Helmholtz)
+        && (stats.slip_fraction - beta).abs() <= SLIP_FRACTION_TOLERANCE * beta
+        && (stats.stick_velocity_m_per_s - v_b).abs() <= STICK_TOLERANCE * v_b.abs();
+    Ok(Measured {
+        regime: if peak > 0.0 { regime } else { None },
+        slips_per_period: stats.slips_per_period,
+        slip_fraction: stats.slip_fraction,
+        stick_velocity_m_per_s: stats.stick_velocity_m_per_s,
+        cents: cents(bowed, f0),
+        helmholtz,
+        peak,
+    })
+}
+
+/// The notes a map covers on `kind`: the lowest open string to two octaves above the
+/// highest, every `step` semitones (the highest note always included).
+pub fn notes(kind: InstrumentKind, step: usize) -> Vec<u8> {
+    let open = kind.open_notes();
+    let (lo, hi) = (open[0], open[STRINGS - 1] + 24);
+    let mut v: Vec<u8> = (lo..=hi).step_by(step.max(1)).collect();
+    if v.last() != Some(&hi) {
+        v.push(hi);
+    }
+    v
+}
+
+/// What a run covers.
+#[derive(Debug, Clone)]
+pub struct Plan {
+    pub models: Vec<Model>,
+    pub kinds: Vec<InstrumentKind>,
+    pub note_step: usize,
+    pub bowings: Vec<Bowing>,
+    pub rates_hz: Vec<f64>,
+    pub seconds: f64,
+}
+
+impl Plan {
+    /// The full map: every semitone, the whole grid, the six host rates of issue 16.
+    pub fn full() -> Self {
+        Self {
+            models: Model::ALL.to_vec(),
+            kinds: InstrumentKind::ALL.to_vec(),
+            note_step: 1,
+            bowings: Bowing::all(false),
+            rates_hz: vec![44_100.0, 48_000.0, 88_200.0, 96_000.0, 176_400.0, 192_000.0],
+            seconds: 1.0,
+        }
+    }
+
+    /// The coarse subset: every fifth semitone, two grid forces at one beta, two rates.
+    pub fn quick() -> Self {
+        Self {
+            note_step: 5,
+            bowings: Bowing::all(true),
+            rates_hz: vec![44_100.0, 96_000.0],
+            seconds: 0.8,
+            ..Self::full()
+        }
+    }
+
+    pub fn cells(&self) -> Vec<Cell> {
+        let mut cells = Vec::new();
+        for &model in &self.models {
+            for &rate in &self.rates_hz {
+                for &kind in &self.kinds {
+                    for note in notes(kind, self.note_step) {
+                        for &bowing in &self.bowings {
+                            cells.push(Cell::new(model, kind, note, rate, bowing, self.seconds));
+                        }
+                    }
+                }
+            }
+        }
+        cells
+    }
+}
+
+/// Measures every cell of `plan` in parallel (rayon), with a progress bar on standard error
+/// when `progress` is set.
+pub fn run_plan(plan: &Plan, progress: bool) -> Result<Vec<(Cell, Measured)>, String> {
+    let cells = plan.cells();
+    let bar = if progress {
+        indicatif::ProgressBar::new(cells.len() as u64)
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{elapsed_precise} [{bar:40}] {pos}/{len} cells, eta {eta}",
+        )
+        .map_err(|e| e.to_string())?,
+    );
+    // Longest cells first, so the cores finish together.
+    let mut order: Vec<usize> = (0..cells.len()).collect();
+    order.sort_by(|&a, &b| cost(&cells[b]).total_cmp(&cost(&cells[a])));
+    let mut results: Vec<(usize, Result<Measured, String>)> = order
+        .into_par_iter()
+        .map(|i| {
+            let r = measure(&cells[i]);
+            bar.inc(1);
+            (i, r)
+        })
+        .collect();
+    bar.finish_and_clear();
+    results.sort_by_key(|r| r.0);
+    results
+        .into_iter()
+        .map(|(i, r)| r.map(|m| (cells[i], m)))
+        .collect()
+}
+
+/// A rough relative cost of a cell, for scheduling only.
+fn cost(cell: &Cell) -> f64 {
+    let per_sample = match cell.model {
+        Model::Point(FrictionModel::Hyperbolic) => 1.0,
+        Model::Point(_) => 4.0,
+        Model::Thermal => 0.0,
+    };
+    let thermal = if cell.model == Model::Thermal { 20.0 * 48_000.0 } else { 0.0 };
+    cell.seconds * (per_sample * cell.rate_hz + thermal)
+}
+
+/// Shares of one model at one rate.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Shares {
+    pub nominal_cells: usize,
+    /// Nominal cells within [`NOMINAL_CENTS`] (and Helmholtz).
+    pub nominal_in_tune: usize,
+    pub window_cells: usize,
+    /// Window cells within [`WINDOW_CENTS`] (and Helmholtz).
+    pub window_in_tune: usize,
+    /// Window cells in Helmholtz motion.
+    pub window_helmholtz: usize,
+    /// Nominal cells' median bowed pitch, cents (Helmholtz cells only).
+    pub nominal_median_cents: f64,
+}
+
+impl Shares {
+    pub fn of(results: &[(Cell, Measured)], model: Model, rate_hz: f64) -> Self {
+        let mut s = Shares::default();
+        let mut nominal_cents = Vec::new();
+        for (c, m) in results
+            .iter()
+            .filter(|(c, _)| c.model == model && c.rate_hz == rate_hz)
+        {
+            if c.bowing.is_nominal() {
+                s.nominal_cells += 1;
+                if m.helmholtz {
+                    nominal_cents.push(m.cents);
+                    if m.cents.abs() <= NOMINAL_CENTS {
+                        s.nominal_in_tune += 1;
+                    }
+                }
+            } else {
+                s.window_cells += 1;
+                if m.helmholtz {
+                    s.window_helmholtz += 1;
+                    if m.cents.abs() <= WINDOW_CENTS {
+                        s.window_in_tune += 1;
+                    }
+                }
+            }
+        }
+        nominal_cents.sort_by(f64::total_cmp);
+        s.nominal_median_cents = nominal_cents
+            .get(nominal_cents.len() / 2)
+            .copied()
+            .unwrap_or(f64::NAN);
+        s
+    }
+}
+
+fn percent(part: usize, whole: usize) -> f64 {
+    100.0 * part as f64 / whole.max(1) as f64
+}
+
+/// The CSV of every cell.
+pub fn csv(results: &[(Cell, Measured)]) -> String {
+    let mut s = String::from(
+        "model,instrument,note,rate_hz,bowing,velocity_m_per_s,force_n,beta,f_min_n,f_max_n,regime,slips_per_period,slip_fraction,stick_velocity_m_per_s,cents,helmholtz,peak\n",
+    );
+    for (c, m) in results {
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{},{:.4},{:.5},{},{:.5},{:.5},{},{:.3},{:.4},{:.4},{:.2},{},{:.4}",
+            c.model.name(),
+            c.kind.name(),
+            c.note,
+            c.rate_hz,
+            c.bowing.label(),
+            c.bow.velocity_m_per_s,
+            c.bow.force_n,
+            c.bow.position_beta,
+            c.f_min_n,
+            c.f_max_n,
+            regime_name(m.regime),
+            m.slips_per_period,
+            m.slip_fraction,
+            m.stick_velocity_m_per_s,
+            m.cents,
+            m.helmholtz,
+            m.peak
+        );
+    }
+    s
+}
+
+pub fn regime_name(r: Option<Regime>) -> String {
+    match r {
+        None => "refused".into(),
+        Some(Regime::Silent) => "silent".into(),
+        Some(Regime::Sliding) => "sliding".into(),
+        Some(Regime::Helmholtz) => "helmholtz".into(),
+        Some(Regime::MultipleSlips(n)) => format!("slips{n}"),
+        Some(Regime::Raucous) => "raucous".into(),
+    }
+}
+
+/// The summary table (markdown): per model and rate, the shares.
+pub fn summary(plan: &Plan, results: &[(Cell, Measured)]) -> String {
+    let mut s = String::from(
+        "| model | rate (kHz) | nominal in tune (±3 c) | nominal median (c) | window in tune (±10 c) | window Helmholtz |\n|---|---|---|---|---|---|\n",
+    );
+    for &model in &plan.models {
+        for &rate in &plan.rates_hz {
+            let sh = Shares::of(results, model, rate);
+            let _ = writeln!(
+                s,
+                "| {} | {} | {:.0} % ({}/{}) | {:+.1} | {:.0} % ({}/{}) | {:.0} % ({}/{}) |",
+                model.name(),
+                rate / 1000.0,
+                percent(sh.nominal_in_tune, sh.nominal_cells),
+                sh.nominal_in_tune,
+                sh.nominal_cells,
+                sh.nominal_median_cents,
+                percent(sh.window_in_tune, sh.window_cells),
+                sh.window_in_tune,
+                sh.window_cells,
+                percent(sh.window_helmholtz, sh.window_cells),
+                sh.window_helmholtz,
+                sh.window_cells,
+            );
+        }
+    }
+    s
+}
+
+/// `colophony bench playing-space --out DIR [--quick]`.
+pub fn run(out: &Path, quick: bool) -> Result<String, String> {
+    let plan = if quick { Plan::quick() } else { Plan::full() };
+    std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+    let t = std::time::Instant::now();
+    let results = run_plan(&plan, true)?;
+    let csv_path = out.join("playing-space.csv");
+    std::fs::write(&csv_path, csv(&results))
+        .map_err(|e| format!("cannot write {}: {e}", csv_path.display()))?;
+    let mut pngs = Vec::new();
+    for &model in &plan.models {
+        let path = out.join(format!("playing-space-{}.png", model.name()));
+        crate::playing_space_figure::draw(&plan, &results, model, &path)?;
+        pngs.push(path.display().to_string());
+    }
+    Ok(format!(
+        "{} cells in {:.0} s\n\n{}\nwrote {} and {}",
+        results.len(),
+        t.elapsed().as_secs_f64(),
+        summary(&plan, &results),
+        csv_path.display(),
+        pngs.join(", ")
+    ))
+}
