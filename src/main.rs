@@ -94,9 +94,20 @@ enum Command {
         /// Output directory (precision).
         #[arg(long)]
         out: Option<PathBuf>,
-        /// A one-minute variant with fewer configurations (precision).
+        /// A one-minute variant with fewer configurations (precision), or the coarse
+        /// subset of the map (playing-space).
         #[arg(long)]
         quick: bool,
+        /// playing-space: host rates in Hz, comma-separated (default: 44100, 48000, 88200,
+        /// 96000, 176400, 192000; with --quick 44100, 96000).
+        #[arg(long, value_delimiter = ',')]
+        rates: Vec<f64>,
+        /// playing-space: every Nth semitone (default 1; with --quick 5).
+        #[arg(long)]
+        step: Option<usize>,
+        /// playing-space: friction models, comma-separated (default all five).
+        #[arg(long, value_delimiter = ',')]
+        models: Vec<String>,
     },
     /// Fit a passive modal bridge admittance to measured data (CSV in, JSON out).
     FitBridge {
@@ -272,7 +283,14 @@ fn main() -> ExitCode {
             },
             other => colophony::figures::draw(other, &out),
         }),
-        Command::Bench { what, out, quick } => report(match what.as_str() {
+        Command::Bench {
+            what,
+            out,
+            quick,
+            rates,
+            step,
+            models,
+        } => report(match what.as_str() {
             "friction" => colophony::bench::friction_table(),
             "table1" => colophony::bench::table1(),
             "scenes" => colophony::bench::scenes(),
@@ -281,7 +299,8 @@ fn main() -> ExitCode {
                 None => Err("bench precision needs --out DIR".into()),
             },
             "playing-space" => match out {
-                Some(dir) => colophony::playing_space::run(&dir, quick),
+                Some(dir) => colophony::playing_space::Plan::from_options(quick, &rates, step, &models)
+                    .and_then(|plan| colophony::playing_space::run(&dir, &plan)),
                 None => Err("bench playing-space needs --out DIR".into()),
             },
             other => Err(format!(

@@ -366,6 +366,41 @@ impl Plan {
         }
     }
 
+    /// The full or quick plan with the command line's overrides: host rates (Hz), note
+    /// step, model names.
+    pub fn from_options(
+        quick: bool,
+        rates_hz: &[f64],
+        step: Option<usize>,
+        models: &[String],
+    ) -> Result<Self, String> {
+        let mut plan = if quick { Self::quick() } else { Self::full() };
+        if !rates_hz.is_empty() {
+            if let Some(bad) = rates_hz.iter().find(|r| !(r.is_finite() && **r >= 8000.0 && **r <= 384_000.0)) {
+                return Err(format!("rate {bad} Hz is outside 8000 .. 384000"));
+            }
+            plan.rates_hz = rates_hz.to_vec();
+        }
+        if let Some(step) = step {
+            plan.note_step = step.max(1);
+        }
+        if !models.is_empty() {
+            plan.models = models
+                .iter()
+                .map(|name| {
+                    Model::ALL
+                        .into_iter()
+                        .find(|m| m.name().eq_ignore_ascii_case(name))
+                        .ok_or_else(|| {
+                            let names: Vec<&str> = Model::ALL.iter().map(|m| m.name()).collect();
+                            format!("unknown model '{name}': choose from {}", names.join(", "))
+                        })
+                })
+                .collect::<Result<_, _>>()?;
+        }
+        Ok(plan)
+    }
+
     pub fn cells(&self) -> Vec<Cell> {
         let mut cells = Vec::new();
         for &model in &self.models {
@@ -554,8 +589,8 @@ pub fn summary(plan: &Plan, results: &[(Cell, Measured)]) -> String {
 }
 
 /// `colophony bench playing-space --out DIR [--quick]`.
-pub fn run(out: &Path, quick: bool) -> Result<String, String> {
-    let plan = if quick { Plan::quick() } else { Plan::full() };
+pub fn run(out: &Path, plan: &Plan) -> Result<String, String> {
+    let plan = plan.clone();
     std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
     let t = std::time::Instant::now();
     let results = run_plan(&plan, true)?;
