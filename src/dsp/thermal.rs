@@ -53,6 +53,10 @@ use std::f64::consts::PI;
 pub const FTCS_TARGET: f64 = 0.45;
 /// Most thermal sub-steps per sample before a configuration is refused.
 pub const MAX_THERMAL_SUBSTEPS: usize = 64;
+/// Fewest nodes a bow narrowed on a short string keeps (a point contact).
+pub const MIN_BOW_NODES: usize = 1;
+/// Samples of string the bow leaves free: one at the bridge, the rest toward the nut.
+pub const BOW_CLEARANCE: usize = 4;
 
 /// Temperature-dependent friction and heat (see the module doc).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -310,7 +314,9 @@ pub enum ThermalConfigError {
     Nodes(usize),
     Width(f64),
     Rate(f64),
-    /// The bow does not fit on the vibrating length (too high a note for this bow).
+    /// Not even one bow node fits on the vibrating length (too high a note for this
+    /// internal rate); a bow wider than the string but for that is narrowed instead
+    /// ([`ThermalString::set_fundamental`]).
     BowWiderThanString,
     /// The FTCS bound would need more than [`MAX_THERMAL_SUBSTEPS`] sub-steps.
     GridTooFine {
@@ -327,7 +333,9 @@ impl std::fmt::Display for ThermalConfigError {
             Self::Nodes(n) => write!(f, "the node count must be 1..=200, got {n}"),
             Self::Width(w) => write!(f, "the bow width must be 0.1..30 mm, got {w} m"),
             Self::Rate(r) => write!(f, "invalid internal rate {r}"),
-            Self::BowWiderThanString => write!(f, "the bow is wider than the string"),
+            Self::BowWiderThanString => {
+                write!(f, "the string is too short for one bow node at this internal rate")
+            }
             Self::GridTooFine { ratio, substeps } => write!(
                 f,
                 "thermal grid too fine: alpha dt / dx^2 = {ratio:.3} needs {substeps} sub-steps \
@@ -544,7 +552,14 @@ pub struct ThermalString {
     hair: HairParams,
     /// Transverse wave speed `2 L f0` (fixed by tension and density: stopping keeps it).
     c_m_per_s: f64,
+    /// Nodes under the bow now: the configured count, or fewer where the stopped string is
+    /// too short for the whole bow ([`ThermalString::set_fundamental_with_delay`]).
     nodes_count: usize,
+    /// Nodes the bow was configured with.
+    nodes_configured: usize,
+    /// `nodes_configured / nodes_count`: a narrowed bow keeps its total force, so each of
+    /// its nodes presses harder by this factor.
+    narrowing: f64,
     width_m: f64,
     dx_m: f64,
     internal_rate_hz: f64,
@@ -734,6 +749,8 @@ impl ThermalString {
             hair,
             c_m_per_s: c,
             nodes_count: 0,
+            nodes_configured: 0,
+            narrowing: 1.0,
             width_m: 0.0,
             dx_m: dx_min,
             internal_rate_hz: max_rate_hz,
@@ -803,20 +820,16 @@ impl ThermalString {
         if m + 4 > self.mask {
             return Err(ThermalConfigError::Capacity);
         }
-        if m < nodes + 4 {
+        if m < MIN_BOW_NODES + BOW_CLEARANCE {
             return Err(ThermalConfigError::BowWiderThanString);
         }
-        self.nodes_count = nodes;
+        self.nodes_configured = nodes;
         self.width_m = width_m;
         self.dx_m = dx;
         self.internal_rate_hz = fs;
         self.margin_nodes = margin_nodes;
         self.substeps = substeps;
-        self.nodes.resize(nodes);
-        for v in [&mut self.temperature, &mut self.temperature_next] {
-            v.clear();
-            v.resize(grid, 0.0);
-        }
+        self.set_nodes_under_bow(nodes.min(m - BOW_CLEARANCE));
         self.m = m;
         self.loss = [loss; 2];
         self.fraction = [Allpass1::new(a); 2];
@@ -824,6 +837,19 @@ impl ThermalString {
         self.ftcs = self.ftcs_consts();
         self.reset();
         Ok(())
+    }
+
+    /// Puts `n` nodes under the bow (at most the configured count), at rest, with a cool
+    /// grid. Never allocates: the capacity covers the configured count.
+    fn set_nodes_under_bow(&mut self, n: usize) {
+        self.nodes_count = n;
+        self.narrowing = self.nodes_configured as f64 / n as f64;
+        self.nodes.resize(n);
+        let grid = n + 2 * self.margin_nodes;
+        for v in [&mut self.temperature, &mut self.temperature_next] {
+            v.clear();
+            v.resize(grid, 0.0);
+        }
     }
 
     /// Eq. (1)'s sub-step constants at the current rate, spacing and sub-step count.
@@ -879,8 +905,12 @@ impl ThermalString {
 
     /// Stops the string so its fundamental is `f0_hz` (the wave speed stays, the vibrating
     /// length shortens): new loss filter, half-loop and Thiran delay, waves kept where they
-    /// are. Returns `false`, changing nothing, if the note does not fit (beyond the
-    /// capacity, or the bow would not fit on the vibrating length). Never allocates.
+    /// are. Where the stopped string is too short for the whole bow (fewer than
+    /// `nodes + 4` samples), the contact is narrowed to the nodes that fit, keeping the
+    /// bow's total force (a player tilts the bow on a short string), and widened back on a
+    /// longer note; changing the node count puts the bow's nodes at rest. Returns `false`,
+    /// changing nothing, if the note does not fit at all (beyond the capacity, or not one
+    /// node on the vibrating length at this rate). Never allocates.
     pub fn set_fundamental(&mut self, f0_hz: f64) -> bool {
         self.set_fundamental_with_delay(f0_hz, 0.0)
     }
@@ -899,8 +929,12 @@ impl ThermalString {
             extra_delay,
             self.termination_gain(),
         );
-        if m + 4 > self.mask || m < self.nodes_count + 4 {
+        if m + 4 > self.mask || m < MIN_BOW_NODES + BOW_CLEARANCE {
             return false;
+        }
+        let fit = self.nodes_configured.min(m - BOW_CLEARANCE);
+        if fit != self.nodes_count {
+            self.set_nodes_under_bow(fit);
         }
         self.spec.f0_hz = f0_hz;
         self.spec.length_m = self.c_m_per_s / (2.0 * f0_hz);
@@ -950,8 +984,14 @@ impl ThermalString {
         self.internal_rate_hz
     }
 
+    /// Nodes under the bow now (fewer than configured on a note too short for the bow).
     pub fn nodes(&self) -> usize {
         self.nodes_count
+    }
+
+    /// Nodes the bow was configured with.
+    pub fn nodes_configured(&self) -> usize {
+        self.nodes_configured
     }
 
     pub fn width_m(&self) -> f64 {
@@ -1137,7 +1177,7 @@ impl ThermalString {
         let centre = (bow.position_beta.clamp(0.01, 0.5) * m as f64 + 0.5) as usize;
         self.bow_start = centre.saturating_sub(n_b / 2).clamp(1, m - n_b - 1);
         let dx = self.dx_m;
-        let f_b = bow.force_per_m.max(0.0) * dx;
+        let f_b = bow.force_per_m.max(0.0) * dx * self.narrowing;
         let on = f_b > 0.0;
         if on {
             // A landing bow wakes the string (its sleeping lines hold zeros).

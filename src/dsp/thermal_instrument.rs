@@ -12,9 +12,12 @@
 //!
 //! **Notes.** As in [`super::instrument::Instrument`]: a note goes to the highest open
 //! string at or below it, stopped to sound it (the wave speed stays, the vibrating length
-//! shortens); the bow lands and lifts over [`BOW_RAMP_S`]. A note whose vibrating length
-//! cannot hold the bow plus a few samples is ignored (coarse bows on high notes). The bow
-//! force in newtons is spread evenly over the width: `F_b = F / w` (N/m).
+//! shortens); the bow lands and lifts over [`BOW_RAMP_S`]. Every playable note speaks: the
+//! internal rate never falls below [`MIN_SAMPLES_PER_TOP_PERIOD`] samples per period of
+//! the highest note, and where a stopped string is too short for the whole bow the contact
+//! is narrowed to the nodes that fit, keeping the total force
+//! ([`ThermalString::set_fundamental_with_delay`]). The bow force in newtons is spread
+//! evenly over the width: `F_b = F / w` (N/m).
 //!
 //! **Changing the bow** (node count, width) rebuilds the grid: the output fades out over
 //! [`RECONFIGURE_FADE_S`], the strings are reconfigured in place (no allocation) and the
@@ -61,6 +64,13 @@ pub const MIN_WIDTH_M: f64 = 0.005;
 pub const MAX_WIDTH_M: f64 = 0.02;
 /// Fade-out before the grid is rebuilt for a new node count or width, s.
 pub const RECONFIGURE_FADE_S: f64 = 0.01;
+/// The internal rate never gives the highest playable note (bent up) fewer samples per
+/// period than this: its half-loop then holds a bow node and the bow's clearance
+/// ([`super::thermal::BOW_CLEARANCE`]) with the filters' delay to spare, so every note
+/// speaks. Only coarse, wide bows reach the floor (violin: 71 kHz, against 125 kHz for
+/// Good's ten nodes over 1 cm); there the bow keeps its node count and is narrower than
+/// asked.
+pub const MIN_SAMPLES_PER_TOP_PERIOD: f64 = 16.0;
 
 /// The bow's discretisation.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -195,6 +205,9 @@ pub struct ThermalInstrument {
     bend_semitones: f64,
     /// The string the player asks notes to go to (0 = lowest), `None` for the usual choice.
     preferred_string: Option<usize>,
+    /// The bow's width on the lowest string at the current settings, m (the force is
+    /// spread over it).
+    contact_width_m: f64,
     ramp_step: f64,
     output_scale: f64,
     awake: bool,
@@ -251,7 +264,7 @@ impl ThermalInstrument {
             })
             .collect::<Result<Vec<_>, _>>()?;
         let settings = settings.clamped();
-        let rate = Self::internal_rate(&wave_speeds, settings);
+        let rate = Self::internal_rate(kind, &wave_speeds, settings);
         let mut instrument = Self {
             kind,
             settings,
@@ -277,6 +290,7 @@ impl ThermalInstrument {
             wave_speeds,
             bend_semitones: 0.0,
             preferred_string: None,
+            contact_width_m: settings.width_m,
             ramp_step: 1.0 / (BOW_RAMP_S * host_rate_hz).max(1.0),
             output_scale: kind.output_scale_per_n(),
             awake: false,
@@ -290,8 +304,19 @@ impl ThermalInstrument {
         Ok(instrument)
     }
 
-    fn internal_rate(wave_speeds: &[f64; STRINGS], settings: ThermalSettings) -> f64 {
-        wave_speeds[0] * settings.nodes as f64 / settings.width_m
+    /// `c_low N_B / w`, or the floor [`MIN_SAMPLES_PER_TOP_PERIOD`] sets by the highest
+    /// playable note.
+    fn internal_rate(kind: InstrumentKind, wave_speeds: &[f64; STRINGS], settings: ThermalSettings) -> f64 {
+        let top = kind.note_range().1 as f64 + PITCH_BEND_SEMITONES;
+        (wave_speeds[0] * settings.nodes as f64 / settings.width_m)
+            .max(MIN_SAMPLES_PER_TOP_PERIOD * midi_to_hz(top))
+    }
+
+    /// Width of the bow on the lowest string, m: the settings' width, or less where the
+    /// rate floor made the node spacing finer.
+    fn contact_width(&self, settings: ThermalSettings) -> f64 {
+        let rate = Self::internal_rate(self.kind, &self.wave_speeds, settings);
+        settings.nodes as f64 * self.wave_speeds[0] / rate
     }
 
     /// Nodes on string `i` for these settings: about the same width on every string.
@@ -323,13 +348,13 @@ impl ThermalInstrument {
 
     /// Reconfigures everything now (strings silenced, held notes re-landed).
     fn apply_settings(&mut self, settings: ThermalSettings) -> Result<(), ThermalConfigError> {
-        let rate = Self::internal_rate(&self.wave_speeds, settings);
+        let rate = Self::internal_rate(self.kind, &self.wave_speeds, settings);
         for i in 0..STRINGS {
             let nodes = self.nodes_on(i, settings);
             if let Err(e) = self.core.strings[i].configure(nodes, settings.width_m, rate) {
                 // Put every string back on the settings that worked.
                 let old = self.settings;
-                let old_rate = Self::internal_rate(&self.wave_speeds, old);
+                let old_rate = Self::internal_rate(self.kind, &self.wave_speeds, old);
                 for j in 0..=i {
                     let n = self.nodes_on(j, old);
                     let _ = self.core.strings[j].configure(n, old.width_m, old_rate);
@@ -338,6 +363,7 @@ impl ThermalInstrument {
             }
         }
         self.settings = settings;
+        self.contact_width_m = self.contact_width(settings);
         self.core.bridge.set_sample_rate(rate);
         // Within capacity by construction (rate <= the maximum rate).
         let _ = self.resampler.set_input_rate(rate);
@@ -379,7 +405,7 @@ impl ThermalInstrument {
     }
 
     pub fn internal_rate_hz(&self) -> f64 {
-        Self::internal_rate(&self.wave_speeds, self.settings)
+        Self::internal_rate(self.kind, &self.wave_speeds, self.settings)
     }
 
     /// Nodes on each string at the current settings.
@@ -539,7 +565,7 @@ impl ThermalInstrument {
                 return Frame::default();
             }
         }
-        let force_per_m = bow.force_n.max(0.0) / self.settings.width_m;
+        let force_per_m = bow.force_n.max(0.0) / self.contact_width_m;
         for (voice, control) in self.voices.iter_mut().zip(self.core.bows.iter_mut()) {
             let target = if voice.bowed { 1.0 } else { 0.0 };
             if voice.bow_gain != target {
