@@ -403,6 +403,11 @@ impl Plugin for Colophony {
             .newton_tolerance_m_per_s();
         self.instrument.set_newton_tolerance(tolerance);
         self.rubbed.set_newton_tolerance(tolerance);
+        let reference = p.reference_pitch.value() as f64;
+        self.instrument.set_reference_pitch(reference);
+        for engine in &mut self.thermal {
+            engine.set_reference_pitch(reference);
+        }
         let preferred = p.string.value().index();
         self.instrument.set_preferred_string(preferred);
         for engine in &mut self.thermal {

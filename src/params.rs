@@ -13,6 +13,7 @@
 //! | `bow_width` | Bow Width | mm of hair in contact (thermal model) | 5 .. 20 | 10 |
 //! | `string` | String | - | auto, I (highest) .. IV (lowest) | auto |
 //! | `quality` | Quality | - | draft, good, reference, auto, custom | good |
+//! | `reference_pitch` | Reference Pitch | Hz (A4) | 415 .. 466 | 440 |
 
 use crate::dsp::friction::FrictionModel;
 use crate::dsp::instrument::InstrumentKind;
@@ -202,6 +203,8 @@ pub struct ColophonyParams {
     pub string: EnumParam<StringChoice>,
     #[id = "quality"]
     pub quality: EnumParam<QualityChoice>,
+    #[id = "reference_pitch"]
+    pub reference_pitch: FloatParam,
     /// The editor window's size, saved with the plugin state (not a parameter).
     #[persist = "editor-state"]
     pub editor_state: crate::editor::EditorState,
@@ -233,6 +236,13 @@ pub fn bow_width_mm_range() -> FloatRange {
     FloatRange::Linear {
         min: (crate::dsp::thermal_instrument::MIN_WIDTH_M * 1e3) as f32,
         max: (crate::dsp::thermal_instrument::MAX_WIDTH_M * 1e3) as f32,
+    }
+}
+
+pub fn reference_pitch_range() -> FloatRange {
+    FloatRange::Linear {
+        min: crate::dsp::instrument::REFERENCE_HZ_MIN as f32,
+        max: crate::dsp::instrument::REFERENCE_HZ_MAX as f32,
     }
 }
 
@@ -283,6 +293,15 @@ impl Default for ColophonyParams {
                 .with_value_to_string(formatters::v2s_f32_rounded(1)),
             string: EnumParam::new("String", StringChoice::Auto),
             quality: EnumParam::new("Quality", QualityChoice::Good),
+            // Not smoothed: a change retunes the sounding notes at the next block.
+            reference_pitch: FloatParam::new(
+                "Reference Pitch",
+                crate::dsp::instrument::REFERENCE_HZ_DEFAULT as f32,
+                reference_pitch_range(),
+            )
+            .with_unit(" Hz")
+            .with_step_size(0.1)
+            .with_value_to_string(formatters::v2s_f32_rounded(1)),
             editor_state: Default::default(),
         }
     }

@@ -24,6 +24,25 @@ pub const MAX_STOP_SEMITONES: u8 = 31;
 pub const BOW_RAMP_S: f64 = 0.02;
 /// Pitch-bend range, semitones either way.
 pub const PITCH_BEND_SEMITONES: f64 = 2.0;
+/// Reference pitch A4, Hz: lowest (baroque pitch), default and highest (Venetian high
+/// pitch). Every note, open strings included, is tuned from it.
+pub const REFERENCE_HZ_MIN: f64 = 415.0;
+pub const REFERENCE_HZ_DEFAULT: f64 = 440.0;
+pub const REFERENCE_HZ_MAX: f64 = 466.0;
+/// Semitones the tuning can move every note (the reference pitch, then the bend) below
+/// and above its equal-tempered pitch at A4 = 440 Hz: the strings' delay lines and the
+/// thermal instrument's rate floor are sized for them.
+pub const LOWEST_TUNING_SEMITONES: f64 = -PITCH_BEND_SEMITONES - 1.013; // 12 log2(415/440)
+pub const HIGHEST_TUNING_SEMITONES: f64 = PITCH_BEND_SEMITONES + 0.993; // 12 log2(466/440)
+
+/// Semitones from A4 = 440 Hz to the reference `a4_hz` (clamped to
+/// [`REFERENCE_HZ_MIN`]..=[`REFERENCE_HZ_MAX`]; a NaN is the default).
+pub fn reference_semitones(a4_hz: f64) -> f64 {
+    if a4_hz.is_nan() {
+        return 0.0;
+    }
+    12.0 * (a4_hz.clamp(REFERENCE_HZ_MIN, REFERENCE_HZ_MAX) / REFERENCE_HZ_DEFAULT).log2()
+}
 /// A lifted string whose wave energy is below this sleeps (about -130 dB below a
 /// default bowed note's few millijoules).
 pub const SLEEP_ENERGY_J: f64 = 1e-16;
@@ -224,6 +243,8 @@ pub struct Instrument {
     voices: [StringVoice; STRINGS],
     body: BodyModes,
     bend_semitones: f64,
+    /// The reference pitch's offset from A4 = 440 Hz ([`reference_semitones`]).
+    reference_semitones: f64,
     /// The string the player asks notes to go to (0 = lowest), `None` for the usual choice.
     preferred_string: Option<usize>,
     probed: usize,
@@ -240,8 +261,9 @@ pub struct Instrument {
 impl Instrument {
     /// Allocates everything for this sample rate; instrument changes later do not allocate.
     pub fn new(kind: InstrumentKind, sample_rate_hz: f64) -> Self {
-        // Lowest fundamental any instrument can reach: cello C bent down.
-        let lowest_hz = midi_to_hz(36.0 - PITCH_BEND_SEMITONES) * 0.99;
+        // Lowest fundamental any instrument can reach: cello C bent down at the lowest
+        // reference pitch.
+        let lowest_hz = midi_to_hz(36.0 + LOWEST_TUNING_SEMITONES) * 0.99;
         let specs = kind.strings();
         let voices = std::array::from_fn(|i| StringVoice {
             string: WaveguideString::new(specs[i], sample_rate_hz, lowest_hz),
@@ -262,6 +284,7 @@ impl Instrument {
             voices,
             body: BodyModes::new(&kind.body_modes(), 1.0, sample_rate_hz),
             bend_semitones: 0.0,
+            reference_semitones: 0.0,
             preferred_string: None,
             probed: 0,
             ramp_step: 1.0 / (BOW_RAMP_S * sample_rate_hz),
@@ -314,7 +337,7 @@ impl Instrument {
     /// `None` if the instrument cannot play the note (it is then ignored).
     pub fn note_on(&mut self, note: u8) -> Option<usize> {
         let index = self.kind.string_for_note_on(note, self.preferred_string)?;
-        let bend = self.bend_semitones;
+        let bend = self.bend_semitones + self.reference_semitones;
         let voice = &mut self.voices[index];
         voice.string.stop_at(midi_to_hz(note as f64 + bend));
         voice.note = Some(note);
@@ -354,9 +377,26 @@ impl Instrument {
             return;
         }
         self.bend_semitones = semitones;
+        self.retune();
+    }
+
+    /// Tunes every note from the reference pitch `a4_hz` (415..466 Hz; see
+    /// [`reference_semitones`]); sounding notes follow at once.
+    pub fn set_reference_pitch(&mut self, a4_hz: f64) {
+        let semitones = reference_semitones(a4_hz);
+        if semitones == self.reference_semitones {
+            return;
+        }
+        self.reference_semitones = semitones;
+        self.retune();
+    }
+
+    /// Moves every stopped note to its pitch under the current bend and reference.
+    fn retune(&mut self) {
+        let offset = self.bend_semitones + self.reference_semitones;
         for voice in &mut self.voices {
             if let Some(note) = voice.note {
-                voice.string.bend_to(midi_to_hz(note as f64 + semitones));
+                voice.string.bend_to(midi_to_hz(note as f64 + offset));
             }
         }
     }
@@ -599,6 +639,35 @@ mod tests {
         );
         // Unplayable notes stay unplayable.
         assert_eq!(cello.string_for_note_on(35, Some(0)), None);
+    }
+
+    /// Issue 16, item 1: the reference pitch tunes every note, the lowest open string bent
+    /// down at 415 Hz and the highest stopped note bent up at 466 Hz included. The free
+    /// string's first partial is tuned exactly (as at 440 Hz), so its pitch is checked to
+    /// 0.05 cents: the peak estimator's resolution on one second of a decaying partial.
+    #[test]
+    fn the_reference_pitch_tunes_every_note_from_a4() {
+        use crate::analysis::{cents, peak_frequency_hz};
+        let fs = 48_000.0;
+        for (a4, note, bend) in [(415.0, 36u8, -2.0), (466.0, 57 + 31, 2.0), (415.0, 57, 0.0)] {
+            let mut cello = Instrument::new(InstrumentKind::Cello, fs);
+            cello.set_reference_pitch(a4);
+            cello.set_pitch_bend(bend);
+            let index = cello.note_on(note).unwrap();
+            let bow = BowControl::default();
+            for _ in 0..(0.2 * fs) as usize {
+                cello.tick(bow);
+            }
+            cello.note_off(note);
+            for _ in 0..(0.1 * fs) as usize {
+                cello.tick(bow);
+            }
+            let x: Vec<f64> = (0..fs as usize).map(|_| cello.tick(bow).audio).collect();
+            let want = a4 * 2f64.powf((note as f64 + bend - 69.0) / 12.0);
+            assert!((cello.string(index).fundamental_hz() - want).abs() < 1e-9 * want);
+            let got = peak_frequency_hz(&x, fs, want, 30.0);
+            assert!(cents(got, want).abs() < 0.05, "A4 = {a4}, note {note}: {} cents", cents(got, want));
+        }
     }
 
     #[test]

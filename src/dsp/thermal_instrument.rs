@@ -47,8 +47,9 @@
 use super::bridge::{solve_junction, BridgeMode, ModalBridge};
 use super::filters::flush_tiny;
 use super::instrument::{
-    midi_to_hz, BowControl, Frame, InstrumentKind, BOW_RAMP_S, PITCH_BEND_SEMITONES,
-    SLEEP_ENERGY_J, STRINGS,
+    midi_to_hz, reference_semitones, BowControl, Frame, InstrumentKind, BOW_RAMP_S,
+    HIGHEST_TUNING_SEMITONES, LOWEST_TUNING_SEMITONES, PITCH_BEND_SEMITONES, SLEEP_ENERGY_J,
+    STRINGS,
 };
 use super::resample::Resampler;
 use super::thermal::{
@@ -203,6 +204,8 @@ pub struct ThermalInstrument {
     /// Wave speed of each string, m/s.
     wave_speeds: [f64; STRINGS],
     bend_semitones: f64,
+    /// The reference pitch's offset from A4 = 440 Hz ([`reference_semitones`]).
+    reference_semitones: f64,
     /// The string the player asks notes to go to (0 = lowest), `None` for the usual choice.
     preferred_string: Option<usize>,
     /// The bow's width on the lowest string at the current settings, m (the force is
@@ -237,7 +240,7 @@ impl ThermalInstrument {
         let length = kind.string_length_m();
         let wave_speeds: [f64; STRINGS] = std::array::from_fn(|i| 2.0 * length * open[i].open_hz);
         let max_rate = wave_speeds[0] * MAX_NODES as f64 / MIN_WIDTH_M;
-        let lowest_hz = open[0].open_hz * 2f64.powf(-PITCH_BEND_SEMITONES / 12.0) * 0.99;
+        let lowest_hz = open[0].open_hz * 2f64.powf(LOWEST_TUNING_SEMITONES / 12.0) * 0.99;
         let strings = open
             .iter()
             .map(|s| {
@@ -289,6 +292,7 @@ impl ThermalInstrument {
             voices: [Voice::default(); STRINGS],
             wave_speeds,
             bend_semitones: 0.0,
+            reference_semitones: 0.0,
             preferred_string: None,
             contact_width_m: settings.width_m,
             ramp_step: 1.0 / (BOW_RAMP_S * host_rate_hz).max(1.0),
@@ -307,7 +311,7 @@ impl ThermalInstrument {
     /// `c_low N_B / w`, or the floor [`MIN_SAMPLES_PER_TOP_PERIOD`] sets by the highest
     /// playable note.
     fn internal_rate(kind: InstrumentKind, wave_speeds: &[f64; STRINGS], settings: ThermalSettings) -> f64 {
-        let top = kind.note_range().1 as f64 + PITCH_BEND_SEMITONES;
+        let top = kind.note_range().1 as f64 + HIGHEST_TUNING_SEMITONES;
         (wave_speeds[0] * settings.nodes as f64 / settings.width_m)
             .max(MIN_SAMPLES_PER_TOP_PERIOD * midi_to_hz(top))
     }
@@ -370,8 +374,8 @@ impl ThermalInstrument {
         for i in 0..STRINGS {
             self.voices[i].bow_gain = 0.0;
             let f0 = match self.voices[i].note {
-                Some(note) => midi_to_hz(note as f64 + self.bend_semitones),
-                None => self.kind.strings()[i].open_hz,
+                Some(note) => midi_to_hz(note as f64 + self.tuning_semitones()),
+                None => self.kind.strings()[i].open_hz * 2f64.powf(self.reference_semitones / 12.0),
             };
             if !self.tune(i, f0) {
                 self.voices[i] = Voice::default();
@@ -417,7 +421,7 @@ impl ThermalInstrument {
     /// play it with this bow.
     pub fn note_on(&mut self, note: u8) -> Option<usize> {
         let index = self.kind.string_for_note_on(note, self.preferred_string)?;
-        let f0 = midi_to_hz(note as f64 + self.bend_semitones);
+        let f0 = midi_to_hz(note as f64 + self.tuning_semitones());
         if !self.tune(index, f0) {
             return None;
         }
@@ -458,10 +462,32 @@ impl ThermalInstrument {
             return;
         }
         self.bend_semitones = semitones;
+        self.retune();
+    }
+
+    /// Tunes every note from the reference pitch `a4_hz` (415..466 Hz; see
+    /// [`reference_semitones`]); sounding notes follow at once.
+    pub fn set_reference_pitch(&mut self, a4_hz: f64) {
+        let semitones = reference_semitones(a4_hz);
+        if semitones == self.reference_semitones {
+            return;
+        }
+        self.reference_semitones = semitones;
+        self.retune();
+    }
+
+    /// Bend plus reference pitch, semitones from equal temperament at A4 = 440 Hz.
+    fn tuning_semitones(&self) -> f64 {
+        self.bend_semitones + self.reference_semitones
+    }
+
+    /// Moves every stopped note to its pitch under the current bend and reference.
+    fn retune(&mut self) {
+        let offset = self.tuning_semitones();
         for i in 0..STRINGS {
             if let Some(note) = self.voices[i].note {
-                if !self.tune(i, midi_to_hz(note as f64 + semitones)) {
-                    // Bent out of what the bow allows: lift it, the string rings on.
+                if !self.tune(i, midi_to_hz(note as f64 + offset)) {
+                    // Tuned out of what the bow allows: lift it, the string rings on.
                     self.voices[i].bowed = false;
                 }
             }
