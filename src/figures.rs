@@ -72,6 +72,8 @@ pub fn serafin_fig7(out: &Path) -> Result<String, String> {
         sample_rate_hz: fs,
         friction: FrictionModel::ElastoPlastic,
         bristle: BristleParams::waveguide_string(),
+        // Paper A's string is purely transverse.
+        torsion: false,
         ..RenderSettings::default()
     };
     let r = render(&settings).map_err(err)?;

@@ -29,6 +29,9 @@ pub struct RenderSettings {
     pub friction: FrictionModel,
     /// Bristle parameters for the LuGre and elasto-plastic laws.
     pub bristle: BristleParams,
+    /// Whether the bow feels the string's torsion (the plugin's string; off for paper A's
+    /// purely transverse string).
+    pub torsion: bool,
 }
 
 impl Default for RenderSettings {
@@ -42,6 +45,7 @@ impl Default for RenderSettings {
             release_s: None,
             friction: FrictionModel::Hyperbolic,
             bristle: BristleParams::waveguide_string(),
+            torsion: true,
         }
     }
 }
@@ -170,6 +174,7 @@ pub fn render_with(
         .set_bristle_params(settings.bristle)
         .map_err(RenderError::BadSetting)?;
     instrument.set_friction_model(settings.friction);
+    instrument.set_torsion(settings.torsion);
     configure(&mut instrument);
     instrument.note_on(settings.note);
     let mut out = Rendered::with_capacity(fs, frames);

@@ -24,6 +24,8 @@ fn cello_d(friction: FrictionModel, seconds: f64) -> RenderSettings {
         },
         sample_rate_hz: FS,
         friction,
+        // Paper A's string is purely transverse.
+        torsion: false,
         ..RenderSettings::default()
     }
 }

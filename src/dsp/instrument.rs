@@ -543,6 +543,14 @@ impl Instrument {
         }
     }
 
+    /// Turns the strings' torsion at the bow on (the default) or off
+    /// ([`WaveguideString::set_torsion`]).
+    pub fn set_torsion(&mut self, enabled: bool) {
+        for voice in &mut self.voices {
+            voice.string.set_torsion(enabled);
+        }
+    }
+
     /// Replaces the bristle parameters of every string (validated; real-time safe).
     pub fn set_bristle_params(&mut self, params: BristleParams) -> Result<(), String> {
         for voice in &mut self.voices {

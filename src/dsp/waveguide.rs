@@ -21,6 +21,17 @@
 //! | `Q1` | quality factor of the fundamental (paper A: 500) | 1 | §1.4 |
 //! | `Q_hi` | quality factor at ten times the fundamental | 1 | Artifastring decays, §1.4 |
 //! | `beta` | bow distance from the bridge over the vibrating length | 1 | player |
+//! | `Z_t` | torsional impedance at the surface, [`TORSION_IMPEDANCE_RATIO`] `Z0` | kg/s | CLM Stradivarius model (Serafin, Smith), PARAMETERS.md §1.4 |
+//! | `c_t` | torsional wave speed, [`TORSION_SPEED_RATIO`] times the transverse | m/s | same |
+//!
+//! **Torsion.** The bow rubs the string's surface, which moves with the transverse
+//! velocity plus the torsional one. The torsional waves are fast and heavily damped (Q of a
+//! few tens), so the bow feels them as a high-pass admittance `s / (s + w_c) / (2 Z_t)` in
+//! parallel with the transverse `1 / (2 Z0)` (see `Torsion`): it takes up part of every
+//! fast change of the friction force, which damps the ripple and the secondary slips of
+//! the Helmholtz motion. The playing-space map (docs/playing-space.md) measured what it
+//! changes. [`WaveguideString::set_torsion`] turns it off for paper A's purely transverse
+//! string. The probe's bow-point velocity is the surface's (what sticks to the bow).
 //!
 //! ```
 //! use colophony::dsp::friction::{BowInput, HyperbolicFriction};
@@ -100,7 +111,57 @@ pub struct WaveguideString {
     /// Most dispersion sections the fit may use.
     dispersion_cap: usize,
     fraction: Allpass1,
+    torsion: Torsion,
 }
+
+/// The string's torsional motion as the bow feels it: a high-pass admittance in parallel
+/// with the transverse one, `Y_t(s) = s / (s + w_c) / (2 Z_t)`. The bow drives the string's
+/// surface, which moves with the transverse velocity plus the torsional one. Above `w_c`
+/// the torsional waves (fast, and damped to a Q of a few tens) leave the bow as into an
+/// endless string of impedance `Z_t` on each side; below it the short twisted segment
+/// between bow and bridge is a stiff torsional spring and the surface follows the
+/// transverse motion: `w_c = c_t / (beta L)`. Discretised by the bilinear transform
+/// (pre-warped at `w_c`), which keeps it passive.
+#[derive(Debug, Clone, Copy, Default)]
+struct Torsion {
+    /// Instantaneous admittance `b0 / (2 Z_t)`, s/kg.
+    y0: f64,
+    /// `b1 / (2 Z_t)` (= -y0) and the pole coefficient `a1`.
+    y1: f64,
+    a1: f64,
+    /// Transposed direct-form state, m/s.
+    state: f64,
+    /// The bow index the coefficients were computed for.
+    index: usize,
+    /// Whether the bow feels the torsion (the default; off reproduces the papers' models).
+    enabled: bool,
+}
+
+impl Torsion {
+    fn design(&mut self, z_t: f64, w_c_rad_per_s: f64, fs: f64, index: usize, enabled: bool) {
+        let w = w_c_rad_per_s.min(0.45 * 2.0 * PI * fs);
+        // Bilinear with pre-warping: s = k (1 - z^-1) / (1 + z^-1), k = w / tan(w / 2 fs).
+        let k = w / (w / (2.0 * fs)).tan();
+        let b0 = k / (k + w);
+        // Off (paper A's rigid point contact): no admittance, the state stays 0.
+        self.y0 = if enabled { b0 / (2.0 * z_t) } else { 0.0 };
+        self.y1 = -self.y0;
+        self.a1 = (w - k) / (k + w);
+        self.index = index;
+    }
+
+    #[inline]
+    fn finish(&mut self, force_n: f64, v_t: f64) {
+        self.state = super::filters::flush_tiny(self.y1 * force_n - self.a1 * v_t);
+    }
+}
+
+/// Torsional over transverse wave speed (CLM's Stradivarius model after Serafin and Smith,
+/// PARAMETERS.md: 5.2).
+pub const TORSION_SPEED_RATIO: f64 = 5.2;
+/// Torsional over transverse characteristic impedance, both at the string's surface
+/// (the same model: 1.8 against 0.55 kg/s).
+pub const TORSION_IMPEDANCE_RATIO: f64 = 3.3;
 
 impl WaveguideString {
     /// Allocates delay lines long enough for any fundamental down to `lowest_hz` at this
@@ -123,6 +184,11 @@ impl WaveguideString {
             dispersion_stages: 0,
             dispersion_cap: DEFAULT_DISPERSION_STAGES,
             fraction: Allpass1::default(),
+            torsion: Torsion {
+                index: usize::MAX,
+                enabled: true,
+                ..Torsion::default()
+            },
         };
         s.stop_at(spec.open_hz);
         s
@@ -233,6 +299,31 @@ impl WaveguideString {
         self.m = m;
         self.loop_samples = n;
         self.fundamental_hz = f1_hz;
+        // The torsion's corner follows the pitch: redesigned at the next bow position.
+        self.torsion.index = usize::MAX;
+    }
+
+    /// The loop's delay in samples at angular frequency `w` (rad/sample): the two
+    /// half-loops plus each nut filter's phase delay there.
+    pub fn loop_delay_at(&self, w: f64) -> f64 {
+        2.0 * self.m as f64
+            + Allpass1::phase_delay(self.fraction.a, w)
+            + self.dispersion[..self.dispersion_stages]
+                .iter()
+                .map(|ap| Allpass1::phase_delay(ap.a, w))
+                .sum::<f64>()
+            + self.loss.phase_delay(w)
+    }
+
+    /// Frequency of the free loop's partial `n`, Hz: the `f` at which the loop holds `n`
+    /// periods, `f = n fs / D(2 pi f / fs)` (fixed point, from the stiff-string guess).
+    pub fn partial_hz(&self, n: usize) -> f64 {
+        let fs = self.sample_rate_hz;
+        let mut f = n as f64 * self.fundamental_hz;
+        for _ in 0..20 {
+            f = n as f64 * fs / self.loop_delay_at(2.0 * PI * f / fs);
+        }
+        f
     }
 
     /// Moves the bow to `beta` (distance from the bridge over the vibrating length).
@@ -240,6 +331,30 @@ impl WaveguideString {
     pub fn set_bow_position(&mut self, beta: f64) {
         let k = ((beta * self.loop_samples - 1.0) * 0.5).round();
         self.bow_index = (k.max(0.0) as usize).min(self.m - 2);
+        if self.bow_index != self.torsion.index {
+            self.design_torsion();
+        }
+    }
+
+    /// Turns the torsional admittance at the bow on (the default) or off (a purely
+    /// transverse string, as in paper A and McIntyre, Schumacher and Woodhouse). Real-time
+    /// safe; the torsional state restarts at rest.
+    pub fn set_torsion(&mut self, enabled: bool) {
+        if enabled != self.torsion.enabled {
+            self.torsion.enabled = enabled;
+            self.torsion.state = 0.0;
+            self.torsion.index = usize::MAX;
+        }
+    }
+
+    /// Torsion at the current bow point: `w_c = c_t / (beta L) = 2 r f1 / beta` rad/s with
+    /// `r` [`TORSION_SPEED_RATIO`] and beta the bow's grid position.
+    fn design_torsion(&mut self) {
+        let beta = self.effective_beta().max(1e-3);
+        let w_c = 2.0 * TORSION_SPEED_RATIO * self.fundamental_hz / beta;
+        let z_t = TORSION_IMPEDANCE_RATIO * self.spec.z0_kg_per_s;
+        self.torsion
+            .design(z_t, w_c, self.sample_rate_hz, self.bow_index, self.torsion.enabled);
     }
 
     pub fn reset(&mut self) {
@@ -248,6 +363,7 @@ impl WaveguideString {
         self.loss.reset();
         self.dispersion.iter_mut().for_each(Allpass1::reset);
         self.fraction.reset();
+        self.torsion.state = 0.0;
     }
 
     /// Energy of the string, J: `(Z0 / fs) * (sum(a^2 + b^2) + S)`, the travelling waves
@@ -292,12 +408,15 @@ impl WaveguideString {
         // Bow junction.
         let (ir, il) = (at(self.bow_index), at(m - 1 - self.bow_index));
         let v_h = self.right[ir] + self.left[il];
+        // The surface under the bow: transverse plus torsional velocity.
         let load = LoadLine {
-            free_velocity_m_per_s: v_h,
-            admittance_s_per_kg: admittance,
+            free_velocity_m_per_s: v_h + self.torsion.state,
+            admittance_s_per_kg: admittance + self.torsion.y0,
         };
         let force = contact.solve(load, bow);
         let dv = force * admittance;
+        let v_t = self.torsion.y0 * force + self.torsion.state;
+        self.torsion.finish(force, v_t);
         self.right[ir] += dv;
         self.left[il] += dv;
 
@@ -316,7 +435,7 @@ impl WaveguideString {
 
         StringOutput {
             bridge_force_n: 2.0 * z0 * at_bridge,
-            bow_point_velocity_m_per_s: v_h + dv,
+            bow_point_velocity_m_per_s: v_h + dv + v_t,
             friction_force_n: force,
         }
     }
@@ -409,6 +528,45 @@ fn fit_dispersion(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The torsional admittance at the bow: passive (real part never negative, so the
+    /// surface can only absorb the bow's work), `1 / (2 Z_t)` well above the corner
+    /// `w_c = c_t / (beta L)` and a small fraction of it well below, at every rate.
+    #[test]
+    fn the_torsional_admittance_is_a_passive_high_pass_with_its_corner_at_c_t_over_beta_l() {
+        for fs in [8_000.0, 44_100.0, 192_000.0] {
+            let mut s = WaveguideString::new(cello_d(), fs, 60.0);
+            s.set_bow_position(0.1);
+            let t = s.torsion;
+            let z_t = TORSION_IMPEDANCE_RATIO * cello_d().z0_kg_per_s;
+            let y = |f: f64| {
+                // Y(z) = y0 (1 - z^-1) / (1 + a1 z^-1) at z = e^jw.
+                let w = 2.0 * PI * f / fs;
+                let (c, sn) = (w.cos(), w.sin());
+                let num = (t.y0 * (1.0 - c), t.y0 * sn);
+                let den = (1.0 + t.a1 * c, -t.a1 * sn);
+                let d2 = den.0 * den.0 + den.1 * den.1;
+                (
+                    (num.0 * den.0 + num.1 * den.1) / d2,
+                    (num.1 * den.0 - num.0 * den.1) / d2,
+                )
+            };
+            let f_c = TORSION_SPEED_RATIO * s.fundamental_hz() / (PI * s.effective_beta());
+            for k in 1..400 {
+                let f = k as f64 / 400.0 * 0.5 * fs;
+                assert!(y(f).0 >= -1e-15, "fs {fs}: Re Y({f}) = {}", y(f).0);
+            }
+            let high = (0.2 * fs).max(4.0 * f_c).min(0.45 * fs);
+            if high > 3.0 * f_c {
+                let m = y(high).0.hypot(y(high).1) * 2.0 * z_t;
+                assert!(m > 0.85 && m < 1.0 + 1e-9, "fs {fs}: |Y| 2 Z_t = {m} at {high} Hz");
+            }
+            let low = 0.1 * f_c;
+            let m = y(low).0.hypot(y(low).1) * 2.0 * z_t;
+            // A first-order high-pass one decade below its corner: 1/sqrt(101).
+            assert!(m < 0.11, "fs {fs}: |Y| 2 Z_t = {m} at {low} Hz");
+        }
+    }
     use crate::dsp::friction::HyperbolicFriction;
 
     fn cello_d() -> StringSpec {
