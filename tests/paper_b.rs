@@ -617,3 +617,44 @@ fn every_note_speaks_with_every_bow_setting_at_every_host_rate() {
         }
     }
 }
+
+/// Issue 16, item 3: the explicit convective loss of eq. (1), `-h C_C |v| T` per
+/// sub-step, overshoots when `h C_C |v|` nears 1 (the node would lose more heat than it
+/// holds) and grows when it exceeds 2. The fastest slips the plugin allows (1.5 m/s at
+/// beta 0.02 slips at up to about v_b / beta = 75 m/s) on the coarsest bow (one node,
+/// 27 kHz: h C_C |v| up to 5.5) must keep every temperature excess finite and never below
+/// zero: cooling brings a node at most to the ambient temperature.
+#[test]
+fn the_thermal_grid_never_cools_below_ambient_or_blows_up_at_the_fastest_slips() {
+    for nodes in [1, 3, 10] {
+        let mut s = cello_c(nodes);
+        let fs = s.internal_rate_hz();
+        let bow = ThermalBowControl {
+            velocity_m_per_s: 1.5,
+            force_per_m: 1000.0,
+            position_beta: 0.02,
+        };
+        let mut lowest = f64::MAX;
+        let mut highest = f64::MIN;
+        let mut fastest = 0.0f64;
+        for i in 0..(0.5 * fs) as usize {
+            // Reversals every 20 ms drive the fastest slips again and again.
+            let sign = if (i / (0.02 * fs) as usize) % 2 == 0 { 1.0 } else { -1.0 };
+            s.tick(ThermalBowControl {
+                velocity_m_per_s: sign * bow.velocity_m_per_s,
+                ..bow
+            });
+            for &t in s.temperature_grid() {
+                lowest = lowest.min(t as f64);
+                highest = highest.max(t as f64);
+            }
+            for &v in s.node_sliding_velocities() {
+                fastest = fastest.max((v as f64).abs());
+            }
+        }
+        println!("N_B {nodes}: temperature excess {lowest:.3e} .. {highest:.1} K, fastest slip {fastest:.1} m/s, h C_C |v| up to {:.2}", fastest * ThermalParams::default().c_c_per_m / fs / s.thermal_substeps() as f64);
+        assert!(highest.is_finite() && highest < 1e4, "N_B {nodes}: {highest} K");
+        // f32 rounding of a cooled node: a few ulps of the largest value.
+        assert!(lowest >= -1e-4 * highest.max(1.0), "N_B {nodes}: {lowest} K");
+    }
+}

@@ -857,10 +857,12 @@ impl ThermalString {
         let p = self.thermal;
         let dx = self.dx_m;
         let h = 1.0 / self.internal_rate_hz / self.substeps as f64;
+        let r = p.diffusivity_m2_per_s * h / (dx * dx);
         FtcsConsts {
-            r: (p.diffusivity_m2_per_s * h / (dx * dx)) as NodeReal,
+            r: r as NodeReal,
             heat: (h * p.c_h_kelvin_m_per_j / dx) as NodeReal,
             cool: (h * p.c_c_per_m) as NodeReal,
+            max_cool: (1.0 - 2.0 * r).max(0.0) as NodeReal,
         }
     }
 
@@ -1414,11 +1416,21 @@ impl ThermalString {
 
 /// The per-sub-step constants of eq. (1) (set with the configuration): the FTCS ratio
 /// `r = alpha h / dx^2`, the heating `h C_H / dx` and the cooling `h C_C`, `h` the sub-step.
+///
+/// The convective loss `h C_C |v| T` is explicit: once `h C_C |v|` passes `1 - 2 r`, a
+/// node's new temperature would take a negative weight of its old one (it would lose more
+/// heat than it holds, and beyond 2 the loss grows without bound: fast slips on a coarse
+/// grid, a few m/s at N_B 1). The loss factor is therefore capped at `max_cool = 1 - 2 r`,
+/// which keeps every weight of the update non-negative and their sum at most 1: the grid
+/// obeys the maximum principle (never below ambient, never above what the heating put
+/// in) at any slip velocity. Below the cap, which is every sample of ordinary playing,
+/// the update is unchanged.
 #[derive(Debug, Clone, Copy, Default)]
 struct FtcsConsts {
     r: NodeReal,
     heat: NodeReal,
     cool: NodeReal,
+    max_cool: NodeReal,
 }
 
 /// [`flush_tiny`] (same threshold) for the grid's float type.
@@ -1442,7 +1454,12 @@ fn ftcs_step(
     vd: &[NodeReal],
     force: &[NodeReal],
 ) {
-    let FtcsConsts { r, heat, cool } = k;
+    let FtcsConsts {
+        r,
+        heat,
+        cool,
+        max_cool,
+    } = k;
     let n = t.len();
     let next = &mut next[..n];
     if n == 1 {
@@ -1461,13 +1478,38 @@ fn ftcs_step(
     let t_bow = &t[off..off + n_b];
     for (((out, tj), vd), f) in bow.iter_mut().zip(t_bow).zip(vd).zip(&force[..n_b]) {
         let v = vd.abs();
-        *out = flush_tiny_node(*out + heat * f.abs() * v - cool * tj * v);
+        *out = flush_tiny_node(*out + heat * f.abs() * v - (cool * v).min(max_cool) * tj);
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The capped convective loss (see [`FtcsConsts`]): at a slip far beyond the cap (here
+    /// `h C_C |v|` = 50) a hot node cools at most to ambient in one sub-step and never
+    /// goes negative or grows; below the cap the loss is the explicit `h C_C |v| T`.
+    #[test]
+    fn the_convective_loss_never_takes_a_node_below_ambient() {
+        let k = FtcsConsts {
+            r: 0.2,
+            heat: 0.0,
+            cool: 0.5,
+            max_cool: 0.6,
+        };
+        let t = [0.0, 10.0, 10.0, 10.0, 0.0];
+        let mut next = [0.0; 5];
+        for (v, want_middle) in [
+            // 0.5 * 0.1 = 0.05 below the cap: 10 + 0.2 * (10 - 20 + 10) - 0.05 * 10.
+            (0.1, 9.5),
+            // Capped at 0.6: 10 - 0.6 * 10 = 4 (uncapped: 10 - 50 * 10 = -490).
+            (100.0, 4.0),
+        ] {
+            ftcs_step(k, &t, &mut next, 1, &[v; 3], &[1.0; 3]);
+            assert!((next[2] - want_middle).abs() < 1e-5, "v {v}: {}", next[2]);
+            assert!(next.iter().all(|x| *x >= 0.0 && *x <= 10.0), "v {v}: {next:?}");
+        }
+    }
 
     #[test]
     fn reflections_of_psd_admittances_are_passive() {
