@@ -40,8 +40,10 @@ pub fn draw(name: &str, out: &Path) -> Result<String, String> {
         "serafin-fig7" => serafin_fig7(out),
         "serafin-modal" => serafin_modal(out),
         "maestre-fig6" => maestre_fig6(out),
+        "maestre-fig7" => maestre_fig7(out),
+        "maestre-fig8" => maestre_fig8(out),
         other => Err(format!(
-            "unknown figure '{other}': choose serafin-fig7, serafin-modal, maestre-fig6 or bridge-fit"
+            "unknown figure '{other}': choose serafin-fig7, serafin-modal, maestre-fig6, maestre-fig7, maestre-fig8 or bridge-fit"
         )),
     }
 }
@@ -447,6 +449,225 @@ pub fn maestre_fig6(out: &Path) -> Result<String, String> {
             grid.iter().enumerate().map(|(i, v)| (i as f64, *v)),
             &RED,
         ))
+        .map_err(err)?;
+    root.present().map_err(err)?;
+    Ok(format!("wrote {}", out.display()))
+}
+
+/// Per-node values over time: `rows[k][i]` is node `i` at column `k`.
+struct NodeMovie {
+    rows: Vec<Vec<f64>>,
+    t_end_ms: f64,
+}
+
+/// Runs paper B's Figure 6 bow (cello open C, v_b 0.15 m/s, beta 0.07, 300 N/m, 60 nodes
+/// over 1 cm) with `hair`, settles for 1.5 s, then records two periods of each per-node
+/// quantity `take` returns (one value per node), and the total normal force.
+fn fig6_movie(
+    hair: crate::dsp::thermal::HairParams,
+    takes: &[&dyn Fn(&crate::dsp::thermal::ThermalString) -> Vec<f64>],
+) -> Result<(Vec<NodeMovie>, Vec<(f64, f64)>), String> {
+    use crate::dsp::thermal::{ThermalBowControl, ThermalParams, ThermalString, ThermalStringSpec};
+    let mut s = ThermalString::new(
+        ThermalStringSpec::cello_c(),
+        60,
+        0.01,
+        ThermalParams::default(),
+        hair,
+    )?;
+    let bow = ThermalBowControl {
+        velocity_m_per_s: 0.15,
+        force_per_m: 300.0,
+        position_beta: 0.07,
+    };
+    let fs = s.internal_rate_hz();
+    for _ in 0..(1.5 * fs) as usize {
+        s.tick(bow);
+    }
+    let shown = (2.0 * fs / 65.41) as usize;
+    let every = (shown / 600).max(1);
+    let mut movies: Vec<NodeMovie> = takes
+        .iter()
+        .map(|_| NodeMovie {
+            rows: Vec::new(),
+            t_end_ms: 1e3 * shown as f64 / fs,
+        })
+        .collect();
+    let mut total = Vec::new();
+    for k in 0..shown {
+        let f = s.tick(bow);
+        total.push((1e3 * k as f64 / fs, f.normal_force_n));
+        if k % every == 0 {
+            for (movie, take) in movies.iter_mut().zip(takes) {
+                movie.rows.push(take(&s));
+            }
+        }
+    }
+    Ok((movies, total))
+}
+
+/// A node-time map with the nut side at the top: blue negative, white zero, red
+/// positive, scaled to the largest magnitude.
+fn node_map(
+    area: &DrawingArea<BitMapBackend, plotters::coord::Shift>,
+    title: &str,
+    movie: &NodeMovie,
+) -> Result<(), String> {
+    let nodes = movie.rows.first().map_or(1, |r| r.len());
+    let peak = movie
+        .rows
+        .iter()
+        .flatten()
+        .fold(1e-30, |m: f64, v| m.max(v.abs()));
+    let mut chart = ChartBuilder::on(area)
+        .margin(10)
+        .x_label_area_size(35)
+        .y_label_area_size(60)
+        .caption(
+            format!("{title} (colour scale +-{peak:.2e})"),
+            ("sans-serif", 18),
+        )
+        .build_cartesian_2d(0.0..movie.t_end_ms, 0.0..nodes as f64)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("time (ms)")
+        .y_desc("node (nut side at the top)")
+        .disable_mesh()
+        .draw()
+        .map_err(err)?;
+    let cols = movie.rows.len();
+    let dt = movie.t_end_ms / cols as f64;
+    chart
+        .draw_series(movie.rows.iter().enumerate().flat_map(|(c, row)| {
+            row.iter().enumerate().map(move |(i, v)| {
+                let u = (v / peak).clamp(-1.0, 1.0);
+                let colour = if u >= 0.0 {
+                    RGBColor(255, (255.0 * (1.0 - u)) as u8, (255.0 * (1.0 - u)) as u8)
+                } else {
+                    RGBColor((255.0 * (1.0 + u)) as u8, (255.0 * (1.0 + u)) as u8, 255)
+                };
+                // Higher node indices are nearer the nut: drawn at the top.
+                Rectangle::new(
+                    [
+                        (c as f64 * dt, i as f64),
+                        ((c + 1) as f64 * dt, (i + 1) as f64),
+                    ],
+                    colour.filled(),
+                )
+            })
+        }))
+        .map_err(err)?;
+    Ok(())
+}
+
+/// Paper B, Figure 7: the friction force and the hair's relative (sliding) velocity over
+/// the bow's width and two periods of the Figure 6 motion, seen from the nut side.
+pub fn maestre_fig7(out: &Path) -> Result<String, String> {
+    use crate::dsp::thermal::HairParams;
+    fonts();
+    let force = |s: &crate::dsp::thermal::ThermalString| -> Vec<f64> {
+        s.node_forces().iter().map(|v| f64::from(*v)).collect()
+    };
+    let sliding = |s: &crate::dsp::thermal::ThermalString| -> Vec<f64> {
+        s.node_sliding_velocities()
+            .iter()
+            .map(|v| f64::from(*v))
+            .collect()
+    };
+    let (movies, _) = fig6_movie(HairParams::default(), &[&force, &sliding])?;
+    let root = BitMapBackend::new(out, (1400, 900)).into_drawing_area();
+    root.fill(&WHITE).map_err(err)?;
+    let root = root
+        .titled(
+            "Paper B, Fig. 7: cello open C, Fig. 6 bow; friction force and hair relative velocity per node, from the nut side",
+            ("sans-serif", 22),
+        )
+        .map_err(err)?;
+    let panels = root.split_evenly((2, 1));
+    node_map(&panels[0], "Friction force per node (N)", &movies[0])?;
+    node_map(
+        &panels[1],
+        "Sliding velocity of string over hair per node (m/s)",
+        &movies[1],
+    )?;
+    root.present().map_err(err)?;
+    Ok(format!("wrote {}", out.display()))
+}
+
+/// Paper B, Figure 8: the normal (vertical) force per node over two periods of the
+/// Figure 6 motion, with the default hair and with ten times its vertical damping, and
+/// the total normal force of both.
+pub fn maestre_fig8(out: &Path) -> Result<String, String> {
+    use crate::dsp::thermal::HairParams;
+    fonts();
+    let normal = |s: &crate::dsp::thermal::ThermalString| -> Vec<f64> {
+        s.node_normal_forces()
+            .iter()
+            .map(|v| f64::from(*v))
+            .collect()
+    };
+    let default_hair = HairParams::default();
+    let damped = HairParams {
+        vertical_c_kg_per_s_per_m: 10.0 * default_hair.vertical_c_kg_per_s_per_m,
+        ..default_hair
+    };
+    let (mut a, total_a) = fig6_movie(default_hair, &[&normal])?;
+    let (mut b, total_b) = fig6_movie(damped, &[&normal])?;
+    // The bow's static share (about 0.05 N a node) would hide the motion: the maps show
+    // each node's departure from its own mean over the two periods.
+    for movie in [&mut a[0], &mut b[0]] {
+        let nodes = movie.rows.first().map_or(0, |r| r.len());
+        let cols = movie.rows.len().max(1) as f64;
+        for i in 0..nodes {
+            let mean = movie.rows.iter().map(|r| r[i]).sum::<f64>() / cols;
+            for r in &mut movie.rows {
+                r[i] -= mean;
+            }
+        }
+    }
+    let root = BitMapBackend::new(out, (1400, 1200)).into_drawing_area();
+    root.fill(&WHITE).map_err(err)?;
+    let root = root
+        .titled(
+            "Paper B, Fig. 8: normal force per node, Fig. 6 bow; default hair and ten times its vertical damping",
+            ("sans-serif", 22),
+        )
+        .map_err(err)?;
+    let panels = root.split_evenly((3, 1));
+    node_map(
+        &panels[0],
+        "Normal force per node minus its mean, default hair (N)",
+        &a[0],
+    )?;
+    node_map(
+        &panels[1],
+        "Normal force per node minus its mean, 10x vertical hair damping (N)",
+        &b[0],
+    )?;
+    let (lo, hi) = range(total_a.iter().chain(&total_b).map(|p| p.1));
+    let t_end = total_a.last().map_or(1.0, |p| p.0);
+    let mut chart = ChartBuilder::on(&panels[2])
+        .margin(10)
+        .x_label_area_size(35)
+        .y_label_area_size(60)
+        .caption(
+            "Total normal force (black default, red 10x damping)",
+            ("sans-serif", 18),
+        )
+        .build_cartesian_2d(0.0..t_end, lo..hi)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("time (ms)")
+        .y_desc("N")
+        .draw()
+        .map_err(err)?;
+    chart
+        .draw_series(LineSeries::new(total_a.iter().copied(), &BLACK))
+        .map_err(err)?;
+    chart
+        .draw_series(LineSeries::new(total_b.iter().copied(), &RED))
         .map_err(err)?;
     root.present().map_err(err)?;
     Ok(format!("wrote {}", out.display()))

@@ -263,7 +263,8 @@ pub fn render_cell(cell: &Cell) -> Result<(Vec<f64>, Vec<ContactSample>), String
                 nodes: GOOD_NODES,
                 width_m: 0.01,
             };
-            let mut engine = ThermalInstrument::new(cell.kind, &bridge.modes, cell.rate_hz, settings)?;
+            let mut engine =
+                ThermalInstrument::new(cell.kind, &bridge.modes, cell.rate_hz, settings)?;
             engine.note_on(cell.note);
             for i in 0..n {
                 if i % BLOCK == 0 {
@@ -376,7 +377,10 @@ impl Plan {
     ) -> Result<Self, String> {
         let mut plan = if quick { Self::quick() } else { Self::full() };
         if !rates_hz.is_empty() {
-            if let Some(bad) = rates_hz.iter().find(|r| !(r.is_finite() && **r >= 8000.0 && **r <= 384_000.0)) {
+            if let Some(bad) = rates_hz
+                .iter()
+                .find(|r| !(r.is_finite() && **r >= 8000.0 && **r <= 384_000.0))
+            {
                 return Err(format!("rate {bad} Hz is outside 8000 .. 384000"));
             }
             plan.rates_hz = rates_hz.to_vec();
@@ -459,7 +463,11 @@ fn cost(cell: &Cell) -> f64 {
         Model::Point(_) => 4.0,
         Model::Thermal => 0.0,
     };
-    let thermal = if cell.model == Model::Thermal { 20.0 * 48_000.0 } else { 0.0 };
+    let thermal = if cell.model == Model::Thermal {
+        20.0 * 48_000.0
+    } else {
+        0.0
+    };
     cell.seconds * (per_sample * cell.rate_hz + thermal)
 }
 

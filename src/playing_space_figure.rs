@@ -31,12 +31,19 @@ fn colour(m: &Measured) -> RGBColor {
 }
 
 fn note_name(note: u8) -> String {
-    const NAMES: [&str; 12] = ["C", "C#", "D", "D#", "E", "F", "F#", "G", "G#", "A", "A#", "B"];
+    const NAMES: [&str; 12] = [
+        "C", "C#", "D", "D#", "E", "F", "F#", "G", "G#", "A", "A#", "B",
+    ];
     format!("{}{}", NAMES[note as usize % 12], note as i32 / 12 - 1)
 }
 
 /// Draws `model`'s map to `out`.
-pub fn draw(plan: &Plan, results: &[(Cell, Measured)], model: Model, out: &Path) -> Result<(), String> {
+pub fn draw(
+    plan: &Plan,
+    results: &[(Cell, Measured)],
+    model: Model,
+    out: &Path,
+) -> Result<(), String> {
     crate::figures::fonts();
     let err = |e: &dyn std::fmt::Display| e.to_string();
     let columns = plan

@@ -602,7 +602,10 @@ fn every_note_speaks_with_every_bow_setting_at_every_host_rate() {
                 for note in notes {
                     engine.reset();
                     let string = engine.note_on(note);
-                    assert!(string.is_some(), "{kind:?} note {note}, {nodes} nodes over {width_m} m at {rate} Hz refused");
+                    assert!(
+                        string.is_some(),
+                        "{kind:?} note {note}, {nodes} nodes over {width_m} m at {rate} Hz refused"
+                    );
                     let n = (0.05 * rate) as usize;
                     let out: Vec<f64> = (0..n).map(|_| engine.tick(bow).audio).collect();
                     assert!(out.iter().all(|x| x.is_finite()));
@@ -639,7 +642,11 @@ fn the_thermal_grid_never_cools_below_ambient_or_blows_up_at_the_fastest_slips()
         let mut fastest = 0.0f64;
         for i in 0..(0.5 * fs) as usize {
             // Reversals every 20 ms drive the fastest slips again and again.
-            let sign = if (i / (0.02 * fs) as usize) % 2 == 0 { 1.0 } else { -1.0 };
+            let sign = if (i / (0.02 * fs) as usize) % 2 == 0 {
+                1.0
+            } else {
+                -1.0
+            };
             s.tick(ThermalBowControl {
                 velocity_m_per_s: sign * bow.velocity_m_per_s,
                 ..bow
@@ -653,8 +660,14 @@ fn the_thermal_grid_never_cools_below_ambient_or_blows_up_at_the_fastest_slips()
             }
         }
         println!("N_B {nodes}: temperature excess {lowest:.3e} .. {highest:.1} K, fastest slip {fastest:.1} m/s, h C_C |v| up to {:.2}", fastest * ThermalParams::default().c_c_per_m / fs / s.thermal_substeps() as f64);
-        assert!(highest.is_finite() && highest < 1e4, "N_B {nodes}: {highest} K");
+        assert!(
+            highest.is_finite() && highest < 1e4,
+            "N_B {nodes}: {highest} K"
+        );
         // f32 rounding of a cooled node: a few ulps of the largest value.
-        assert!(lowest >= -1e-4 * highest.max(1.0), "N_B {nodes}: {lowest} K");
+        assert!(
+            lowest >= -1e-4 * highest.max(1.0),
+            "N_B {nodes}: {lowest} K"
+        );
     }
 }

@@ -2,11 +2,11 @@
 //! every fifth semitone from the lowest open string to two octaves above the highest, at
 //! 44.1 and 96 kHz, through the engines the plugin plays (`colophony::playing_space`).
 
+use colophony::dsp::instrument::InstrumentKind;
 use colophony::editor::regime::Regime;
 use colophony::playing_space::{
     measure, notes, regime_name, run_plan, Bowing, Cell, Measured, Model, Plan,
 };
-use colophony::dsp::instrument::InstrumentKind;
 use rayon::prelude::*;
 
 const RATES: [f64; 2] = [44_100.0, 96_000.0];
@@ -70,7 +70,12 @@ fn every_note_of_every_model_speaks_at_nominal_bowing() {
             quiet.push(describe(c, m));
         }
     }
-    assert!(quiet.is_empty(), "{} quiet notes:\n{}", quiet.len(), quiet.join("\n"));
+    assert!(
+        quiet.is_empty(),
+        "{} quiet notes:\n{}",
+        quiet.len(),
+        quiet.join("\n")
+    );
 }
 
 /// Far below Schelleng's lower limit (a tenth of `F_min`) no model shows Helmholtz motion:
@@ -84,7 +89,12 @@ fn far_below_the_window_no_model_is_in_helmholtz_motion() {
         .filter(|(_, m)| m.regime == Some(Regime::Helmholtz) || m.helmholtz)
         .map(|(c, m)| describe(c, m))
         .collect();
-    assert!(wrong.is_empty(), "{} cells:\n{}", wrong.len(), wrong.join("\n"));
+    assert!(
+        wrong.is_empty(),
+        "{} cells:\n{}",
+        wrong.len(),
+        wrong.join("\n")
+    );
 }
 
 /// Far above Schelleng's upper limit (eight times `F_max`) the static friction laws
@@ -113,7 +123,12 @@ fn far_above_the_window_the_static_laws_are_never_in_helmholtz_motion() {
         .filter(|(_, m)| m.regime == Some(Regime::Helmholtz) || m.helmholtz)
         .map(|(c, m)| describe(c, m))
         .collect();
-    assert!(wrong.is_empty(), "{} cells:\n{}", wrong.len(), wrong.join("\n"));
+    assert!(
+        wrong.is_empty(),
+        "{} cells:\n{}",
+        wrong.len(),
+        wrong.join("\n")
+    );
 }
 
 /// Issue 16, item 2, on the coarse subset: inside the window every model is in Helmholtz
@@ -134,5 +149,11 @@ fn inside_the_window_every_model_is_in_helmholtz_motion() {
         .filter(|(c, m)| !c.bowing.is_nominal() && !m.helmholtz)
         .map(|(c, m)| describe(c, m))
         .collect();
-    assert!(wrong.is_empty(), "{} of {} cells:\n{}", wrong.len(), results.len(), wrong.join("\n"));
+    assert!(
+        wrong.is_empty(),
+        "{} of {} cells:\n{}",
+        wrong.len(),
+        results.len(),
+        wrong.join("\n")
+    );
 }

@@ -168,7 +168,13 @@ fn presets_and_friction_laws_render_and_unknown_names_fail_cleanly() {
 
 #[test]
 fn paper_figures_are_written_as_png() {
-    for name in ["serafin-fig7", "serafin-modal", "maestre-fig6"] {
+    for name in [
+        "serafin-fig7",
+        "serafin-modal",
+        "maestre-fig6",
+        "maestre-fig7",
+        "maestre-fig8",
+    ] {
         let out = scratch(&format!("{name}.png"));
         let run = colophony(&["figure", name, "--out", out.to_str().unwrap()]);
         assert!(

@@ -674,7 +674,11 @@ mod tests {
             let want = a4 * 2f64.powf((note as f64 + bend - 69.0) / 12.0);
             assert!((cello.string(index).fundamental_hz() - want).abs() < 1e-9 * want);
             let got = peak_frequency_hz(&x, fs, want, 30.0);
-            assert!(cents(got, want).abs() < 0.05, "A4 = {a4}, note {note}: {} cents", cents(got, want));
+            assert!(
+                cents(got, want).abs() < 0.05,
+                "A4 = {a4}, note {note}: {} cents",
+                cents(got, want)
+            );
         }
     }
 

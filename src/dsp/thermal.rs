@@ -334,7 +334,10 @@ impl std::fmt::Display for ThermalConfigError {
             Self::Width(w) => write!(f, "the bow width must be 0.1..30 mm, got {w} m"),
             Self::Rate(r) => write!(f, "invalid internal rate {r}"),
             Self::BowWiderThanString => {
-                write!(f, "the string is too short for one bow node at this internal rate")
+                write!(
+                    f,
+                    "the string is too short for one bow node at this internal rate"
+                )
             }
             Self::GridTooFine { ratio, substeps } => write!(
                 f,
@@ -1037,6 +1040,12 @@ impl ThermalString {
         &self.nodes.force
     }
 
+    /// Normal (vertical) force per node on the last sample, N: the bow's share plus what
+    /// the hair's vertical motion adds.
+    pub fn node_normal_forces(&self) -> &[NodeReal] {
+        &self.nodes.normal
+    }
+
     /// Sliding velocity per node on the last sample, m/s.
     pub fn node_sliding_velocities(&self) -> &[NodeReal] {
         &self.nodes.v_delta
@@ -1507,7 +1516,10 @@ mod tests {
         ] {
             ftcs_step(k, &t, &mut next, 1, &[v; 3], &[1.0; 3]);
             assert!((next[2] - want_middle).abs() < 1e-5, "v {v}: {}", next[2]);
-            assert!(next.iter().all(|x| *x >= 0.0 && *x <= 10.0), "v {v}: {next:?}");
+            assert!(
+                next.iter().all(|x| *x >= 0.0 && *x <= 10.0),
+                "v {v}: {next:?}"
+            );
         }
     }
 

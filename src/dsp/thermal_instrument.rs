@@ -310,7 +310,11 @@ impl ThermalInstrument {
 
     /// `c_low N_B / w`, or the floor [`MIN_SAMPLES_PER_TOP_PERIOD`] sets by the highest
     /// playable note.
-    fn internal_rate(kind: InstrumentKind, wave_speeds: &[f64; STRINGS], settings: ThermalSettings) -> f64 {
+    fn internal_rate(
+        kind: InstrumentKind,
+        wave_speeds: &[f64; STRINGS],
+        settings: ThermalSettings,
+    ) -> f64 {
         let top = kind.note_range().1 as f64 + HIGHEST_TUNING_SEMITONES;
         (wave_speeds[0] * settings.nodes as f64 / settings.width_m)
             .max(MIN_SAMPLES_PER_TOP_PERIOD * midi_to_hz(top))

@@ -353,8 +353,13 @@ impl WaveguideString {
         let beta = self.effective_beta().max(1e-3);
         let w_c = 2.0 * TORSION_SPEED_RATIO * self.fundamental_hz / beta;
         let z_t = TORSION_IMPEDANCE_RATIO * self.spec.z0_kg_per_s;
-        self.torsion
-            .design(z_t, w_c, self.sample_rate_hz, self.bow_index, self.torsion.enabled);
+        self.torsion.design(
+            z_t,
+            w_c,
+            self.sample_rate_hz,
+            self.bow_index,
+            self.torsion.enabled,
+        );
     }
 
     pub fn reset(&mut self) {
@@ -559,7 +564,10 @@ mod tests {
             let high = (0.2 * fs).max(4.0 * f_c).min(0.45 * fs);
             if high > 3.0 * f_c {
                 let m = y(high).0.hypot(y(high).1) * 2.0 * z_t;
-                assert!(m > 0.85 && m < 1.0 + 1e-9, "fs {fs}: |Y| 2 Z_t = {m} at {high} Hz");
+                assert!(
+                    m > 0.85 && m < 1.0 + 1e-9,
+                    "fs {fs}: |Y| 2 Z_t = {m} at {high} Hz"
+                );
             }
             let low = 0.1 * f_c;
             let m = y(low).0.hypot(y(low).1) * 2.0 * z_t;
