@@ -46,6 +46,9 @@ enum Command {
         bow_position: f64,
         #[arg(long, default_value_t = 48_000.0)]
         sample_rate: f64,
+        /// Reference pitch A4, Hz (415 .. 466).
+        #[arg(long, default_value_t = 440.0)]
+        reference_pitch: f64,
         /// Lift the bow after this many seconds and let the string ring.
         #[arg(long)]
         release: Option<f64>,
@@ -179,6 +182,7 @@ fn main() -> ExitCode {
             bow_force,
             bow_position,
             sample_rate,
+            reference_pitch,
             release,
             probe,
             friction,
@@ -241,6 +245,7 @@ fn main() -> ExitCode {
                 sample_rate_hz: sample_rate,
                 release_s: release,
                 friction,
+                reference_hz: reference_pitch,
                 ..RenderSettings::default()
             };
             let started = std::time::Instant::now();

@@ -29,6 +29,8 @@ pub struct RenderSettings {
     pub friction: FrictionModel,
     /// Bristle parameters for the LuGre and elasto-plastic laws.
     pub bristle: BristleParams,
+    /// Reference pitch A4, Hz (415..=466; the plugin's `reference_pitch`).
+    pub reference_hz: f64,
     /// Whether the bow feels the string's torsion (the plugin's string; off for paper A's
     /// purely transverse string).
     pub torsion: bool,
@@ -45,6 +47,7 @@ impl Default for RenderSettings {
             release_s: None,
             friction: FrictionModel::Hyperbolic,
             bristle: BristleParams::waveguide_string(),
+            reference_hz: crate::dsp::instrument::REFERENCE_HZ_DEFAULT,
             torsion: true,
         }
     }
@@ -123,6 +126,15 @@ fn check(settings: &RenderSettings) -> Result<(), RenderError> {
             settings.sample_rate_hz
         ));
     }
+    use crate::dsp::instrument::{REFERENCE_HZ_MAX, REFERENCE_HZ_MIN};
+    if !(settings.reference_hz.is_finite()
+        && (REFERENCE_HZ_MIN..=REFERENCE_HZ_MAX).contains(&settings.reference_hz))
+    {
+        return bad(format!(
+            "--reference-pitch must be {REFERENCE_HZ_MIN}..={REFERENCE_HZ_MAX} Hz, got {}",
+            settings.reference_hz
+        ));
+    }
     if !(b.velocity_m_per_s.is_finite() && b.velocity_m_per_s.abs() <= 1.5) {
         return bad(format!(
             "--bow-velocity must be within -1.5..=1.5 m/s, got {}",
@@ -175,6 +187,7 @@ pub fn render_with(
         .map_err(RenderError::BadSetting)?;
     instrument.set_friction_model(settings.friction);
     instrument.set_torsion(settings.torsion);
+    instrument.set_reference_pitch(settings.reference_hz);
     configure(&mut instrument);
     instrument.note_on(settings.note);
     let mut out = Rendered::with_capacity(fs, frames);
@@ -283,7 +296,9 @@ pub fn thermal_string(
         .string_for_note(settings.note)
         .expect("check() accepted the note");
     let open = kind.strings()[index];
-    let f0 = crate::dsp::instrument::midi_to_hz(settings.note as f64);
+    let f0 = crate::dsp::instrument::midi_to_hz(
+        settings.note as f64 + crate::dsp::instrument::reference_semitones(settings.reference_hz),
+    );
     let spec = ThermalStringSpec {
         f0_hz: f0,
         z0_kg_per_s: open.z0_kg_per_s,
