@@ -117,7 +117,18 @@ impl EditorUi {
         let kind: InstrumentKind = self.params.instrument.value().into();
         let beta = self.params.bow_position.value() as f64;
         let string = self.window_string(kind, self.window_note(kind));
-        Some(SchellengWindow::for_string(kind, string, beta))
+        let window = SchellengWindow::for_string(kind, string, beta);
+        // Paper B's bow: its friction coefficient runs from mu(T) cold to hot (the
+        // playing-space map uses the same window).
+        if self.params.friction_model.value() == FrictionChoice::Thermal {
+            let p = crate::dsp::thermal::ThermalParams::default();
+            return Some(SchellengWindow {
+                mu_s: p.mu_cold,
+                mu_d: p.mu_hot,
+                ..window
+            });
+        }
+        Some(window)
     }
 
     /// Draws one frame.
