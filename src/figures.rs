@@ -454,6 +454,24 @@ pub fn maestre_fig6(out: &Path) -> Result<String, String> {
     Ok(format!("wrote {}", out.display()))
 }
 
+/// One value per node, as f64.
+fn widen(x: &[crate::dsp::thermal::NodeReal]) -> Vec<f64> {
+    x.iter().map(|v| f64::from(*v)).collect()
+}
+
+/// A white PNG of `size` titled `title`, split into `rows` panels stacked down.
+fn titled_rows<'a>(
+    out: &'a Path,
+    size: (u32, u32),
+    title: &str,
+    rows: usize,
+) -> Result<Vec<DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>>, String> {
+    let root = BitMapBackend::new(out, size).into_drawing_area();
+    root.fill(&WHITE).map_err(err)?;
+    let root = root.titled(title, ("sans-serif", 22)).map_err(err)?;
+    Ok(root.split_evenly((rows, 1)))
+}
+
 /// Per-node values over time: `rows[k][i]` is node `i` at column `k`.
 struct NodeMovie {
     rows: Vec<Vec<f64>>,
@@ -564,34 +582,24 @@ fn node_map(
 /// Paper B, Figure 7: the friction force and the hair's relative (sliding) velocity over
 /// the bow's width and two periods of the Figure 6 motion, seen from the nut side.
 pub fn maestre_fig7(out: &Path) -> Result<String, String> {
-    use crate::dsp::thermal::HairParams;
+    use crate::dsp::thermal::{HairParams, ThermalString};
     fonts();
-    let force = |s: &crate::dsp::thermal::ThermalString| -> Vec<f64> {
-        s.node_forces().iter().map(|v| f64::from(*v)).collect()
-    };
-    let sliding = |s: &crate::dsp::thermal::ThermalString| -> Vec<f64> {
-        s.node_sliding_velocities()
-            .iter()
-            .map(|v| f64::from(*v))
-            .collect()
-    };
+    let force = |s: &ThermalString| widen(s.node_forces());
+    let sliding = |s: &ThermalString| widen(s.node_sliding_velocities());
     let (movies, _) = fig6_movie(HairParams::default(), &[&force, &sliding])?;
-    let root = BitMapBackend::new(out, (1400, 900)).into_drawing_area();
-    root.fill(&WHITE).map_err(err)?;
-    let root = root
-        .titled(
-            "Paper B, Fig. 7: cello open C, Fig. 6 bow; friction force and hair relative velocity per node, from the nut side",
-            ("sans-serif", 22),
-        )
-        .map_err(err)?;
-    let panels = root.split_evenly((2, 1));
+    let panels = titled_rows(
+        out,
+        (1400, 900),
+        "Paper B, Fig. 7: cello open C, Fig. 6 bow; friction force and hair relative velocity per node, from the nut side",
+        2,
+    )?;
     node_map(&panels[0], "Friction force per node (N)", &movies[0])?;
     node_map(
         &panels[1],
         "Sliding velocity of string over hair per node (m/s)",
         &movies[1],
     )?;
-    root.present().map_err(err)?;
+    panels[0].present().map_err(err)?;
     Ok(format!("wrote {}", out.display()))
 }
 
@@ -599,14 +607,9 @@ pub fn maestre_fig7(out: &Path) -> Result<String, String> {
 /// Figure 6 motion, with the default hair and with ten times its vertical damping, and
 /// the total normal force of both.
 pub fn maestre_fig8(out: &Path) -> Result<String, String> {
-    use crate::dsp::thermal::HairParams;
+    use crate::dsp::thermal::{HairParams, ThermalString};
     fonts();
-    let normal = |s: &crate::dsp::thermal::ThermalString| -> Vec<f64> {
-        s.node_normal_forces()
-            .iter()
-            .map(|v| f64::from(*v))
-            .collect()
-    };
+    let normal = |s: &ThermalString| widen(s.node_normal_forces());
     let default_hair = HairParams::default();
     let damped = HairParams {
         vertical_c_kg_per_s_per_m: 10.0 * default_hair.vertical_c_kg_per_s_per_m,
@@ -626,15 +629,12 @@ pub fn maestre_fig8(out: &Path) -> Result<String, String> {
             }
         }
     }
-    let root = BitMapBackend::new(out, (1400, 1200)).into_drawing_area();
-    root.fill(&WHITE).map_err(err)?;
-    let root = root
-        .titled(
-            "Paper B, Fig. 8: normal force per node, Fig. 6 bow; default hair and ten times its vertical damping",
-            ("sans-serif", 22),
-        )
-        .map_err(err)?;
-    let panels = root.split_evenly((3, 1));
+    let panels = titled_rows(
+        out,
+        (1400, 1200),
+        "Paper B, Fig. 8: normal force per node, Fig. 6 bow; default hair and ten times its vertical damping",
+        3,
+    )?;
     node_map(
         &panels[0],
         "Normal force per node minus its mean, default hair (N)",
@@ -669,6 +669,6 @@ pub fn maestre_fig8(out: &Path) -> Result<String, String> {
     chart
         .draw_series(LineSeries::new(total_b.iter().copied(), &RED))
         .map_err(err)?;
-    root.present().map_err(err)?;
+    panels[0].present().map_err(err)?;
     Ok(format!("wrote {}", out.display()))
 }

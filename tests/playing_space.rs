@@ -34,6 +34,23 @@ fn measure_all(cells: &[Cell]) -> Vec<(Cell, Measured)> {
         .collect()
 }
 
+/// Renders `cells` and fails, listing them, on any that the classifier calls Helmholtz
+/// motion.
+fn assert_never_helmholtz(cells: &[Cell]) {
+    let results = measure_all(cells);
+    let wrong: Vec<String> = results
+        .iter()
+        .filter(|(_, m)| m.regime == Some(Regime::Helmholtz) || m.helmholtz)
+        .map(|(c, m)| describe(c, m))
+        .collect();
+    assert!(
+        wrong.is_empty(),
+        "{} cells:\n{}",
+        wrong.len(),
+        wrong.join("\n")
+    );
+}
+
 fn describe(c: &Cell, m: &Measured) -> String {
     format!(
         "{} {} note {} at {} Hz, {:.3} N at beta {}: {} (peak {:.2e})",
@@ -83,18 +100,7 @@ fn every_note_of_every_model_speaks_at_nominal_bowing() {
 #[test]
 fn far_below_the_window_no_model_is_in_helmholtz_motion() {
     let cells = coarse_cells(Bowing::Middle, 0.6, |c| 0.1 * c.f_min_n);
-    let results = measure_all(&cells);
-    let wrong: Vec<String> = results
-        .iter()
-        .filter(|(_, m)| m.regime == Some(Regime::Helmholtz) || m.helmholtz)
-        .map(|(c, m)| describe(c, m))
-        .collect();
-    assert!(
-        wrong.is_empty(),
-        "{} cells:\n{}",
-        wrong.len(),
-        wrong.join("\n")
-    );
+    assert_never_helmholtz(&cells);
 }
 
 /// Far above Schelleng's upper limit (eight times `F_max`) the static friction laws
@@ -117,18 +123,7 @@ fn far_above_the_window_the_static_laws_are_never_in_helmholtz_motion() {
             )
         })
         .collect();
-    let results = measure_all(&cells);
-    let wrong: Vec<String> = results
-        .iter()
-        .filter(|(_, m)| m.regime == Some(Regime::Helmholtz) || m.helmholtz)
-        .map(|(c, m)| describe(c, m))
-        .collect();
-    assert!(
-        wrong.is_empty(),
-        "{} cells:\n{}",
-        wrong.len(),
-        wrong.join("\n")
-    );
+    assert_never_helmholtz(&cells);
 }
 
 /// Issue 16, item 2, on the coarse subset: inside the window every model is in Helmholtz
