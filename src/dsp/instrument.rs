@@ -83,7 +83,7 @@ impl InstrumentKind {
         }
     }
 
-    /// String data, low to high (PARAMETERS.md §1.4: Desvages/NESS sets; viola G, D, A
+    /// String data, low to high (docs/parameters.md §1.4: Desvages/NESS sets; viola G, D, A
     /// inharmonicities are not in the table and are chosen between the neighbouring
     /// violin and viola values). Open pitches are equal-tempered from A4 = 440 Hz.
     pub fn strings(self) -> [StringSpec; STRINGS] {
@@ -141,7 +141,7 @@ impl InstrumentKind {
     }
 
     /// The string a note goes to, if the instrument can play it.
-    /// Vibrating length of the open strings, m (PARAMETERS.md §1.4: violin 0.32,
+    /// Vibrating length of the open strings, m (docs/parameters.md §1.4: violin 0.32,
     /// viola 0.38, cello 0.69).
     pub fn string_length_m(self) -> f64 {
         match self {

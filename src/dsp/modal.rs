@@ -1,4 +1,4 @@
-//! Modal objects and friction between two of them (paper A, MODELS.md §A; the sound
+//! Modal objects and friction between two of them (paper A, docs/models.md §A; the sound
 //! effects of its §5.2).
 //!
 //! A [`ModalObject`] is a bank of second-order modes `m x'' + r x' + k x = w f`, each

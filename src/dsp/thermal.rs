@@ -1,5 +1,5 @@
 //! Paper B (Maestre, Spa and Smith, "A bowed string physical model including finite-width
-//! thermal friction and hair dynamics"; MODELS.md §B): a bow of `N_B` hair nodes across its
+//! thermal friction and hair dynamics"; docs/models.md §B): a bow of `N_B` hair nodes across its
 //! width `w` on a string with two transverse polarisations, run at the internal rate
 //! `fs = c / dx` (`dx = w / N_B`) so that the waveguide segments between nodes are one
 //! sample long.
@@ -73,10 +73,10 @@ pub struct ThermalParams {
 }
 
 impl Default for ThermalParams {
-    /// Paper B publishes none of these (PARAMETERS.md §1.3: [NF]); chosen so that:
+    /// Paper B publishes none of these (docs/parameters.md §1.3: [NF]); chosen so that:
     /// - the equilibrium temperature of steady sliding, `T_eq = C_H f / C_C`, is
     ///   `250 * 0.4 * 300 / 2000 = 15 K` at paper B's 300 N/m, inside the 10-25 K swing
-    ///   reported for rosin (van Walstijn et al., PARAMETERS.md §1.3), and independent of
+    ///   reported for rosin (van Walstijn et al., docs/parameters.md §1.3), and independent of
     ///   the sliding speed;
     /// - a slip of ~1 ms at ~0.5 m/s relaxes toward it (`C_C |v| ~ 1000 /s`);
     /// - diffusion cools the contact within about a period of a low string: with
@@ -153,7 +153,7 @@ pub struct HairParams {
 
 impl Default for HairParams {
     /// Horizontal: the lumped ribbon of Matusiak's code (k 4.83e4 N/m, d 5.77 kg/s over
-    /// 1 cm; PARAMETERS.md §1.5) per metre. Vertical: [NF] in paper B; a ribbon of ~50
+    /// 1 cm; docs/parameters.md §1.5) per metre. Vertical: [NF] in paper B; a ribbon of ~50
     /// active hairs (0.1 g/m each, so 5 g/m) on the bow's vertical stiffness, chosen at the
     /// same per-metre stiffness and damping as the horizontal hair.
     fn default() -> Self {
@@ -182,7 +182,7 @@ pub struct ThermalStringSpec {
 }
 
 impl ThermalStringSpec {
-    /// The cello's four strings C, G, D, A (Z0 from PARAMETERS.md §1.4 and §1.7), 0.69 m.
+    /// The cello's four strings C, G, D, A (Z0 from docs/parameters.md §1.4 and §1.7), 0.69 m.
     pub fn cello_strings() -> [Self; 4] {
         [
             (65.41, 1.88),
@@ -197,7 +197,7 @@ impl ThermalStringSpec {
         })
     }
 
-    /// Cello open C (PARAMETERS.md §1.7: Z0 ~ 1.85-1.91 kg/s, L 0.67-0.69 m).
+    /// Cello open C (docs/parameters.md §1.7: Z0 ~ 1.85-1.91 kg/s, L 0.67-0.69 m).
     pub fn cello_c() -> Self {
         Self {
             f0_hz: 65.41,

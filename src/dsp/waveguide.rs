@@ -16,12 +16,12 @@
 //!
 //! | symbol | meaning | unit | source |
 //! |---|---|---|---|
-//! | `Z0` | characteristic impedance `sqrt(T mu)` | kg/s | PARAMETERS.md §1.4 |
+//! | `Z0` | characteristic impedance `sqrt(T mu)` | kg/s | docs/parameters.md §1.4 |
 //! | `B` | inharmonicity `pi^2 E I / (T L^2)`: `f_n = n F sqrt(1 + B n^2)` | 1 | §1.4 |
 //! | `Q1` | quality factor of the fundamental (paper A: 500) | 1 | §1.4 |
 //! | `Q_hi` | quality factor at ten times the fundamental | 1 | Artifastring decays, §1.4 |
 //! | `beta` | bow distance from the bridge over the vibrating length | 1 | player |
-//! | `Z_t` | torsional impedance at the surface, [`TORSION_IMPEDANCE_RATIO`] `Z0` | kg/s | CLM Stradivarius model (Serafin, Smith), PARAMETERS.md §1.4 |
+//! | `Z_t` | torsional impedance at the surface, [`TORSION_IMPEDANCE_RATIO`] `Z0` | kg/s | CLM Stradivarius model (Serafin, Smith), docs/parameters.md §1.4 |
 //! | `c_t` | torsional wave speed, [`TORSION_SPEED_RATIO`] times the transverse | m/s | same |
 //!
 //! **Torsion.** The bow rubs the string's surface, which moves with the transverse
@@ -126,8 +126,7 @@ pub struct WaveguideString {
 struct Torsion {
     /// Instantaneous admittance `b0 / (2 Z_t)`, s/kg.
     y0: f64,
-    /// `b1 / (2 Z_t)` (= -y0) and the pole coefficient `a1`.
-    y1: f64,
+    /// The pole coefficient (the zero is at DC: `b1 = -b0`).
     a1: f64,
     /// Transposed direct-form state, m/s.
     state: f64,
@@ -145,19 +144,18 @@ impl Torsion {
         let b0 = k / (k + w);
         // Off (paper A's rigid point contact): no admittance, the state stays 0.
         self.y0 = if enabled { b0 / (2.0 * z_t) } else { 0.0 };
-        self.y1 = -self.y0;
         self.a1 = (w - k) / (k + w);
         self.index = index;
     }
 
     #[inline]
     fn finish(&mut self, force_n: f64, v_t: f64) {
-        self.state = super::filters::flush_tiny(self.y1 * force_n - self.a1 * v_t);
+        self.state = super::filters::flush_tiny(-self.y0 * force_n - self.a1 * v_t);
     }
 }
 
 /// Torsional over transverse wave speed (CLM's Stradivarius model after Serafin and Smith,
-/// PARAMETERS.md: 5.2).
+/// docs/parameters.md: 5.2).
 pub const TORSION_SPEED_RATIO: f64 = 5.2;
 /// Torsional over transverse characteristic impedance, both at the string's surface
 /// (the same model: 1.8 against 0.55 kg/s).

@@ -1,7 +1,7 @@
 //! Bristle friction: LuGre and elasto-plastic (Dupont et al. 2002), solved without delay by
 //! the K-method and a safeguarded Newton-Raphson iteration, as in Serafin, Avanzini and
 //! Rocchesso, "Bowed string simulation using an elasto-plastic friction model" (paper A,
-//! MODELS.md §A).
+//! docs/models.md §A).
 //!
 //! ```text
 //! f   = sigma0 z + sigma1 zdot + sigma2 v                         friction force
@@ -77,7 +77,7 @@ pub struct BristleParams {
 }
 
 impl BristleParams {
-    /// Paper A's modal scenario (the authors' SMAC-03 script, PARAMETERS.md §1.7 row 1).
+    /// Paper A's modal scenario (the authors' SMAC-03 script, docs/parameters.md §1.7 row 1).
     pub fn modal_scenario() -> Self {
         Self {
             sigma0_n_per_m: 1e4,
@@ -91,7 +91,7 @@ impl BristleParams {
     }
 
     /// Values chosen for the waveguide string (paper A's cello D scenario). The modal set
-    /// does not give Helmholtz motion there (MODELS.md, pitfalls): `sigma2 = 0.4 kg/s` lifts
+    /// does not give Helmholtz motion there (docs/models.md, pitfalls): `sigma2 = 0.4 kg/s` lifts
     /// sliding friction at 1 m/s above the static level, and `sigma1 = 10 kg/s`, far above
     /// the string's `2 Z0 ~ 1 kg/s`, makes the contact chatter. Here `sigma2 = 0`; `sigma0`
     /// is raised to 1e5 N/m so presliding stays below a micrometre and the bristle time
