@@ -458,17 +458,14 @@ pub fn run_plan(plan: &Plan, progress: bool) -> Result<Vec<(Cell, Measured)>, St
 
 /// A rough relative cost of a cell, for scheduling only.
 fn cost(cell: &Cell) -> f64 {
-    let per_sample = match cell.model {
-        Model::Point(FrictionModel::Hyperbolic) => 1.0,
-        Model::Point(_) => 4.0,
-        Model::Thermal => 0.0,
+    // Relative cost of one second: a point law scales with the host rate; the thermal
+    // instrument runs at its own rate (about twenty hyperbolic strings at 48 kHz).
+    let per_second = match cell.model {
+        Model::Point(FrictionModel::Hyperbolic) => cell.rate_hz,
+        Model::Point(_) => 4.0 * cell.rate_hz,
+        Model::Thermal => 20.0 * 48_000.0,
     };
-    let thermal = if cell.model == Model::Thermal {
-        20.0 * 48_000.0
-    } else {
-        0.0
-    };
-    cell.seconds * (per_sample * cell.rate_hz + thermal)
+    cell.seconds * per_second
 }
 
 /// Shares of one model at one rate.
