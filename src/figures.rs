@@ -74,8 +74,9 @@ pub fn serafin_fig7(out: &Path) -> Result<String, String> {
         sample_rate_hz: fs,
         friction: FrictionModel::ElastoPlastic,
         bristle: BristleParams::waveguide_string(),
-        // Paper A's string is purely transverse.
+        // Paper A's string is purely transverse, tuned by its free decay.
         torsion: false,
+        intonation: false,
         ..RenderSettings::default()
     };
     let r = render(&settings).map_err(err)?;

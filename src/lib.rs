@@ -11,6 +11,7 @@ pub mod bench;
 pub mod dsp;
 pub mod editor;
 pub mod figures;
+pub mod intonation_fit;
 pub mod params;
 pub mod playing_space;
 pub mod playing_space_figure;

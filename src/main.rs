@@ -108,9 +108,12 @@ enum Command {
         /// playing-space: every Nth semitone (default 1; with --quick 5).
         #[arg(long)]
         step: Option<usize>,
-        /// playing-space: friction models, comma-separated (default all five).
+        /// playing-space, intonation: friction models, comma-separated (default all five).
         #[arg(long, value_delimiter = ',')]
         models: Vec<String>,
+        /// intonation: measuring passes (default 2).
+        #[arg(long)]
+        passes: Option<usize>,
     },
     /// Fit a passive modal bridge admittance to measured data (CSV in, JSON out).
     FitBridge {
@@ -295,6 +298,7 @@ fn main() -> ExitCode {
             rates,
             step,
             models,
+            passes,
         } => report(match what.as_str() {
             "friction" => colophony::bench::friction_table(),
             "table1" => colophony::bench::table1(),
@@ -308,8 +312,16 @@ fn main() -> ExitCode {
                     .and_then(|plan| colophony::playing_space::run(&dir, &plan)),
                 None => Err("bench playing-space needs --out DIR".into()),
             },
+            "intonation" => match out {
+                Some(file) => colophony::playing_space::Plan::from_options(false, &rates, None, &models)
+                    .and_then(|plan| {
+                        let rate = if rates.is_empty() { 48_000.0 } else { plan.rates_hz[0] };
+                        colophony::intonation_fit::run(&file, &plan.models, rate, passes.unwrap_or(2))
+                    }),
+                None => Err("bench intonation needs --out FILE (the shipped one: assets/intonation.csv)".into()),
+            },
             other => Err(format!(
-                "unknown bench '{other}': choose friction, table1, scenes, precision or playing-space"
+                "unknown bench '{other}': choose friction, table1, scenes, precision, playing-space or intonation"
             )),
         }),
         Command::FitBridge { input, modes, out } => {

@@ -27,6 +27,7 @@
 use crate::analysis::{cents, peak_frequency_hz, slip_stats};
 use crate::dsp::friction::FrictionModel;
 use crate::dsp::instrument::{midi_to_hz, BowControl, Frame, Instrument, InstrumentKind, STRINGS};
+use crate::dsp::intonation::{self, IntonationTable};
 use crate::dsp::thermal::ThermalParams;
 use crate::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
 use crate::editor::live::ContactSample;
@@ -151,6 +152,10 @@ pub struct Cell {
     pub f_min_n: f64,
     pub f_max_n: f64,
     pub seconds: f64,
+    /// The string the note is asked onto (`None`: the usual choice).
+    pub string: Option<usize>,
+    /// The intonation the engine tunes by (the shipped table unless a tool says otherwise).
+    pub intonation: Option<&'static IntonationTable>,
 }
 
 impl Cell {
@@ -162,16 +167,29 @@ impl Cell {
         bowing: Bowing,
         seconds: f64,
     ) -> Self {
+        Self::on_string(model, kind, note, None, rate_hz, bowing, seconds)
+    }
+
+    /// A cell whose note is asked onto `string` (where that string can play it).
+    pub fn on_string(
+        model: Model,
+        kind: InstrumentKind,
+        note: u8,
+        string: Option<usize>,
+        rate_hz: f64,
+        bowing: Bowing,
+        seconds: f64,
+    ) -> Self {
         let beta = match bowing {
             Bowing::Defaults | Bowing::Middle => 0.1,
             Bowing::TwiceMin(b) | Bowing::Centre(b) | Bowing::HalfMax(b) => b,
         };
         let (mu_s, mu_d) = model.friction_coefficients();
+        let index = kind.string_for_note_on(note, string).unwrap_or(0);
         let window = SchellengWindow {
             mu_s,
             mu_d,
-            ..SchellengWindow::for_note(kind, note, beta)
-                .unwrap_or_else(|| SchellengWindow::for_string(kind, 0, beta))
+            ..SchellengWindow::for_string(kind, index, beta)
         };
         let mut v = 0.1;
         if !matches!(bowing, Bowing::Defaults) {
@@ -201,6 +219,8 @@ impl Cell {
             f_min_n: f_min,
             f_max_n: f_max,
             seconds,
+            string,
+            intonation: Some(intonation::shipped()),
         }
     }
 
@@ -249,6 +269,8 @@ pub fn render_cell(cell: &Cell) -> Result<(Vec<f64>, Vec<ContactSample>), String
             let mut engine = Instrument::new(cell.kind, cell.rate_hz);
             engine.set_friction_model(law);
             engine.set_newton_tolerance(Quality::Good.newton_tolerance_m_per_s());
+            engine.set_intonation(cell.intonation);
+            engine.set_preferred_string(cell.string);
             engine.note_on(cell.note);
             for i in 0..n {
                 if i % BLOCK == 0 {
@@ -265,6 +287,8 @@ pub fn render_cell(cell: &Cell) -> Result<(Vec<f64>, Vec<ContactSample>), String
             };
             let mut engine =
                 ThermalInstrument::new(cell.kind, &bridge.modes, cell.rate_hz, settings)?;
+            engine.set_intonation(cell.intonation);
+            engine.set_preferred_string(cell.string);
             engine.note_on(cell.note);
             for i in 0..n {
                 if i % BLOCK == 0 {

@@ -34,6 +34,9 @@ pub struct RenderSettings {
     /// Whether the bow feels the string's torsion (the plugin's string; off for paper A's
     /// purely transverse string).
     pub torsion: bool,
+    /// Whether notes are tuned by the bowed sound (the plugin's tuning,
+    /// [`crate::dsp::intonation`]); off, by the free decay (paper A's string).
+    pub intonation: bool,
 }
 
 impl Default for RenderSettings {
@@ -49,6 +52,7 @@ impl Default for RenderSettings {
             bristle: BristleParams::waveguide_string(),
             reference_hz: crate::dsp::instrument::REFERENCE_HZ_DEFAULT,
             torsion: true,
+            intonation: true,
         }
     }
 }
@@ -187,6 +191,7 @@ pub fn render_with(
         .map_err(RenderError::BadSetting)?;
     instrument.set_friction_model(settings.friction);
     instrument.set_torsion(settings.torsion);
+    instrument.set_intonation(settings.intonation.then(crate::dsp::intonation::shipped));
     instrument.set_reference_pitch(settings.reference_hz);
     configure(&mut instrument);
     instrument.note_on(settings.note);

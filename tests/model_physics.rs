@@ -128,7 +128,18 @@ fn helmholtz_amplitude_scales_as_bow_velocity_over_beta() {
     assert!((closer / base - 2.0).abs() < 0.2);
 }
 
-/// Bows `note`, lifts the bow, and measures the first partial of the free decay.
+/// Where the intonation table puts the free decay of `note` on `kind` (hyperbolic law,
+/// the usual string): equal temperament moved by the table's correction, Hz.
+fn tuned_free_decay_hz(kind: InstrumentKind, note: u8) -> f64 {
+    use colophony::dsp::intonation::{model_index, shipped};
+    let string = kind.string_for_note(note).unwrap();
+    let above_open = (note - kind.open_notes()[string]) as f64;
+    let c = shipped().correction_cents(model_index("hyperbolic"), kind, string, above_open);
+    midi_to_hz(note as f64 - c / 100.0)
+}
+
+/// Bows `note`, lifts the bow, and measures the first partial of the free decay against
+/// where the intonation table tunes it.
 fn free_decay_pitch_error_cents(instrument: InstrumentKind, note: u8) -> f64 {
     let s = RenderSettings {
         seconds: 3.7,
@@ -137,12 +148,13 @@ fn free_decay_pitch_error_cents(instrument: InstrumentKind, note: u8) -> f64 {
     };
     let out = render(&s).unwrap();
     let decay = window(&out.audio, 1.2, 3.7, FS);
-    let f = peak_frequency_hz(decay, FS, midi_to_hz(note as f64), 50.0);
-    cents(f, midi_to_hz(note as f64))
+    let want = tuned_free_decay_hz(instrument, note);
+    let f = peak_frequency_hz(decay, FS, want, 50.0);
+    cents(f, want)
 }
 
 #[test]
-fn free_decay_pitch_error_below_two_cents_across_every_range() {
+fn free_decay_sits_where_the_intonation_table_tunes_it_across_every_range() {
     for kind in InstrumentKind::ALL {
         let open = kind.open_notes();
         let mut notes: Vec<u8> = open.to_vec();
@@ -276,13 +288,17 @@ fn render_score(
 
 #[test]
 fn waking_from_sleep_matches_never_sleeping_and_keeps_the_pitch() {
-    // A high violin note rings out within a second, sleeps, and is bowed again.
+    // A high violin note rings out within a second, sleeps, and is bowed again. The note
+    // must be one whose bowed motion is periodic at the defaults: in an irregular regime
+    // (several high violin notes are) the attack is chaotic, and the 1e-16 J left in the
+    // never-sleeping string grows into a different waveform within a period, sleep or
+    // not. MIDI 99 is periodic (and was with free-decay tuning too).
     let s = |t: f64| (t * FS) as usize;
     let score = [
-        (0, true, 100u8),
-        (s(0.3), false, 100),
-        (s(3.0), true, 100),
-        (s(3.5), false, 100),
+        (0, true, 99u8),
+        (s(0.3), false, 99),
+        (s(3.0), true, 99),
+        (s(3.5), false, 99),
     ];
     let frames = s(4.0);
     let (slept, blocks) = render_score(InstrumentKind::Violin, &score, frames, true);
@@ -298,7 +314,7 @@ fn waking_from_sleep_matches_never_sleeping_and_keeps_the_pitch() {
     // The sleep threshold (1e-16 J against a few mJ bowed) is -130 dB in energy; the
     // difference can only be what was cleared at that level.
     assert!(db < -100.0, "waking differs by {db:.1} dB");
-    let f = midi_to_hz(100.0);
+    let f = midi_to_hz(99.0);
     let after = |x: &[f64]| peak_frequency_hz(&x[s(3.1)..s(3.5)], FS, f, 50.0);
     let shift = cents(after(&slept), after(&full));
     println!("pitch after waking: {shift:+.4} cents from never sleeping");

@@ -24,8 +24,9 @@ fn cello_d(friction: FrictionModel, seconds: f64) -> RenderSettings {
         },
         sample_rate_hz: FS,
         friction,
-        // Paper A's string is purely transverse.
+        // Paper A's string is purely transverse, tuned by its free decay.
         torsion: false,
+        intonation: false,
         ..RenderSettings::default()
     }
 }

@@ -8,6 +8,7 @@ use colophony::playing_space::{
     measure, notes, regime_name, run_plan, Bowing, Cell, Measured, Model, Plan,
 };
 use rayon::prelude::*;
+use std::sync::OnceLock;
 
 const RATES: [f64; 2] = [44_100.0, 96_000.0];
 
@@ -65,21 +66,31 @@ fn describe(c: &Cell, m: &Measured) -> String {
     )
 }
 
+/// The nominal cells (the plugin's defaults and the middle of each note's window, beta
+/// 0.1), every fifth semitone, every model, at 44.1 and 96 kHz (the intonation table is
+/// measured at 48 kHz), one second each: rendered once, shared by the tests below.
+fn nominal_results() -> &'static [(Cell, Measured)] {
+    static RESULTS: OnceLock<Vec<(Cell, Measured)>> = OnceLock::new();
+    RESULTS.get_or_init(|| {
+        let plan = Plan {
+            note_step: 5,
+            bowings: vec![Bowing::Defaults, Bowing::Middle],
+            rates_hz: RATES.to_vec(),
+            seconds: 1.0,
+            ..Plan::full()
+        };
+        run_plan(&plan, false).expect("every cell renders")
+    })
+}
+
 /// Every note of every model speaks at the plugin's defaults and at the middle of its
 /// window, at both rates, with finite output: no note is refused or silent (the thermal
 /// model used to drop high notes whose string was shorter than the bow).
 #[test]
 fn every_note_of_every_model_speaks_at_nominal_bowing() {
-    let plan = Plan {
-        note_step: 5,
-        bowings: vec![Bowing::Defaults, Bowing::Middle],
-        rates_hz: RATES.to_vec(),
-        seconds: 0.5,
-        ..Plan::full()
-    };
-    let results = run_plan(&plan, false).expect("every cell renders");
+    let results = nominal_results();
     let mut quiet = Vec::new();
-    for (c, m) in &results {
+    for (c, m) in results {
         assert!(m.peak.is_finite(), "{}", describe(c, m));
         // A bowed note peaks near 0.1 at the plugin's scale; 1e-3 is 40 dB below it, far
         // above the exact zeros of a refused note.
@@ -92,6 +103,78 @@ fn every_note_of_every_model_speaks_at_nominal_bowing() {
         "{} quiet notes:\n{}",
         quiet.len(),
         quiet.join("\n")
+    );
+}
+
+/// Tuned by the bowed sound (issue 16, item 1): bowed at nominal, the point laws' notes
+/// centre on equal temperament, and most lie within 10 cents of it, at rates the
+/// intonation table was not measured at. Before the table every point law sat 6 to 9
+/// cents sharp (median) with 50-74 % of the cells within 10 cents
+/// (docs/playing-space.md, "Tuned by the bowed sound").
+#[test]
+fn bowed_at_nominal_the_point_laws_centre_on_equal_temperament() {
+    let results = nominal_results();
+    let mut failures = Vec::new();
+    for model in Model::ALL
+        .into_iter()
+        .filter(|m| matches!(m, Model::Point(_)))
+    {
+        for rate in RATES {
+            let mut cents: Vec<f64> = results
+                .iter()
+                .filter(|(c, _)| c.model == model && c.rate_hz == rate)
+                .map(|(_, m)| m.cents)
+                .collect();
+            cents.sort_by(f64::total_cmp);
+            let median = cents[cents.len() / 2];
+            let within =
+                cents.iter().filter(|c| c.abs() <= 10.0).count() as f64 / cents.len() as f64;
+            println!(
+                "{} at {rate} Hz: median {median:+.1} cents, {:.0} % within 10 cents",
+                model.name(),
+                100.0 * within
+            );
+            // 2 cents: a systematic offset below what players hear on sustained notes
+            // (the table's residual scatter at 48 kHz is about 3 cents either way).
+            // Two thirds within 10 cents: the rest are the irregular regimes of the
+            // lower window (their pitch wanders), which item 2 of issue 16 still has.
+            if median.abs() > 2.0 || within < 2.0 / 3.0 {
+                failures.push(format!(
+                    "{} at {rate} Hz: median {median:+.1} cents, {:.0} % within 10 cents",
+                    model.name(),
+                    100.0 * within
+                ));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// The thermal model bowed at the plugin's defaults (1 N) in Helmholtz motion sounds in
+/// tune: before the intonation table its notes were 17 cents flat (median).
+#[test]
+fn the_thermal_model_bowed_at_its_defaults_is_in_tune_where_it_is_helmholtz() {
+    let results = nominal_results();
+    let mut cents: Vec<f64> = results
+        .iter()
+        .filter(|(c, m)| {
+            c.model == Model::Thermal
+                && c.bowing == Bowing::Defaults
+                && m.regime == Some(Regime::Helmholtz)
+        })
+        .map(|(_, m)| m.cents)
+        .collect();
+    cents.sort_by(f64::total_cmp);
+    println!("thermal, defaults, Helmholtz: {cents:?}");
+    assert!(
+        !cents.is_empty(),
+        "no thermal note at its defaults is in Helmholtz motion"
+    );
+    let median = cents[cents.len() / 2];
+    // 3 cents: issue 16's nominal target.
+    assert!(
+        median.abs() <= 3.0,
+        "median {median:+.1} cents over {cents:?}"
     );
 }
 

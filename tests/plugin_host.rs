@@ -49,7 +49,28 @@ fn bow_then_lift(
     channel_f64(&out, 0)
 }
 
-/// Free-decay pitch error in cents of `note` on `kind`, from a fresh instance (so no
+/// Where the intonation table puts the free decay of `note` on `kind` (the default
+/// hyperbolic law, the usual string): equal temperament moved by the table, Hz.
+fn tuned_free_decay_hz(kind: InstrumentKind, note: u8) -> f64 {
+    tuned_hz(
+        kind,
+        "hyperbolic",
+        kind.string_for_note(note).unwrap(),
+        note as f64,
+    )
+}
+
+/// Where the intonation table of `model` (its name in the table) puts `semitones` (MIDI,
+/// fractional: bends) played on `string` of `kind`, Hz.
+fn tuned_hz(kind: InstrumentKind, model: &str, string: usize, semitones: f64) -> f64 {
+    use colophony::dsp::intonation::{model_index, shipped};
+    let above_open = semitones - kind.open_notes()[string] as f64;
+    let c = shipped().correction_cents(model_index(model), kind, string, above_open);
+    midi_to_hz(semitones - c / 100.0)
+}
+
+/// Free-decay pitch error in cents of `note` on `kind` against where the intonation table
+/// tunes it, from a fresh instance (so no
 /// earlier note still rings): bow 1.5 s, lift, skip 0.2 s (the 20 ms bow lift and the
 /// body's transients), then measure 1.5 s of ringing.
 fn free_decay_error_cents(kind: InstrumentKind, note: u8) -> f64 {
@@ -63,7 +84,7 @@ fn free_decay_error_cents(kind: InstrumentKind, note: u8) -> f64 {
         "{} MIDI {note}: no sound after the bow lifted",
         kind.name()
     );
-    let nominal = midi_to_hz(note as f64);
+    let nominal = tuned_free_decay_hz(kind, note);
     // +-50 cents: wide enough for any plausible mistuning, narrow enough that the
     // neighbouring partials (1200 cents away) cannot be picked.
     cents(peak_frequency_hz(decay, fs, nominal, 50.0), nominal)
@@ -134,7 +155,7 @@ fn a_lifted_string_rings_down_to_exact_silence_without_subnormals() {
 }
 
 #[test]
-fn free_decay_pitch_of_cello_d3_is_within_2_cents() {
+fn free_decay_of_cello_d3_sits_within_2_cents_of_its_intonation() {
     let error = free_decay_error_cents(InstrumentKind::Cello, 50);
     println!("cello MIDI 50 free decay: {error:+.4} cents");
     // 2 cents: the string is tuned to its first partial, which the estimator resolves
@@ -143,7 +164,7 @@ fn free_decay_pitch_of_cello_d3_is_within_2_cents() {
 }
 
 #[test]
-fn free_decay_pitch_is_within_2_cents_across_each_instruments_range() {
+fn free_decay_sits_within_2_cents_of_its_intonation_across_each_instruments_range() {
     let mut failures = Vec::new();
     for kind in InstrumentKind::ALL {
         let open = kind.open_notes();
@@ -463,7 +484,8 @@ fn pitch_bend_moves_the_pitch_by_up_to_two_semitones() {
             .at(secs(bow, FS), Event::note_off(50));
         let out = plugin.render(secs(bow + skip + measure, FS) as usize, BLOCK, &score);
         let x = channel_f64(&out, 0);
-        let target = midi_to_hz(50.0 + semitones);
+        // The bend moves the stopping point: to the bent note's intonation.
+        let target = tuned_hz(InstrumentKind::Cello, "hyperbolic", 2, 50.0 + semitones);
         // The strongest peak within 250 cents of the unbent note: covers both the bent
         // and the unbent pitch, and no other partial (1200 cents away).
         let decay = &x[secs(bow + skip, FS) as usize..];
@@ -712,12 +734,13 @@ fn thermal_model_plays_in_tune_and_survives_bow_changes_and_switches_during_note
     // After the note off, A3 (moved to the violin's G string by the instrument switch)
     // rings at its pitch: 5 cents, about the smallest difference players notice on
     // sustained tones (the bowed pitch flattens with force: tests/paper_b.rs).
-    let nominal = midi_to_hz(57.0);
+    // The violin G string, 2 semitones up, tuned by the thermal model's intonation.
+    let nominal = tuned_hz(InstrumentKind::Violin, "thermal", 0, 57.0);
     let error = cents(
         peak_frequency_hz(&x[148_800..168_000], FS, nominal, 50.0),
         nominal,
     );
-    println!("thermal A3 free decay: {error:+.2} cents");
+    println!("thermal A3 free decay: {error:+.2} cents from its intonation");
     assert!(error.abs() < 5.0, "{error:+.2} cents");
     assert_no_click_at(&x, &switch_at);
 }
@@ -761,12 +784,17 @@ fn quality_and_string_switches_during_notes_keep_sounding_in_tune_without_clicks
             println!("{model}: from sample {from}: RMS {level:.4}");
             assert!(level > 1e-3, "{model}: silent after {from}");
         }
-        let nominal = midi_to_hz(48.0);
+        let row = if model.starts_with("Thermal") {
+            "thermal"
+        } else {
+            "elasto-plastic"
+        };
+        let nominal = tuned_hz(InstrumentKind::Cello, row, 0, 48.0);
         let error = cents(
             peak_frequency_hz(&x[172_800..192_000], FS, nominal, 50.0),
             nominal,
         );
-        println!("{model}: C3 on the C string, free decay {error:+.2} cents");
+        println!("{model}: C3 on the C string, free decay {error:+.2} cents from its intonation");
         assert!(error.abs() < 5.0, "{model}: {error:+.2} cents");
         assert_no_click_at(&x, &switch_at);
     }

@@ -15,6 +15,7 @@
 use super::body::{BodyMode, BodyModes};
 use super::friction::bristle::{BristleParams, SolverStats};
 use super::friction::{AnyFriction, BowInput, FrictionContact, FrictionModel};
+use super::intonation::{self, IntonationTable, MAX_CORRECTION_CENTS};
 use super::waveguide::{StringSpec, WaveguideString};
 
 pub const STRINGS: usize = 4;
@@ -32,8 +33,10 @@ pub const REFERENCE_HZ_MAX: f64 = 466.0;
 /// Semitones the tuning can move every note (the reference pitch, then the bend) below
 /// and above its equal-tempered pitch at A4 = 440 Hz: the strings' delay lines and the
 /// thermal instrument's rate floor are sized for them.
-pub const LOWEST_TUNING_SEMITONES: f64 = -PITCH_BEND_SEMITONES - 1.013; // 12 log2(415/440)
-pub const HIGHEST_TUNING_SEMITONES: f64 = PITCH_BEND_SEMITONES + 0.993; // 12 log2(466/440)
+pub const LOWEST_TUNING_SEMITONES: f64 =
+    -PITCH_BEND_SEMITONES - 1.013 - MAX_CORRECTION_CENTS / 100.0; // 12 log2(415/440)
+pub const HIGHEST_TUNING_SEMITONES: f64 =
+    PITCH_BEND_SEMITONES + 0.993 + MAX_CORRECTION_CENTS / 100.0; // 12 log2(466/440)
 
 /// Semitones from A4 = 440 Hz to the reference `a4_hz` (clamped to
 /// [`REFERENCE_HZ_MIN`]..=[`REFERENCE_HZ_MAX`]; a NaN is the default).
@@ -256,6 +259,10 @@ pub struct Instrument {
     body_asleep: bool,
     /// Times the non-finite guard in [`Instrument::tick`] reset the instrument.
     recoveries: u64,
+    /// Tuning by the bowed sound ([`super::intonation`]); `None` tunes by the free decay.
+    intonation: Option<&'static IntonationTable>,
+    /// The friction model's row of the intonation table.
+    intonation_model: usize,
 }
 
 impl Instrument {
@@ -292,6 +299,8 @@ impl Instrument {
             skipping: true,
             body_asleep: true,
             recoveries: 0,
+            intonation: Some(intonation::shipped()),
+            intonation_model: intonation::model_index(FrictionModel::Hyperbolic.name()),
         }
     }
 
@@ -337,9 +346,9 @@ impl Instrument {
     /// `None` if the instrument cannot play the note (it is then ignored).
     pub fn note_on(&mut self, note: u8) -> Option<usize> {
         let index = self.kind.string_for_note_on(note, self.preferred_string)?;
-        let bend = self.bend_semitones + self.reference_semitones;
+        let hz = self.tuned_hz(index, note);
         let voice = &mut self.voices[index];
-        voice.string.stop_at(midi_to_hz(note as f64 + bend));
+        voice.string.stop_at(hz);
         voice.note = Some(note);
         voice.bowed = true;
         voice.awake = voice.string.is_playable();
@@ -393,12 +402,31 @@ impl Instrument {
 
     /// Moves every stopped note to its pitch under the current bend and reference.
     fn retune(&mut self) {
-        let offset = self.bend_semitones + self.reference_semitones;
-        for voice in &mut self.voices {
-            if let Some(note) = voice.note {
-                voice.string.bend_to(midi_to_hz(note as f64 + offset));
+        for i in 0..STRINGS {
+            if let Some(note) = self.voices[i].note {
+                let hz = self.tuned_hz(i, note);
+                self.voices[i].string.bend_to(hz);
             }
         }
+    }
+
+    /// The free-decay pitch string `string` is stopped at for `note`: equal temperament
+    /// under the bend and reference, moved by the intonation table.
+    fn tuned_hz(&self, string: usize, note: u8) -> f64 {
+        let open = self.kind.open_notes()[string.min(STRINGS - 1)] as f64;
+        let played = note as f64 + self.bend_semitones;
+        let correction = self.intonation.map_or(0.0, |t| {
+            t.correction_cents(self.intonation_model, self.kind, string, played - open)
+        });
+        midi_to_hz(played + self.reference_semitones - correction / 100.0)
+    }
+
+    /// Tunes by the bowed sound with `table` (the default is the shipped one), or by the
+    /// free decay with `None` (paper A's scenes, the free-string tuning tests). Sounding
+    /// notes follow at once.
+    pub fn set_intonation(&mut self, table: Option<&'static IntonationTable>) {
+        self.intonation = table;
+        self.retune();
     }
 
     /// The string a note was sent to, with its current tuning (for tests and tools).
@@ -541,6 +569,11 @@ impl Instrument {
         for voice in &mut self.voices {
             voice.contact.set_model(model);
         }
+        let row = intonation::model_index(model.name());
+        if row != self.intonation_model {
+            self.intonation_model = row;
+            self.retune();
+        }
     }
 
     /// Turns the strings' torsion at the bow on (the default) or off
@@ -650,9 +683,11 @@ mod tests {
     }
 
     /// Issue 16, item 1: the reference pitch tunes every note, the lowest open string bent
-    /// down at 415 Hz and the highest stopped note bent up at 466 Hz included. The free
-    /// string's first partial is tuned exactly (as at 440 Hz), so its pitch is checked to
-    /// 0.05 cents: the peak estimator's resolution on one second of a decaying partial.
+    /// down at 415 Hz and the highest stopped note bent up at 466 Hz included. With the
+    /// intonation table the free string sits the table's correction (at the bent note's
+    /// place on its string) below; without it, its first partial is tuned exactly (as at
+    /// 440 Hz), so its pitch is checked to 0.05 cents: the peak estimator's resolution on
+    /// one second of a decaying partial.
     #[test]
     fn the_reference_pitch_tunes_every_note_from_a4() {
         use crate::analysis::{cents, peak_frequency_hz};
@@ -662,6 +697,21 @@ mod tests {
             cello.set_reference_pitch(a4);
             cello.set_pitch_bend(bend);
             let index = cello.note_on(note).unwrap();
+            let want = a4 * 2f64.powf((note as f64 + bend - 69.0) / 12.0);
+            let above_open = note as f64 + bend - InstrumentKind::Cello.open_notes()[index] as f64;
+            let c = intonation::shipped().correction_cents(
+                intonation::model_index("hyperbolic"),
+                InstrumentKind::Cello,
+                index,
+                above_open,
+            );
+            let tuned = want * 2f64.powf(-c / 1200.0);
+            let f = cello.string(index).fundamental_hz();
+            assert!(
+                (f - tuned).abs() < 1e-9 * tuned,
+                "{f} Hz, table says {tuned} Hz"
+            );
+            cello.set_intonation(None);
             let bow = BowControl::default();
             for _ in 0..(0.2 * fs) as usize {
                 cello.tick(bow);
@@ -671,7 +721,6 @@ mod tests {
                 cello.tick(bow);
             }
             let x: Vec<f64> = (0..fs as usize).map(|_| cello.tick(bow).audio).collect();
-            let want = a4 * 2f64.powf((note as f64 + bend - 69.0) / 12.0);
             assert!((cello.string(index).fundamental_hz() - want).abs() < 1e-9 * want);
             let got = peak_frequency_hz(&x, fs, want, 30.0);
             assert!(

@@ -9,6 +9,7 @@ pub mod bridge;
 pub mod filters;
 pub mod friction;
 pub mod instrument;
+pub mod intonation;
 pub mod modal;
 pub mod resample;
 pub mod rubbed;

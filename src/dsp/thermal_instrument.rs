@@ -51,6 +51,7 @@ use super::instrument::{
     HIGHEST_TUNING_SEMITONES, LOWEST_TUNING_SEMITONES, PITCH_BEND_SEMITONES, SLEEP_ENERGY_J,
     STRINGS,
 };
+use super::intonation::{self, IntonationTable};
 use super::resample::Resampler;
 use super::thermal::{
     HairParams, ThermalBowControl, ThermalCapacity, ThermalConfigError, ThermalParams,
@@ -221,6 +222,8 @@ pub struct ThermalInstrument {
     wide_simd: bool,
     /// Times the non-finite guard in [`ThermalInstrument::tick`] reset the instrument.
     recoveries: u64,
+    /// Tuning by the bowed sound ([`super::intonation`]); `None` tunes by the free decay.
+    intonation: Option<&'static IntonationTable>,
 }
 
 impl ThermalInstrument {
@@ -301,6 +304,7 @@ impl ThermalInstrument {
             skipping: true,
             wide_simd: super::detect_wide_simd(),
             recoveries: 0,
+            intonation: Some(intonation::shipped()),
         };
         instrument
             .apply_settings(settings)
@@ -378,7 +382,7 @@ impl ThermalInstrument {
         for i in 0..STRINGS {
             self.voices[i].bow_gain = 0.0;
             let f0 = match self.voices[i].note {
-                Some(note) => midi_to_hz(note as f64 + self.tuning_semitones()),
+                Some(note) => self.tuned_hz(i, note),
                 None => self.kind.strings()[i].open_hz * 2f64.powf(self.reference_semitones / 12.0),
             };
             if !self.tune(i, f0) {
@@ -425,7 +429,7 @@ impl ThermalInstrument {
     /// play it with this bow.
     pub fn note_on(&mut self, note: u8) -> Option<usize> {
         let index = self.kind.string_for_note_on(note, self.preferred_string)?;
-        let f0 = midi_to_hz(note as f64 + self.tuning_semitones());
+        let f0 = self.tuned_hz(index, note);
         if !self.tune(index, f0) {
             return None;
         }
@@ -480,17 +484,35 @@ impl ThermalInstrument {
         self.retune();
     }
 
-    /// Bend plus reference pitch, semitones from equal temperament at A4 = 440 Hz.
-    fn tuning_semitones(&self) -> f64 {
-        self.bend_semitones + self.reference_semitones
+    /// The free-decay pitch string `string` is stopped at for `note`: equal temperament
+    /// under the bend and reference, moved by the intonation table.
+    fn tuned_hz(&self, string: usize, note: u8) -> f64 {
+        let open = self.kind.open_notes()[string.min(STRINGS - 1)] as f64;
+        let played = note as f64 + self.bend_semitones;
+        let correction = self.intonation.map_or(0.0, |t| {
+            t.correction_cents(
+                intonation::model_index("thermal"),
+                self.kind,
+                string,
+                played - open,
+            )
+        });
+        midi_to_hz(played + self.reference_semitones - correction / 100.0)
+    }
+
+    /// Tunes by the bowed sound with `table` (the default is the shipped one), or by the
+    /// free decay with `None`. Sounding notes follow at once.
+    pub fn set_intonation(&mut self, table: Option<&'static IntonationTable>) {
+        self.intonation = table;
+        self.retune();
     }
 
     /// Moves every stopped note to its pitch under the current bend and reference.
     fn retune(&mut self) {
-        let offset = self.tuning_semitones();
         for i in 0..STRINGS {
             if let Some(note) = self.voices[i].note {
-                if !self.tune(i, midi_to_hz(note as f64 + offset)) {
+                let f0 = self.tuned_hz(i, note);
+                if !self.tune(i, f0) {
                     // Tuned out of what the bow allows: lift it, the string rings on.
                     self.voices[i].bowed = false;
                 }

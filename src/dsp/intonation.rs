@@ -1,0 +1,213 @@
+//! Intonation by the bowed sound: how many cents each stopped string is tuned away from
+//! its equal-tempered free-decay pitch so that the *bowed* note sounds in tune.
+//!
+//! A bowed string does not sound at its free-decay fundamental. Helmholtz motion is
+//! periodic, so the stick-slip locks every partial to an exact harmonic of one frequency,
+//! and with a stiff string (partials stretched above the harmonic series) that frequency
+//! lies a few cents above the first partial; the friction law adds its own shift, which
+//! changes with force (the "flattening effect" toward the top of Schelleng's window).
+//! Players tune by the bowed sound and place their fingers by ear, so a real instrument
+//! plays its bowed notes in tune and its free decays a little off.
+//!
+//! The table does what the player's ear does, once, offline: for every friction model,
+//! instrument, string and semitone above the open string (0..=
+//! [`MAX_STOP_SEMITONES`](super::instrument::MAX_STOP_SEMITONES)) it holds the cents the
+//! note is moved so that bowing it at nominal (the plugin's defaults, 0.1 m/s, 1 N,
+//! beta 0.1, and the geometric middle of the note's Schelleng window) sounds at equal
+//! temperament. It is measured through the same engines the plugin plays by
+//! `colophony bench intonation` (`src/intonation_fit.rs`), written to
+//! `assets/intonation.csv` and compiled in. Between semitones (pitch bend, vibrato) it is
+//! interpolated linearly. The change of pitch with force and bow position is left as the
+//! physics gives it.
+
+use super::instrument::{InstrumentKind, MAX_STOP_SEMITONES, STRINGS};
+use std::sync::OnceLock;
+
+/// Largest correction the table may hold, cents (the tuning margins of the instruments'
+/// buffers include it).
+pub const MAX_CORRECTION_CENTS: f64 = 50.0;
+
+/// Semitones per string in the table: 0 (open) ..= [`MAX_STOP_SEMITONES`].
+const SEMITONES: usize = MAX_STOP_SEMITONES as usize + 1;
+
+/// The models the table covers, in file order.
+pub const MODEL_NAMES: [&str; 5] = ["hyperbolic", "static", "lugre", "elasto-plastic", "thermal"];
+
+/// The table row of a model named as [`MODEL_NAMES`] (the friction models' `name()`, and
+/// "thermal"); an unknown name reads the first row.
+pub fn model_index(name: &str) -> usize {
+    MODEL_NAMES.iter().position(|&m| m == name).unwrap_or(0)
+}
+
+/// Corrections for every model, instrument, string and semitone, cents.
+#[derive(Debug, Clone, PartialEq)]
+pub struct IntonationTable {
+    cents: Vec<f64>,
+}
+
+fn index(model: usize, kind: InstrumentKind, string: usize, semitone: usize) -> usize {
+    let k = InstrumentKind::ALL
+        .iter()
+        .position(|&k| k == kind)
+        .unwrap_or(0);
+    ((model * InstrumentKind::ALL.len() + k) * STRINGS + string) * SEMITONES + semitone
+}
+
+impl IntonationTable {
+    /// A table of zeros: every string tuned by its free decay.
+    pub fn zero() -> Self {
+        Self {
+            cents: vec![0.0; MODEL_NAMES.len() * InstrumentKind::ALL.len() * STRINGS * SEMITONES],
+        }
+    }
+
+    /// The correction of one table entry, cents.
+    pub fn get(&self, model: usize, kind: InstrumentKind, string: usize, semitone: usize) -> f64 {
+        self.cents[index(model, kind, string, semitone)]
+    }
+
+    /// Sets one entry (clamped to +-[`MAX_CORRECTION_CENTS`]; a NaN is 0).
+    pub fn set(
+        &mut self,
+        model: usize,
+        kind: InstrumentKind,
+        string: usize,
+        semitone: usize,
+        cents: f64,
+    ) {
+        let c = if cents.is_nan() {
+            0.0
+        } else {
+            cents.clamp(-MAX_CORRECTION_CENTS, MAX_CORRECTION_CENTS)
+        };
+        self.cents[index(model, kind, string, semitone)] = c;
+    }
+
+    /// The correction for `model` (an index into [`MODEL_NAMES`]) on `string` of `kind`,
+    /// `semitones` (fractional) above the open string, cents: linear between semitones,
+    /// the end values beyond them.
+    pub fn correction_cents(
+        &self,
+        model: usize,
+        kind: InstrumentKind,
+        string: usize,
+        semitones: f64,
+    ) -> f64 {
+        if model >= MODEL_NAMES.len() || string >= STRINGS || !semitones.is_finite() {
+            return 0.0;
+        }
+        let s = semitones.clamp(0.0, (SEMITONES - 1) as f64);
+        let lo = (s.floor() as usize).min(SEMITONES - 2);
+        let t = s - lo as f64;
+        let a = self.get(model, kind, string, lo);
+        let b = self.get(model, kind, string, lo + 1);
+        a + t * (b - a)
+    }
+
+    /// Parses the CSV written by [`IntonationTable::to_csv`]. Lines starting with `#` are
+    /// comments; entries not in the file stay 0.
+    pub fn parse(text: &str) -> Result<Self, String> {
+        let mut table = Self::zero();
+        let mut lines = text
+            .lines()
+            .filter(|l| !l.trim_start().starts_with('#') && !l.trim().is_empty());
+        let header = lines.next().ok_or("empty intonation table")?;
+        if header.trim() != "model,instrument,string,semitone,cents" {
+            return Err(format!("unexpected intonation header '{header}'"));
+        }
+        for (n, line) in lines.enumerate() {
+            let f: Vec<&str> = line.split(',').map(str::trim).collect();
+            let bad = || format!("intonation table line {}: '{line}'", n + 2);
+            if f.len() != 5 {
+                return Err(bad());
+            }
+            let model = MODEL_NAMES
+                .iter()
+                .position(|&m| m == f[0])
+                .ok_or_else(bad)?;
+            let kind = InstrumentKind::from_name(f[1]).ok_or_else(bad)?;
+            let string: usize = f[2].parse().map_err(|_| bad())?;
+            let semitone: usize = f[3].parse().map_err(|_| bad())?;
+            let cents: f64 = f[4].parse().map_err(|_| bad())?;
+            if string >= STRINGS || semitone >= SEMITONES || !cents.is_finite() {
+                return Err(bad());
+            }
+            table.set(model, kind, string, semitone, cents);
+        }
+        Ok(table)
+    }
+
+    /// The table as CSV (header `model,instrument,string,semitone,cents`).
+    pub fn to_csv(&self) -> String {
+        let mut s = String::from("model,instrument,string,semitone,cents\n");
+        for (m, name) in MODEL_NAMES.iter().enumerate() {
+            for kind in InstrumentKind::ALL {
+                for string in 0..STRINGS {
+                    for semitone in 0..SEMITONES {
+                        s.push_str(&format!(
+                            "{name},{},{string},{semitone},{:.2}\n",
+                            kind.name(),
+                            self.get(m, kind, string, semitone)
+                        ));
+                    }
+                }
+            }
+        }
+        s
+    }
+}
+
+/// The shipped table (`assets/intonation.csv`), parsed once. Call it off the audio thread
+/// first (the instruments do, when built); later calls are a load.
+pub fn shipped() -> &'static IntonationTable {
+    static TABLE: OnceLock<IntonationTable> = OnceLock::new();
+    TABLE.get_or_init(|| {
+        IntonationTable::parse(include_str!("../../assets/intonation.csv"))
+            .expect("the shipped intonation table parses (tested)")
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_shipped_table_parses_and_stays_within_its_bound() {
+        let t = shipped();
+        assert!(t.cents.iter().all(|c| c.abs() <= MAX_CORRECTION_CENTS));
+    }
+
+    #[test]
+    fn a_table_round_trips_through_csv() {
+        let mut t = IntonationTable::zero();
+        t.set(2, InstrumentKind::Viola, 3, 17, -4.25);
+        t.set(4, InstrumentKind::Cello, 0, 0, 12.5);
+        assert_eq!(IntonationTable::parse(&t.to_csv()).unwrap(), t);
+    }
+
+    #[test]
+    fn corrections_interpolate_between_semitones_and_hold_beyond_the_ends() {
+        let mut t = IntonationTable::zero();
+        let k = InstrumentKind::Violin;
+        t.set(0, k, 1, 4, 2.0);
+        t.set(0, k, 1, 5, 6.0);
+        t.set(0, k, 1, SEMITONES - 1, -3.0);
+        assert_eq!(t.correction_cents(0, k, 1, 4.25), 3.0);
+        assert_eq!(t.correction_cents(0, k, 1, 100.0), -3.0);
+        assert_eq!(t.correction_cents(0, k, 1, -2.0), 0.0);
+        assert_eq!(t.correction_cents(0, k, 1, f64::NAN), 0.0);
+    }
+
+    #[test]
+    fn broken_tables_are_refused_with_the_line() {
+        for bad in [
+            "",
+            "nope\n",
+            "model,instrument,string,semitone,cents\nhyperbolic,cello,9,0,1\n",
+            "model,instrument,string,semitone,cents\nhyperbolic,lute,0,0,1\n",
+            "model,instrument,string,semitone,cents\nhyperbolic,cello,0,0,NaN\n",
+        ] {
+            assert!(IntonationTable::parse(bad).is_err(), "{bad:?}");
+        }
+    }
+}
