@@ -1,0 +1,163 @@
+//! Golden renders (issue 17, item 7): a few seconds of every source the plugin plays
+//! (the four point laws on the waveguide strings, paper B's thermal cello, each rubbed
+//! object), rendered through the CLAP build in the headless host with notes, a bend, a
+//! string choice and bow automation, must keep the same bits across refactoring.
+//!
+//! Each render is kept as a 64-bit FNV-1a hash of its samples' bits, with its RMS and
+//! peak for the failure message, in `tests/golden/renders.txt`. A change meant to be
+//! audible re-records them: `COLOPHONY_RECORD_GOLDEN=1 cargo test --test golden`, and the
+//! commit says why.
+
+mod host;
+
+use host::{channel_f64, Event, HostedPlugin, Score};
+use std::fmt::Write as _;
+
+const FS: f64 = 48_000.0;
+const BLOCK: usize = 256;
+const GOLDEN: &str = "tests/golden/renders.txt";
+
+fn secs(t: f64) -> u64 {
+    (t * FS).round() as u64
+}
+
+fn fnv1a(samples: &[f32]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for s in samples {
+        for b in s.to_bits().to_le_bytes() {
+            h ^= b as u64;
+            h = h.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    }
+    h
+}
+
+/// One scene: a name, the parameter texts to set, and the length in seconds.
+struct Scene {
+    name: &'static str,
+    texts: &'static [(&'static str, &'static str)],
+    instrument: &'static str,
+    seconds: f64,
+}
+
+const SCENES: &[Scene] = &[
+    Scene {
+        name: "hyperbolic-cello",
+        texts: &[("Friction Model", "Hyperbolic")],
+        instrument: "Cello",
+        seconds: 2.5,
+    },
+    Scene {
+        name: "static-violin",
+        texts: &[("Friction Model", "Static (Stribeck)")],
+        instrument: "Violin",
+        seconds: 2.5,
+    },
+    Scene {
+        name: "lugre-viola",
+        texts: &[("Friction Model", "LuGre")],
+        instrument: "Viola",
+        seconds: 2.5,
+    },
+    Scene {
+        name: "elasto-plastic-cello",
+        texts: &[("Friction Model", "Elasto-plastic")],
+        instrument: "Cello",
+        seconds: 2.5,
+    },
+    Scene {
+        name: "thermal-cello",
+        texts: &[("Friction Model", "Thermal (paper B)")],
+        instrument: "Cello",
+        seconds: 1.5,
+    },
+    Scene {
+        name: "rubbed-door-hinge",
+        texts: &[("Resonator", "Door hinge")],
+        instrument: "Cello",
+        seconds: 1.5,
+    },
+    Scene {
+        name: "rubbed-wine-glass",
+        texts: &[("Resonator", "Wine glass")],
+        instrument: "Cello",
+        seconds: 1.5,
+    },
+    Scene {
+        name: "rubbed-paper-modal",
+        texts: &[("Resonator", "Paper A modal")],
+        instrument: "Cello",
+        seconds: 1.5,
+    },
+];
+
+/// Renders a scene: two notes (the second a fifth up, overlapping), a bend, a string
+/// choice, force and velocity automation, a bow change, then the release.
+fn render(scene: &Scene) -> Vec<f32> {
+    let mut plugin = HostedPlugin::load_test_build();
+    plugin.activate(FS, BLOCK);
+    let t = scene.seconds;
+    let mut score = Score::new().at(0, plugin.text("Instrument", scene.instrument));
+    for (name, text) in scene.texts {
+        score = score.at(0, plugin.text(name, text));
+    }
+    let low = match scene.instrument {
+        "Violin" => 62,
+        "Viola" => 55,
+        _ => 50,
+    };
+    score = score
+        .at(0, Event::note_on(low))
+        .at(secs(0.25 * t), plugin.plain("Bow Force", 2.0))
+        .at(secs(0.3 * t), Event::pitch_bend(0.6))
+        .at(secs(0.4 * t), plugin.text("String", "IV (lowest)"))
+        .at(secs(0.45 * t), Event::note_on(low + 7))
+        .at(secs(0.5 * t), Event::note_off(low))
+        .at(secs(0.55 * t), plugin.plain("Bow Velocity", -0.15))
+        .at(secs(0.6 * t), plugin.plain("Bow Position", 0.15))
+        .at(secs(0.75 * t), Event::note_off(low + 7));
+    let out = plugin.render(secs(t) as usize, BLOCK, &score);
+    out[0].clone()
+}
+
+fn line(scene: &Scene, x: &[f32]) -> String {
+    let y = channel_f64(&[x.to_vec()], 0);
+    let rms = (y.iter().map(|v| v * v).sum::<f64>() / y.len() as f64).sqrt();
+    let peak = y.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    format!(
+        "{} {:016x} rms {:.6e} peak {:.6e}",
+        scene.name,
+        fnv1a(x),
+        rms,
+        peak
+    )
+}
+
+#[test]
+fn every_source_renders_the_same_bits_as_recorded() {
+    let mut got = String::new();
+    for scene in SCENES {
+        let x = render(scene);
+        assert!(x.iter().any(|v| *v != 0.0), "{}: silent", scene.name);
+        let _ = writeln!(got, "{}", line(scene, &x));
+    }
+    if std::env::var_os("COLOPHONY_RECORD_GOLDEN").is_some() {
+        std::fs::create_dir_all("tests/golden").unwrap();
+        std::fs::write(GOLDEN, &got).unwrap();
+        println!("recorded {GOLDEN}:\n{got}");
+        return;
+    }
+    let want = std::fs::read_to_string(GOLDEN).expect("tests/golden/renders.txt (record it first)");
+    let mut diffs = Vec::new();
+    for (g, w) in got.lines().zip(want.lines()) {
+        if g != w {
+            diffs.push(format!("  now {g}\n  was {w}"));
+        }
+    }
+    assert_eq!(
+        got.lines().count(),
+        want.lines().count(),
+        "scene count changed:\n{got}"
+    );
+    assert!(diffs.is_empty(), "renders changed:\n{}", diffs.join("\n"));
+}
