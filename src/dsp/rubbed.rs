@@ -28,6 +28,7 @@
 
 use super::friction::bristle::{BristleParams, SolverStats};
 use super::friction::{AnyFriction, BowInput, FrictionContact, FrictionModel};
+use super::instrument::BowControl;
 use super::modal::{Exciter, FrictionPair, ModalObject, ModeSpec, PairOutput};
 
 /// The built-in rubbed scenes.
@@ -348,7 +349,16 @@ pub struct RubbedInstrument {
     active: usize,
     notes_down: u32,
     ramp_step: f64,
+    sample_rate_hz: f64,
 }
+
+/// The bow at which every rubbed preset plays at its own velocity and force: a bow of
+/// twice this velocity rubs twice as fast ([`RubbedInstrument::tick_bow`]).
+pub const REFERENCE_BOW: BowControl = BowControl {
+    velocity_m_per_s: 0.1,
+    force_n: 1.0,
+    position_beta: 0.1,
+};
 
 #[derive(Debug, Clone)]
 struct RubbedVoice {
@@ -372,7 +382,12 @@ impl RubbedInstrument {
             active: 1,
             notes_down: 0,
             ramp_step: 1.0 / (RUB_RAMP_S * sample_rate_hz),
+            sample_rate_hz,
         }
+    }
+
+    pub fn sample_rate_hz(&self) -> f64 {
+        self.sample_rate_hz
     }
 
     pub fn preset(&self) -> RubbedPreset {
@@ -483,6 +498,15 @@ impl RubbedInstrument {
                 voice.awake = false;
             }
         }
+    }
+
+    /// One sample bowed with `bow` in SI units: the preset's own velocity and force are
+    /// scaled by the bow's against [`REFERENCE_BOW`].
+    pub fn tick_bow(&mut self, bow: &BowControl) -> f64 {
+        self.tick(
+            bow.velocity_m_per_s / REFERENCE_BOW.velocity_m_per_s,
+            bow.force_n / REFERENCE_BOW.force_n,
+        )
     }
 
     /// One sample; `velocity_scale` and `force_scale` multiply the preset's own values.

@@ -1,0 +1,156 @@
+//! One interface for everything a note can play: the waveguide instrument (paper A's
+//! point laws), paper B's thermal instrument and the rubbed objects. The performer
+//! ([`crate::performer`]) drives them through it, in SI units.
+//!
+//! ```
+//! use colophony::dsp::engine::Engine;
+//! use colophony::dsp::instrument::{BowControl, Instrument, InstrumentKind};
+//! let mut cello = Instrument::new(InstrumentKind::Cello, 48_000.0);
+//! let engine: &mut dyn Engine = &mut cello;
+//! engine.note_on(50);
+//! let bow = BowControl { velocity_m_per_s: 0.1, force_n: 1.0, position_beta: 0.1 };
+//! let sound: f64 = (0..4800).map(|_| engine.tick(bow).audio.abs()).sum();
+//! assert!(sound > 0.0);
+//! ```
+
+use super::instrument::{BowControl, Frame, Instrument};
+use super::rubbed::RubbedInstrument;
+use super::thermal_instrument::ThermalInstrument;
+
+/// An instrument the notes play.
+pub trait Engine {
+    /// Lands the bow for `note`; the string (or object) it went to, `None` if ignored.
+    fn note_on(&mut self, note: u8) -> Option<usize>;
+    /// Lifts the bow from `note`.
+    fn note_off(&mut self, note: u8);
+    fn all_notes_off(&mut self);
+    /// Pitch bend, semitones (engines without pitch ignore it).
+    fn set_pitch_bend(&mut self, _semitones: f64) {}
+    /// The string later notes go to (0 = lowest), `None` for the usual choice.
+    fn set_preferred_string(&mut self, _string: Option<usize>) {}
+    /// Reference pitch A4, Hz.
+    fn set_reference_pitch(&mut self, _a4_hz: f64) {}
+    /// Once per block: what is lifted and quiet sleeps.
+    fn update_sleep(&mut self);
+    /// Whether anything is awake (bowed, or ringing on).
+    fn is_sounding(&self) -> bool;
+    /// Whether anything still rings, its resonators included.
+    fn is_ringing(&self) -> bool {
+        self.is_sounding()
+    }
+    /// Seconds until it would fall asleep with no new note (the host's tail), `None` while
+    /// a bow is on. Walks delay lines: once per block.
+    fn ring_out_s(&self) -> Option<f64>;
+    /// One sample.
+    fn tick(&mut self, bow: BowControl) -> Frame;
+    /// Silence and forget every note.
+    fn reset(&mut self);
+}
+
+impl Engine for Instrument {
+    fn note_on(&mut self, note: u8) -> Option<usize> {
+        Instrument::note_on(self, note)
+    }
+    fn note_off(&mut self, note: u8) {
+        Instrument::note_off(self, note)
+    }
+    fn all_notes_off(&mut self) {
+        Instrument::all_notes_off(self)
+    }
+    fn set_pitch_bend(&mut self, semitones: f64) {
+        Instrument::set_pitch_bend(self, semitones)
+    }
+    fn set_preferred_string(&mut self, string: Option<usize>) {
+        Instrument::set_preferred_string(self, string)
+    }
+    fn set_reference_pitch(&mut self, a4_hz: f64) {
+        Instrument::set_reference_pitch(self, a4_hz)
+    }
+    fn update_sleep(&mut self) {
+        Instrument::update_sleep(self)
+    }
+    fn is_sounding(&self) -> bool {
+        Instrument::is_sounding(self)
+    }
+    fn is_ringing(&self) -> bool {
+        Instrument::is_ringing(self)
+    }
+    fn ring_out_s(&self) -> Option<f64> {
+        Instrument::ring_out_s(self)
+    }
+    fn tick(&mut self, bow: BowControl) -> Frame {
+        Instrument::tick(self, bow)
+    }
+    fn reset(&mut self) {
+        Instrument::reset(self)
+    }
+}
+
+impl Engine for ThermalInstrument {
+    fn note_on(&mut self, note: u8) -> Option<usize> {
+        ThermalInstrument::note_on(self, note)
+    }
+    fn note_off(&mut self, note: u8) {
+        ThermalInstrument::note_off(self, note)
+    }
+    fn all_notes_off(&mut self) {
+        ThermalInstrument::all_notes_off(self)
+    }
+    fn set_pitch_bend(&mut self, semitones: f64) {
+        ThermalInstrument::set_pitch_bend(self, semitones)
+    }
+    fn set_preferred_string(&mut self, string: Option<usize>) {
+        ThermalInstrument::set_preferred_string(self, string)
+    }
+    fn set_reference_pitch(&mut self, a4_hz: f64) {
+        ThermalInstrument::set_reference_pitch(self, a4_hz)
+    }
+    fn update_sleep(&mut self) {
+        ThermalInstrument::update_sleep(self)
+    }
+    fn is_sounding(&self) -> bool {
+        ThermalInstrument::is_sounding(self)
+    }
+    fn ring_out_s(&self) -> Option<f64> {
+        ThermalInstrument::ring_out_s(self)
+    }
+    fn tick(&mut self, bow: BowControl) -> Frame {
+        ThermalInstrument::tick(self, bow)
+    }
+    fn reset(&mut self) {
+        ThermalInstrument::reset(self)
+    }
+}
+
+/// The rubbed objects take every note as one exciter on the active object (a note held
+/// twice counts twice: the performer sends each held key once).
+impl Engine for RubbedInstrument {
+    fn note_on(&mut self, _note: u8) -> Option<usize> {
+        RubbedInstrument::note_on(self);
+        Some(0)
+    }
+    fn note_off(&mut self, _note: u8) {
+        RubbedInstrument::note_off(self)
+    }
+    fn all_notes_off(&mut self) {
+        RubbedInstrument::all_notes_off(self)
+    }
+    fn update_sleep(&mut self) {
+        RubbedInstrument::update_sleep(self)
+    }
+    fn is_sounding(&self) -> bool {
+        RubbedInstrument::is_sounding(self)
+    }
+    fn ring_out_s(&self) -> Option<f64> {
+        self.ring_out_samples().map(|n| n / self.sample_rate_hz())
+    }
+    fn tick(&mut self, bow: BowControl) -> Frame {
+        Frame {
+            audio: self.tick_bow(&bow),
+            ..Frame::default()
+        }
+    }
+    fn reset(&mut self) {
+        RubbedInstrument::reset(self)
+    }
+}

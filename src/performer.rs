@@ -1,0 +1,422 @@
+//! The performer: everything between the player's keys and the engines, free of any
+//! plugin framework. The plugin, and any tool that wants to play what the plugin plays,
+//! hand it a [`Setup`] per block, the notes, and a bow per sample.
+//!
+//! It owns:
+//! - the engines ([`crate::dsp::engine::Engine`]): the waveguide strings (paper A's point
+//!   laws), paper B's thermal instrument of each kind (with its modal bridge), the rubbed
+//!   objects;
+//! - the source the notes go to, and the switch between sources: held notes move to the
+//!   new source (its bow lands over the usual ramp) while the old one rings on;
+//! - the held keys, and the thermal bow's node count under `quality = auto`;
+//! - the tail the host hears about ([`Status`]).
+//!
+//! ```
+//! use colophony::dsp::instrument::{BowControl, InstrumentKind};
+//! use colophony::performer::{Performer, Setup};
+//! let setup = Setup::default();
+//! let mut performer = Performer::new(InstrumentKind::Cello);
+//! performer.activate(&setup, 48_000.0).unwrap();
+//! performer.configure(&setup);
+//! performer.note_on(50);
+//! let bow = BowControl::default();
+//! let peak = (0..9600).map(|_| performer.tick(bow).audio.abs()).fold(0.0, f64::max);
+//! assert!(peak > 0.0);
+//! ```
+
+use crate::admittance_fit;
+use crate::dsp::engine::Engine;
+use crate::dsp::friction::FrictionModel;
+use crate::dsp::instrument::{midi_to_hz, BowControl, Frame, Instrument, InstrumentKind};
+use crate::dsp::rubbed::{RubbedInstrument, RubbedPreset};
+use crate::dsp::thermal::ThermalString;
+use crate::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
+use crate::quality::{self, Quality};
+
+/// Samples between two tail estimates (see [`Performer::status`]).
+const TAIL_EVERY: usize = 2048;
+
+/// The thermal bow's node count: fixed, or chosen per note (`quality = auto`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ThermalNodes {
+    Fixed(usize),
+    Auto,
+}
+
+/// What the player has set, read once per block.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Setup {
+    pub instrument: InstrumentKind,
+    /// The point law for the strings (and the rubbed objects); `None` plays paper B's
+    /// thermal model (the rubbed objects keep the last point law).
+    pub point_law: Option<FrictionModel>,
+    /// A rubbed object instead of the strings.
+    pub rubbed: Option<RubbedPreset>,
+    /// Newton tolerance of the bristle laws, m/s.
+    pub newton_tolerance_m_per_s: f64,
+    /// Reference pitch A4, Hz.
+    pub reference_hz: f64,
+    /// The string notes go to (0 = lowest), `None` for the usual choice.
+    pub preferred_string: Option<usize>,
+    pub thermal_nodes: ThermalNodes,
+    /// Bow hair width, m (thermal model).
+    pub bow_width_m: f64,
+    /// Bow position, for the automatic node count at a note-on.
+    pub bow_position_beta: f64,
+}
+
+impl Default for Setup {
+    fn default() -> Self {
+        Self {
+            instrument: InstrumentKind::Cello,
+            point_law: Some(FrictionModel::Hyperbolic),
+            rubbed: None,
+            newton_tolerance_m_per_s: Quality::Good.newton_tolerance_m_per_s(),
+            reference_hz: crate::dsp::instrument::REFERENCE_HZ_DEFAULT,
+            preferred_string: None,
+            thermal_nodes: ThermalNodes::Fixed(quality::GOOD_NODES),
+            bow_width_m: 0.01,
+            bow_position_beta: 0.1,
+        }
+    }
+}
+
+/// What the notes play: the waveguide strings, paper B's thermal instrument of one kind
+/// (index into [`InstrumentKind::ALL`]), or a rubbed object.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Source {
+    Strings,
+    Thermal(usize),
+    Rubbed(RubbedPreset),
+}
+
+impl Source {
+    /// The source a setup asks for.
+    pub fn of(setup: &Setup) -> Self {
+        match (setup.rubbed, setup.point_law) {
+            (Some(preset), _) => Source::Rubbed(preset),
+            (None, Some(_)) => Source::Strings,
+            (None, None) => {
+                let k = InstrumentKind::ALL
+                    .iter()
+                    .position(|x| *x == setup.instrument);
+                Source::Thermal(k.unwrap_or(0))
+            }
+        }
+    }
+}
+
+/// What the host should hear about a block.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Status {
+    /// A bow or an exciter is on.
+    KeepAlive,
+    /// Lifted strings or objects ring out for this many more samples.
+    Tail(u32),
+    /// Silent.
+    Normal,
+}
+
+/// See the module documentation.
+pub struct Performer {
+    instrument: Instrument,
+    /// Paper B's instrument, one per kind (violin, viola, cello), allocated in
+    /// [`Performer::activate`]: switching kind or model lets the one switched away from
+    /// ring on.
+    thermal: Vec<ThermalInstrument>,
+    rubbed: RubbedInstrument,
+    source: Source,
+    /// Held notes, so a source switch can move them to the new source.
+    held: [bool; 128],
+    /// The last note the strings took.
+    last_note: Option<u8>,
+    /// The thermal node count `quality = auto` chose at the last note-on.
+    auto_nodes: usize,
+    sample_rate_hz: f64,
+    /// The last tail estimate (samples left) and the samples processed since it: the
+    /// estimate walks every delay line, so it is renewed only every [`TAIL_EVERY`] samples.
+    tail: Option<(f64, usize)>,
+    setup: Setup,
+}
+
+impl Performer {
+    /// A performer at 48 kHz with no thermal instrument yet (cheap: call
+    /// [`Performer::activate`] before playing).
+    pub fn new(kind: InstrumentKind) -> Self {
+        Self {
+            instrument: Instrument::new(kind, 48_000.0),
+            thermal: Vec::new(),
+            rubbed: RubbedInstrument::new(48_000.0),
+            source: Source::Strings,
+            held: [false; 128],
+            last_note: None,
+            auto_nodes: quality::GOOD_NODES,
+            sample_rate_hz: 48_000.0,
+            tail: None,
+            setup: Setup {
+                instrument: kind,
+                ..Setup::default()
+            },
+        }
+    }
+
+    /// Allocates every engine for `sample_rate_hz`; nothing allocates after this.
+    pub fn activate(&mut self, setup: &Setup, sample_rate_hz: f64) -> Result<(), String> {
+        self.setup = *setup;
+        let fs = sample_rate_hz;
+        self.instrument = Instrument::new(setup.instrument, fs);
+        let settings = self.thermal_settings();
+        self.thermal.clear();
+        for kind in InstrumentKind::ALL {
+            let bridge = match kind {
+                InstrumentKind::Cello => admittance_fit::shipped_cello_bridge(),
+                // The viola borrows the violin's generic bridge (no viola data shipped).
+                InstrumentKind::Violin | InstrumentKind::Viola => {
+                    admittance_fit::shipped_violin_bridge()
+                }
+            };
+            let engine = ThermalInstrument::new(kind, &bridge.modes, fs, settings)
+                .map_err(|e| format!("cannot build the thermal {}: {e}", kind.name()))?;
+            self.thermal.push(engine);
+        }
+        self.rubbed = RubbedInstrument::new(fs);
+        self.source = Source::Strings;
+        self.held = [false; 128];
+        self.sample_rate_hz = fs;
+        self.tail = None;
+        Ok(())
+    }
+
+    /// Applies a block's setup: instrument, laws, tolerances, tuning, string choice, the
+    /// thermal bow's settings and the source; then what is quiet sleeps.
+    pub fn configure(&mut self, setup: &Setup) {
+        self.setup = *setup;
+        let wanted = Source::of(setup);
+        // The waveguide strings change instrument at once (silenced) only while they are
+        // what the notes play; ringing on behind another source, they finish first.
+        if wanted == Source::Strings || !self.instrument.is_sounding() {
+            self.instrument.set_kind(setup.instrument);
+        }
+        // The rubbed objects keep the last point law while the thermal model is chosen.
+        if let Some(friction) = setup.point_law {
+            self.instrument.set_friction_model(friction);
+            self.rubbed.set_friction_model(friction);
+        }
+        self.instrument
+            .set_newton_tolerance(setup.newton_tolerance_m_per_s);
+        self.rubbed
+            .set_newton_tolerance(setup.newton_tolerance_m_per_s);
+        let settings = self.thermal_settings();
+        for engine in self.engines() {
+            engine.set_reference_pitch(setup.reference_hz);
+            engine.set_preferred_string(setup.preferred_string);
+        }
+        for engine in &mut self.thermal {
+            engine.set_settings(settings);
+        }
+        self.apply_source(wanted);
+        for engine in self.engines() {
+            engine.update_sleep();
+        }
+    }
+
+    /// Every engine.
+    fn engines(&mut self) -> impl Iterator<Item = &mut dyn Engine> {
+        std::iter::once(&mut self.instrument as &mut dyn Engine)
+            .chain(self.thermal.iter_mut().map(|e| e as &mut dyn Engine))
+            .chain(std::iter::once(&mut self.rubbed as &mut dyn Engine))
+    }
+
+    pub fn note_on(&mut self, note: u8) {
+        // A bow lands: whatever tail was estimated no longer holds.
+        self.tail = None;
+        let key = note as usize & 127;
+        match self.source {
+            // Notes the instrument cannot play are ignored.
+            Source::Strings => {
+                if self.instrument.note_on(note).is_some() {
+                    self.held[key] = true;
+                    self.last_note = Some(note);
+                }
+            }
+            Source::Thermal(k) => {
+                self.choose_auto_nodes(note);
+                let settings = self.thermal_settings();
+                if let Some(engine) = self.thermal.get_mut(k) {
+                    // A new node count fades the instrument out and lands the note after.
+                    engine.set_settings(settings);
+                    if engine.note_on(note).is_some() {
+                        self.held[key] = true;
+                        self.last_note = Some(note);
+                    }
+                }
+            }
+            Source::Rubbed(_) => {
+                if !self.held[key] {
+                    self.held[key] = true;
+                    self.rubbed.note_on();
+                }
+            }
+        }
+    }
+
+    pub fn note_off(&mut self, note: u8) {
+        let was_held = std::mem::replace(&mut self.held[note as usize & 127], false);
+        match self.source {
+            Source::Strings => self.instrument.note_off(note),
+            Source::Thermal(k) => {
+                if let Some(engine) = self.thermal.get_mut(k) {
+                    engine.note_off(note);
+                }
+            }
+            Source::Rubbed(_) if was_held => self.rubbed.note_off(),
+            Source::Rubbed(_) => {}
+        }
+    }
+
+    pub fn all_notes_off(&mut self) {
+        self.held = [false; 128];
+        for engine in self.engines() {
+            engine.all_notes_off();
+        }
+    }
+
+    /// Pitch bend in semitones, for every engine with pitch.
+    pub fn set_pitch_bend(&mut self, semitones: f64) {
+        for engine in self.engines() {
+            engine.set_pitch_bend(semitones);
+        }
+    }
+
+    /// Silences every engine and forgets the held notes (the source stays).
+    pub fn reset(&mut self) {
+        for engine in self.engines() {
+            engine.reset();
+        }
+        self.held = [false; 128];
+    }
+
+    /// One sample. Every engine ticks while it sounds (the one just switched away from
+    /// rings on); the contact probe is the source's.
+    #[inline]
+    pub fn tick(&mut self, bow: BowControl) -> Frame {
+        let mut frame = self.instrument.tick(bow);
+        for (k, engine) in self.thermal.iter_mut().enumerate() {
+            if engine.is_sounding() {
+                let f = engine.tick(bow);
+                frame.audio += f.audio;
+                if self.source == Source::Thermal(k) {
+                    frame.bow_point_velocity_m_per_s = f.bow_point_velocity_m_per_s;
+                    frame.friction_force_n = f.friction_force_n;
+                }
+            }
+        }
+        if self.rubbed.is_sounding() {
+            frame.audio += self.rubbed.tick_bow(&bow);
+        }
+        frame
+    }
+
+    /// What the notes play now.
+    pub fn source(&self) -> Source {
+        self.source
+    }
+
+    /// The last note the strings took (the editor draws its Schelleng window).
+    pub fn last_note(&self) -> Option<u8> {
+        self.last_note
+    }
+
+    /// The string the thermal source's last note went to, while the thermal model plays.
+    pub fn probed_thermal_string(&self) -> Option<&ThermalString> {
+        match self.source {
+            Source::Thermal(k) => self.thermal.get(k).map(|e| e.probed_string()),
+            _ => None,
+        }
+    }
+
+    /// Applies a source: held notes move to the new source (its bow lands over the usual
+    /// ramp) and the old one rings on, so there is no click.
+    fn apply_source(&mut self, choice: Source) {
+        if choice == self.source {
+            return;
+        }
+        let held = self.held;
+        self.all_notes_off();
+        self.source = choice;
+        if let Source::Rubbed(preset) = choice {
+            self.rubbed.set_preset(preset);
+        }
+        for (note, down) in held.iter().enumerate() {
+            if *down {
+                self.note_on(note as u8);
+            }
+        }
+    }
+
+    fn thermal_settings(&self) -> ThermalSettings {
+        ThermalSettings {
+            nodes: match self.setup.thermal_nodes {
+                ThermalNodes::Fixed(n) => n,
+                ThermalNodes::Auto => self.auto_nodes,
+            },
+            width_m: self.setup.bow_width_m,
+        }
+    }
+
+    /// `quality = auto`: the node count for a new note at the current bow position, kept
+    /// if the current one is close enough ([`quality::auto_needs_rebuild`]).
+    fn choose_auto_nodes(&mut self, note: u8) {
+        if self.setup.thermal_nodes != ThermalNodes::Auto {
+            return;
+        }
+        let wanted = quality::auto_nodes(
+            self.setup.instrument,
+            midi_to_hz(note as f64),
+            self.setup.bow_position_beta,
+            self.setup.bow_width_m,
+        );
+        if quality::auto_needs_rebuild(self.auto_nodes, wanted) {
+            self.auto_nodes = wanted;
+        }
+    }
+
+    /// What the host hears about a block of `block` samples (CLAP process status and tail
+    /// extension, VST3 `getTailSamples`):
+    /// - `KeepAlive` while a bow or an exciter is on;
+    /// - `Tail(samples)` while lifted strings or rubbed objects ring out (the waveguide
+    ///   body's last blocks after its strings slept count as one sample, renewed while it
+    ///   rings);
+    /// - `Normal` once silent, so a CLAP host may stop calling `process` until input.
+    pub fn status(&mut self, block: usize) -> Status {
+        if let Some((left, since)) = self.tail {
+            if since + block < TAIL_EVERY {
+                let left = (left - block as f64).max(1.0);
+                self.tail = Some((left, since + block));
+                return Status::Tail(left as u32);
+            }
+        }
+        self.tail = None;
+        let mut tail_s = 0.0f64;
+        let mut sounding = false;
+        for engine in self.engines() {
+            if !engine.is_ringing() {
+                continue;
+            }
+            sounding = true;
+            match engine.ring_out_s() {
+                Some(s) => tail_s = tail_s.max(s),
+                None => return Status::KeepAlive,
+            }
+        }
+        if !sounding {
+            return Status::Normal;
+        }
+        // At least one sample while anything rings; below CLAP's "infinite" (i32::MAX).
+        let samples = (tail_s * self.sample_rate_hz)
+            .ceil()
+            .clamp(1.0, (i32::MAX - 1) as f64);
+        self.tail = Some((samples, 0));
+        Status::Tail(samples as u32)
+    }
+}
