@@ -317,6 +317,26 @@ impl Performer {
         frame
     }
 
+    /// The waveguide strings (for tools and tests: energy, solver statistics, and the
+    /// renderer's bristle, torsion and intonation settings).
+    pub fn strings(&self) -> &Instrument {
+        &self.instrument
+    }
+
+    pub fn strings_mut(&mut self) -> &mut Instrument {
+        &mut self.instrument
+    }
+
+    /// Paper B's instrument of `kind` (after [`Performer::activate`]).
+    pub fn thermal(&self, kind: InstrumentKind) -> Option<&ThermalInstrument> {
+        let k = InstrumentKind::ALL.iter().position(|x| *x == kind)?;
+        self.thermal.get(k)
+    }
+
+    pub fn rubbed(&self) -> &RubbedInstrument {
+        &self.rubbed
+    }
+
     /// What the notes play now.
     pub fn source(&self) -> Source {
         self.source

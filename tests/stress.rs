@@ -40,16 +40,17 @@
 
 mod host;
 
-use colophony::admittance_fit::{shipped_cello_bridge, shipped_violin_bridge};
 use colophony::dsp::friction::bristle::{SolverStats, NEWTON_CAP};
 use colophony::dsp::friction::BowInput;
 use colophony::dsp::friction::FrictionModel;
 use colophony::dsp::instrument::{BowControl, Instrument, InstrumentKind, BOW_RAMP_S, STRINGS};
-use colophony::dsp::rubbed::{RubbedInstrument, RubbedPreset, RubbedScene};
+use colophony::dsp::rubbed::{RubbedPreset, RubbedScene};
 use colophony::dsp::thermal_instrument::{
     ThermalInstrument, ThermalSettings, MAX_NODES, RECONFIGURE_FADE_S,
 };
 use colophony::params::{bow_force_range, bow_position_range, bow_velocity_range};
+use colophony::performer::{Performer, Setup, ThermalNodes};
+use colophony::quality::Quality;
 use host::{Event, HostedPlugin, Score};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, RngSeed, TestCaseError, TestError, TestRunner};
@@ -363,130 +364,124 @@ struct DspCase {
     script: Vec<Step>,
 }
 
-fn thermal_instrument(kind: InstrumentKind, rate_hz: f64, s: ThermalSettings) -> ThermalInstrument {
-    let bridge = match kind {
-        InstrumentKind::Cello => shipped_cello_bridge(),
-        // As the plugin: the viola borrows the violin's bridge.
-        InstrumentKind::Violin | InstrumentKind::Viola => shipped_violin_bridge(),
-    };
-    ThermalInstrument::new(kind, &bridge.modes, rate_hz, s).expect("valid thermal settings")
-}
-
 /// The plugin's default bow, at which a rubbed preset plays at its own velocity and force.
-const RUB_REFERENCE: BowControl = BowControl {
-    velocity_m_per_s: 0.1,
-    force_n: 1.0,
-    position_beta: 0.1,
-};
+const RUB_REFERENCE: BowControl = colophony::dsp::rubbed::REFERENCE_BOW;
 
-enum Rig {
-    Strings(Box<Instrument>),
-    Thermal(Box<ThermalInstrument>),
-    Rubbed(Box<RubbedInstrument>, [bool; 128]),
+/// A case played through the plugin's performer, set up for one engine.
+struct Rig {
+    engine: Engine,
+    setup: Setup,
+    performer: Performer,
 }
 
 impl Rig {
     fn new(engine: Engine, rate_hz: f64) -> Self {
-        match engine {
-            Engine::Strings(kind, law) => {
-                let mut i = Instrument::new(kind, rate_hz);
-                i.set_friction_model(law);
-                Rig::Strings(Box::new(i))
-            }
-            Engine::Thermal(kind, s) => {
-                Rig::Thermal(Box::new(thermal_instrument(kind, rate_hz, s)))
-            }
-            Engine::Rubbed(preset, law) => {
-                let mut r = RubbedInstrument::new(rate_hz);
-                r.set_preset(preset);
-                r.set_friction_model(law);
-                Rig::Rubbed(Box::new(r), [false; 128])
-            }
+        let base = Setup {
+            newton_tolerance_m_per_s: Quality::Reference.newton_tolerance_m_per_s(),
+            ..Setup::default()
+        };
+        let setup = match engine {
+            Engine::Strings(kind, law) => Setup {
+                instrument: kind,
+                point_law: Some(law),
+                ..base
+            },
+            Engine::Thermal(kind, s) => Setup {
+                instrument: kind,
+                point_law: None,
+                thermal_nodes: ThermalNodes::Fixed(s.nodes),
+                bow_width_m: s.width_m,
+                ..base
+            },
+            Engine::Rubbed(preset, law) => Setup {
+                rubbed: Some(preset),
+                point_law: Some(law),
+                ..base
+            },
+        };
+        let mut performer = Performer::new(setup.instrument);
+        performer
+            .activate(&setup, rate_hz)
+            .expect("valid thermal settings");
+        performer.configure(&setup);
+        Rig {
+            engine,
+            setup,
+            performer,
         }
     }
 
-    /// Everything that is not a bow control (those the caller keeps).
+    fn strings(&self) -> &Instrument {
+        self.performer.strings()
+    }
+
+    fn thermal(&self) -> &ThermalInstrument {
+        self.performer
+            .thermal(self.setup.instrument)
+            .expect("activated")
+    }
+
+    /// Everything that is not a bow control (those the caller keeps). Setup changes land
+    /// at once, as a parameter change splits the plugin's block.
     fn apply(&mut self, op: Op) {
-        match (self, op) {
-            (Rig::Strings(i), Op::NoteOn(n)) => {
-                i.note_on(n);
+        let before = self.setup;
+        match (self.engine, op) {
+            (_, Op::NoteOn(n)) => self.performer.note_on(n),
+            (_, Op::NoteOff(n)) => self.performer.note_off(n),
+            (_, Op::AllOff) => self.performer.all_notes_off(),
+            (Engine::Strings(..) | Engine::Thermal(..), Op::Bend(b)) => {
+                self.performer.set_pitch_bend(b)
             }
-            (Rig::Strings(i), Op::NoteOff(n)) => i.note_off(n),
-            (Rig::Strings(i), Op::AllOff) => i.all_notes_off(),
-            (Rig::Strings(i), Op::Law(Law::Point(m))) => i.set_friction_model(m),
-            (Rig::Strings(i), Op::Kind(k)) => i.set_kind(k),
-            (Rig::Strings(i), Op::Bend(b)) => i.set_pitch_bend(b),
-            (Rig::Thermal(i), Op::NoteOn(n)) => {
-                i.note_on(n);
+            (Engine::Strings(..) | Engine::Rubbed(..), Op::Law(Law::Point(m))) => {
+                self.setup.point_law = Some(m)
             }
-            (Rig::Thermal(i), Op::NoteOff(n)) => i.note_off(n),
-            (Rig::Thermal(i), Op::AllOff) => i.all_notes_off(),
-            (Rig::Thermal(i), Op::ThermalBow(s)) => i.set_settings(s),
-            (Rig::Thermal(i), Op::Bend(b)) => i.set_pitch_bend(b),
-            // As the plugin: one exciter press per held key.
-            (Rig::Rubbed(r, held), Op::NoteOn(n)) => {
-                if !std::mem::replace(&mut held[n as usize], true) {
-                    r.note_on();
-                }
+            (Engine::Strings(..), Op::Kind(k)) => self.setup.instrument = k,
+            (Engine::Thermal(..), Op::ThermalBow(s)) => {
+                self.setup.thermal_nodes = ThermalNodes::Fixed(s.nodes);
+                self.setup.bow_width_m = s.width_m;
             }
-            (Rig::Rubbed(r, held), Op::NoteOff(n)) => {
-                if std::mem::replace(&mut held[n as usize], false) {
-                    r.note_off();
-                }
-            }
-            (Rig::Rubbed(r, held), Op::AllOff) => {
-                *held = [false; 128];
-                r.all_notes_off();
-            }
-            (Rig::Rubbed(r, _), Op::Law(Law::Point(m))) => r.set_friction_model(m),
-            (Rig::Rubbed(r, _), Op::Resonator(Some(p))) => r.set_preset(p),
+            (Engine::Rubbed(..), Op::Resonator(Some(p))) => self.setup.rubbed = Some(p),
             _ => {}
+        }
+        if self.setup != before {
+            self.performer.configure(&self.setup);
         }
     }
 
     fn block_start(&mut self) {
-        match self {
-            Rig::Strings(i) => i.update_sleep(),
-            Rig::Thermal(i) => i.update_sleep(),
-            Rig::Rubbed(r, _) => r.update_sleep(),
-        }
+        self.performer.configure(&self.setup);
     }
 
     fn tick(&mut self, bow: BowControl) -> f64 {
-        match self {
-            Rig::Strings(i) => i.tick(bow).audio,
-            Rig::Thermal(i) => i.tick(bow).audio,
-            Rig::Rubbed(r, _) => r.tick(
-                bow.velocity_m_per_s / RUB_REFERENCE.velocity_m_per_s,
-                bow.force_n / RUB_REFERENCE.force_n,
-            ),
-        }
+        self.performer.tick(bow).audio
     }
 
     fn energy_j(&self) -> f64 {
-        match self {
-            Rig::Strings(i) => i.energy_j(),
-            Rig::Thermal(i) => i.energy_j(),
-            Rig::Rubbed(r, _) => r.energy_j(),
+        match self.engine {
+            Engine::Strings(..) => self.strings().energy_j(),
+            Engine::Thermal(..) => self.thermal().energy_j(),
+            Engine::Rubbed(..) => self.performer.rubbed().energy_j(),
         }
     }
 
     fn recoveries(&self) -> u64 {
-        match self {
-            Rig::Strings(i) => i.recoveries(),
-            Rig::Thermal(i) => i.recoveries(),
-            Rig::Rubbed(..) => 0,
+        match self.engine {
+            Engine::Strings(..) => self.strings().recoveries(),
+            Engine::Thermal(..) => self.thermal().recoveries(),
+            Engine::Rubbed(..) => 0,
         }
     }
 
     /// The Newton statistics of every bristle contact.
     fn solver_stats(&self) -> Vec<SolverStats> {
-        match self {
-            Rig::Strings(i) => (0..STRINGS).map(|s| i.solver_stats(s)).collect(),
-            Rig::Thermal(_) => Vec::new(),
-            Rig::Rubbed(r, _) => RubbedPreset::ALL
+        match self.engine {
+            Engine::Strings(..) => (0..STRINGS)
+                .map(|s| self.strings().solver_stats(s))
+                .collect(),
+            Engine::Thermal(..) => Vec::new(),
+            Engine::Rubbed(..) => RubbedPreset::ALL
                 .iter()
-                .map(|p| r.solver_stats(*p))
+                .map(|p| self.performer.rubbed().solver_stats(*p))
                 .collect(),
         }
     }
@@ -503,9 +498,9 @@ impl Rig {
     /// loudest preset by this measure gives 30. The runs peak at 13; the runaway exciter
     /// of `paper_modal_exciter_does_not_run_away_while_the_bow_force_is_down` went past.
     fn peak_bound(&self) -> f64 {
-        match self {
-            Rig::Strings(_) | Rig::Thermal(_) => 20.0,
-            Rig::Rubbed(..) => RubbedPreset::ALL
+        match self.engine {
+            Engine::Strings(..) | Engine::Thermal(..) => 20.0,
+            Engine::Rubbed(..) => RubbedPreset::ALL
                 .iter()
                 .map(|p| {
                     let spec = p.spec();
@@ -543,12 +538,14 @@ fn settle_frames(rate_hz: f64) -> usize {
 
 impl EnergyWatch {
     fn start(rig: &Rig, now: usize, rate_hz: f64) -> Self {
-        match rig {
-            Rig::Strings(i) => EnergyWatch::Strings(std::array::from_fn(|s| {
+        match rig.engine {
+            Engine::Strings(..) => EnergyWatch::Strings(std::array::from_fn(|s| {
+                let i = rig.strings();
                 let period = (i.string(s).loop_samples().round() as usize).max(1);
                 (now + period, period, i.string(s).energy_j())
             })),
-            Rig::Thermal(i) => {
+            Engine::Thermal(..) => {
+                let i = rig.thermal();
                 let longest = (0..STRINGS)
                     .map(|s| i.string(s).loop_samples())
                     .max()
@@ -561,10 +558,10 @@ impl EnergyWatch {
                     tolerance: THERMAL_ENERGY_TOLERANCE,
                 }
             }
-            Rig::Rubbed(r, _) => EnergyWatch::Total {
+            Engine::Rubbed(..) => EnergyWatch::Total {
                 next: now + 1,
                 stride: 1,
-                last: r.energy_j(),
+                last: rig.energy_j(),
                 tolerance: MODAL_ENERGY_TOLERANCE,
             },
         }
@@ -572,8 +569,9 @@ impl EnergyWatch {
 
     /// After the tick of frame `now`; `Err` says what grew. Returns checks made.
     fn check(&mut self, rig: &Rig, now: usize) -> Result<u64, String> {
-        match (self, rig) {
-            (EnergyWatch::Strings(state), Rig::Strings(i)) => {
+        match (self, rig.engine) {
+            (EnergyWatch::Strings(state), Engine::Strings(..)) => {
+                let i = rig.strings();
                 let mut checks = 0;
                 for (s, (next, period, last)) in state.iter_mut().enumerate() {
                     if now == *next {
@@ -598,7 +596,7 @@ impl EnergyWatch {
                     last,
                     tolerance,
                 },
-                Rig::Thermal(_) | Rig::Rubbed(..),
+                Engine::Thermal(..) | Engine::Rubbed(..),
             ) => {
                 if now != *next {
                     return Ok(0);

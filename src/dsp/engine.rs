@@ -47,80 +47,52 @@ pub trait Engine {
     fn reset(&mut self);
 }
 
-impl Engine for Instrument {
-    fn note_on(&mut self, note: u8) -> Option<usize> {
-        Instrument::note_on(self, note)
-    }
-    fn note_off(&mut self, note: u8) {
-        Instrument::note_off(self, note)
-    }
-    fn all_notes_off(&mut self) {
-        Instrument::all_notes_off(self)
-    }
-    fn set_pitch_bend(&mut self, semitones: f64) {
-        Instrument::set_pitch_bend(self, semitones)
-    }
-    fn set_preferred_string(&mut self, string: Option<usize>) {
-        Instrument::set_preferred_string(self, string)
-    }
-    fn set_reference_pitch(&mut self, a4_hz: f64) {
-        Instrument::set_reference_pitch(self, a4_hz)
-    }
-    fn update_sleep(&mut self) {
-        Instrument::update_sleep(self)
-    }
-    fn is_sounding(&self) -> bool {
-        Instrument::is_sounding(self)
-    }
-    fn is_ringing(&self) -> bool {
-        Instrument::is_ringing(self)
-    }
-    fn ring_out_s(&self) -> Option<f64> {
-        Instrument::ring_out_s(self)
-    }
-    fn tick(&mut self, bow: BowControl) -> Frame {
-        Instrument::tick(self, bow)
-    }
-    fn reset(&mut self) {
-        Instrument::reset(self)
-    }
+/// The string instruments already have every method under the trait's name.
+macro_rules! string_engine {
+    ($t:ty) => {
+        impl Engine for $t {
+            fn note_on(&mut self, note: u8) -> Option<usize> {
+                <$t>::note_on(self, note)
+            }
+            fn note_off(&mut self, note: u8) {
+                <$t>::note_off(self, note)
+            }
+            fn all_notes_off(&mut self) {
+                <$t>::all_notes_off(self)
+            }
+            fn set_pitch_bend(&mut self, semitones: f64) {
+                <$t>::set_pitch_bend(self, semitones)
+            }
+            fn set_preferred_string(&mut self, string: Option<usize>) {
+                <$t>::set_preferred_string(self, string)
+            }
+            fn set_reference_pitch(&mut self, a4_hz: f64) {
+                <$t>::set_reference_pitch(self, a4_hz)
+            }
+            fn update_sleep(&mut self) {
+                <$t>::update_sleep(self)
+            }
+            fn is_sounding(&self) -> bool {
+                <$t>::is_sounding(self)
+            }
+            fn is_ringing(&self) -> bool {
+                <$t>::is_ringing(self)
+            }
+            fn ring_out_s(&self) -> Option<f64> {
+                <$t>::ring_out_s(self)
+            }
+            fn tick(&mut self, bow: BowControl) -> Frame {
+                <$t>::tick(self, bow)
+            }
+            fn reset(&mut self) {
+                <$t>::reset(self)
+            }
+        }
+    };
 }
 
-impl Engine for ThermalInstrument {
-    fn note_on(&mut self, note: u8) -> Option<usize> {
-        ThermalInstrument::note_on(self, note)
-    }
-    fn note_off(&mut self, note: u8) {
-        ThermalInstrument::note_off(self, note)
-    }
-    fn all_notes_off(&mut self) {
-        ThermalInstrument::all_notes_off(self)
-    }
-    fn set_pitch_bend(&mut self, semitones: f64) {
-        ThermalInstrument::set_pitch_bend(self, semitones)
-    }
-    fn set_preferred_string(&mut self, string: Option<usize>) {
-        ThermalInstrument::set_preferred_string(self, string)
-    }
-    fn set_reference_pitch(&mut self, a4_hz: f64) {
-        ThermalInstrument::set_reference_pitch(self, a4_hz)
-    }
-    fn update_sleep(&mut self) {
-        ThermalInstrument::update_sleep(self)
-    }
-    fn is_sounding(&self) -> bool {
-        ThermalInstrument::is_sounding(self)
-    }
-    fn ring_out_s(&self) -> Option<f64> {
-        ThermalInstrument::ring_out_s(self)
-    }
-    fn tick(&mut self, bow: BowControl) -> Frame {
-        ThermalInstrument::tick(self, bow)
-    }
-    fn reset(&mut self) {
-        ThermalInstrument::reset(self)
-    }
-}
+string_engine!(Instrument);
+string_engine!(ThermalInstrument);
 
 /// The rubbed objects take every note as one exciter on the active object (a note held
 /// twice counts twice: the performer sends each held key once).

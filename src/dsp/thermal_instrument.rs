@@ -538,6 +538,12 @@ impl ThermalInstrument {
         self.awake
     }
 
+    /// Whether anything still rings (the bridge rings with the strings: as
+    /// [`ThermalInstrument::is_sounding`]).
+    pub fn is_ringing(&self) -> bool {
+        self.awake
+    }
+
     /// The string a note went to last (for the editor's views and the tests).
     pub fn probed_string(&self) -> &ThermalString {
         &self.core.strings[self.core.probed]
