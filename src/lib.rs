@@ -12,6 +12,7 @@ pub mod dsp;
 pub mod editor;
 pub mod figures;
 pub mod intonation_fit;
+pub mod midi_file;
 pub mod params;
 pub mod performer;
 pub mod playing_space;
@@ -20,12 +21,11 @@ pub mod precision;
 pub mod quality;
 pub mod render;
 
-use dsp::instrument::{BowControl, InstrumentKind, PITCH_BEND_SEMITONES};
+use dsp::instrument::{BowControl, InstrumentKind};
 use nice_plug::midi::Key;
 use nice_plug::prelude::*;
 use params::ColophonyParams;
-use performer::{Performer, Setup, Status, ThermalNodes};
-use quality::Quality;
+use performer::{Performer, Status};
 use std::sync::Arc;
 
 pub struct Colophony {
@@ -52,32 +52,6 @@ impl Default for Colophony {
 }
 
 impl Colophony {
-    /// The parameters as the performer takes them.
-    fn setup(&self) -> Setup {
-        let p = &self.params;
-        let quality = p.quality.value().preset();
-        Setup {
-            instrument: p.instrument.value().into(),
-            point_law: p.friction_model.value().point_law(),
-            rubbed: p.resonator.value().preset(),
-            // Custom quality solves the bristle laws to the reference's tolerance.
-            newton_tolerance_m_per_s: quality
-                .unwrap_or(Quality::Reference)
-                .newton_tolerance_m_per_s(),
-            reference_hz: p.reference_pitch.value() as f64,
-            preferred_string: p.string.value().index(),
-            thermal_nodes: match quality {
-                None => ThermalNodes::Fixed(p.bow_nodes.value().max(1) as usize),
-                Some(Quality::Auto) => ThermalNodes::Auto,
-                Some(q) => {
-                    ThermalNodes::Fixed(q.fixed_thermal_nodes().unwrap_or(quality::GOOD_NODES))
-                }
-            },
-            bow_width_m: p.bow_width_mm.value() as f64 * 1e-3,
-            bow_position_beta: p.bow_position.value() as f64,
-        }
-    }
-
     fn handle_event(&mut self, event: NoteEvent<()>) {
         match event {
             NoteEvent::NoteOn {
@@ -92,10 +66,9 @@ impl Colophony {
                 key: Key::Wildcard, ..
             }
             | NoteEvent::Choke { .. } => self.performer.all_notes_off(),
-            NoteEvent::MidiPitchBend { value, .. } => {
-                let semitones = (value as f64 - 0.5) * 2.0 * PITCH_BEND_SEMITONES;
-                self.performer.set_pitch_bend(semitones);
-            }
+            NoteEvent::MidiPitchBend { value, .. } => self
+                .performer
+                .set_pitch_bend(performer::bend_semitones(value)),
             _ => {}
         }
     }
@@ -141,7 +114,7 @@ impl Plugin for Colophony {
     ) -> bool {
         // Every buffer is sized here, never in `process`.
         let fs = buffer_config.sample_rate as f64;
-        if let Err(e) = self.performer.activate(&self.setup(), fs) {
+        if let Err(e) = self.performer.activate(&self.params.setup(), fs) {
             nice_log!("{e}");
             return false;
         }
@@ -164,7 +137,7 @@ impl Plugin for Colophony {
         _aux: &mut AuxiliaryBuffers,
         context: &mut impl ProcessContext<Self>,
     ) -> ProcessStatus {
-        self.performer.configure(&self.setup());
+        self.performer.configure(&self.params.setup());
         // The editor's live views are fed only while an editor shows them.
         let live = self.editor_link.is_listening();
         let mut next_event = context.next_event();

@@ -75,6 +75,14 @@ enum Command {
         /// wine-glass or brake-squeal (the other bow settings are then the preset's).
         #[arg(long, value_parser = parse_preset)]
         preset: Option<RubbedPreset>,
+        /// Play a standard MIDI file (notes and pitch bend, with its tempo map) through the
+        /// plugin's performer at the plugin's defaults and the bow given; --note,
+        /// --seconds and --release are then unused.
+        #[arg(long)]
+        midi: Option<PathBuf>,
+        /// With --midi: only this track (0 = the first in the file); default all.
+        #[arg(long)]
+        track: Option<usize>,
     },
     /// Draw a figure as PNG: serafin-fig7, serafin-modal, bridge-fit.
     Figure {
@@ -193,7 +201,20 @@ fn main() -> ExitCode {
             bow_width,
             quality,
             preset,
+            midi,
+            track,
         } => {
+            if let Some(midi) = midi {
+                return report(render_midi(
+                    &midi, track, &out, instrument, friction, quality, nodes, bow_width,
+                    BowControl {
+                        velocity_m_per_s: bow_velocity,
+                        force_n: bow_force,
+                        position_beta: bow_position,
+                    },
+                    sample_rate, reference_pitch,
+                ));
+            }
             let tolerance = quality.map(|q| q.newton_tolerance_m_per_s());
             // The renderer's thermal string runs at its own rate (its nodes, its wave speed).
             let nodes = match (quality, instrument.string_for_note(note)) {
@@ -328,6 +349,69 @@ fn main() -> ExitCode {
             report(colophony::admittance_fit::run_cli(&input, modes, &out))
         }
     }
+}
+
+/// `colophony render --midi`: the plugin's default setup with the command line's
+/// instrument, law, quality, reference pitch and bow.
+#[allow(clippy::too_many_arguments)]
+fn render_midi(
+    midi: &std::path::Path,
+    track: Option<usize>,
+    out: &std::path::Path,
+    instrument: InstrumentKind,
+    friction: FrictionArg,
+    quality: Option<Quality>,
+    nodes: usize,
+    bow_width: f64,
+    bow: BowControl,
+    sample_rate: f64,
+    reference_pitch: f64,
+) -> Result<String, String> {
+    use colophony::performer::ThermalNodes;
+    colophony::render::check(&RenderSettings {
+        instrument,
+        note: instrument.note_range().0,
+        bow,
+        sample_rate_hz: sample_rate,
+        reference_hz: reference_pitch,
+        ..RenderSettings::default()
+    })
+    .map_err(|e| e.to_string())?;
+    use colophony::dsp::thermal_instrument::{MAX_WIDTH_M, MIN_WIDTH_M};
+    if !(bow_width.is_finite() && (MIN_WIDTH_M..=MAX_WIDTH_M).contains(&bow_width)) {
+        return Err(format!(
+            "--bow-width must be within {MIN_WIDTH_M}..={MAX_WIDTH_M} m (the plugin's range), got {bow_width}"
+        ));
+    }
+    let params = colophony::params::ColophonyParams::default();
+    let mut setup = params.setup();
+    setup.instrument = instrument;
+    setup.reference_hz = reference_pitch;
+    setup.bow_width_m = bow_width;
+    setup.bow_position_beta = bow.position_beta;
+    setup.point_law = match friction {
+        FrictionArg::Point(model) => Some(model),
+        FrictionArg::Thermal => None,
+    };
+    setup.thermal_nodes = match quality {
+        Some(Quality::Auto) => ThermalNodes::Auto,
+        Some(q) => ThermalNodes::Fixed(
+            q.fixed_thermal_nodes()
+                .unwrap_or(colophony::quality::GOOD_NODES),
+        ),
+        None => ThermalNodes::Fixed(nodes.max(1)),
+    };
+    if let Some(q) = quality {
+        setup.newton_tolerance_m_per_s = q.newton_tolerance_m_per_s();
+    }
+    let how = colophony::midi_file::Performance {
+        setup,
+        bow,
+        gain: nice_plug::util::db_to_gain(params.gain.value()) as f64,
+        sample_rate_hz: sample_rate,
+        block: 512,
+    };
+    colophony::midi_file::render_file(midi, track, &how, out)
 }
 
 /// `--friction` defaults to hyperbolic for strings; rubbed presets use elasto-plastic

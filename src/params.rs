@@ -306,3 +306,41 @@ impl Default for ColophonyParams {
         }
     }
 }
+
+impl ColophonyParams {
+    /// The parameters as the performer takes them (read once per block).
+    pub fn setup(&self) -> crate::performer::Setup {
+        use crate::performer::{Setup, ThermalNodes};
+        use crate::quality::{self, Quality};
+        let quality = self.quality.value().preset();
+        Setup {
+            instrument: self.instrument.value().into(),
+            point_law: self.friction_model.value().point_law(),
+            rubbed: self.resonator.value().preset(),
+            // Custom quality solves the bristle laws to the reference's tolerance.
+            newton_tolerance_m_per_s: quality
+                .unwrap_or(Quality::Reference)
+                .newton_tolerance_m_per_s(),
+            reference_hz: self.reference_pitch.value() as f64,
+            preferred_string: self.string.value().index(),
+            thermal_nodes: match quality {
+                None => ThermalNodes::Fixed(self.bow_nodes.value().max(1) as usize),
+                Some(Quality::Auto) => ThermalNodes::Auto,
+                Some(q) => {
+                    ThermalNodes::Fixed(q.fixed_thermal_nodes().unwrap_or(quality::GOOD_NODES))
+                }
+            },
+            bow_width_m: self.bow_width_mm.value() as f64 * 1e-3,
+            bow_position_beta: self.bow_position.value() as f64,
+        }
+    }
+
+    /// The bow the parameters set (their values, not their smoothed ramps).
+    pub fn bow(&self) -> crate::dsp::instrument::BowControl {
+        crate::dsp::instrument::BowControl {
+            velocity_m_per_s: self.bow_velocity.value() as f64,
+            force_n: self.bow_force.value() as f64,
+            position_beta: self.bow_position.value() as f64,
+        }
+    }
+}

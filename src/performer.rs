@@ -27,11 +27,19 @@
 use crate::admittance_fit;
 use crate::dsp::engine::Engine;
 use crate::dsp::friction::FrictionModel;
-use crate::dsp::instrument::{midi_to_hz, BowControl, Frame, Instrument, InstrumentKind};
+use crate::dsp::instrument::{
+    midi_to_hz, BowControl, Frame, Instrument, InstrumentKind, PITCH_BEND_SEMITONES,
+};
 use crate::dsp::rubbed::{RubbedInstrument, RubbedPreset};
 use crate::dsp::thermal::ThermalString;
 use crate::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
 use crate::quality::{self, Quality};
+
+/// Semitones of pitch bend for a MIDI pitch-bend wheel at `value` (0 = down, 0.5 =
+/// centre, 1 = up, as nice-plug delivers it).
+pub fn bend_semitones(value: f32) -> f64 {
+    (value as f64 - 0.5) * 2.0 * PITCH_BEND_SEMITONES
+}
 
 /// Samples between two tail estimates (see [`Performer::status`]).
 const TAIL_EVERY: usize = 2048;

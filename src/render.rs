@@ -113,7 +113,8 @@ impl Rendered {
     }
 }
 
-fn check(settings: &RenderSettings) -> Result<(), RenderError> {
+/// Checks the command line's settings: every bound the renderer and the plugin share.
+pub fn check(settings: &RenderSettings) -> Result<(), RenderError> {
     let bad = |s: String| Err(RenderError::BadSetting(s));
     let b = &settings.bow;
     if !(settings.seconds.is_finite() && settings.seconds > 0.0 && settings.seconds <= 600.0) {

@@ -871,3 +871,75 @@ fn assert_no_click_at(x: &[f64], switch_at: &[u64]) {
         assert!(at_switch <= 1.5 * before.max(1e-4), "click at sample {at}");
     }
 }
+
+#[test]
+fn a_midi_file_rendered_offline_gives_the_plugins_bits() {
+    use colophony::midi_file::{perform, MidiEvent, Performance, Timed};
+    // The same notes and bends, at the same samples and block size, through the CLAP
+    // build in the host and through `colophony render --midi`'s performer.
+    let bend = |amount: f64| (8192.0 + amount * 8192.0).round().clamp(0.0, 16383.0) as u16;
+    let events = [
+        Timed {
+            sample: 0,
+            event: MidiEvent::NoteOn(50),
+        },
+        Timed {
+            sample: 24_000,
+            event: MidiEvent::PitchBend(bend(0.5)),
+        },
+        Timed {
+            sample: 36_001,
+            event: MidiEvent::PitchBend(bend(-1.0)),
+        },
+        Timed {
+            sample: 48_000,
+            event: MidiEvent::NoteOff(50),
+        },
+        Timed {
+            sample: 48_000,
+            event: MidiEvent::NoteOn(57),
+        },
+        Timed {
+            sample: 60_123,
+            event: MidiEvent::PitchBend(bend(0.0)),
+        },
+        Timed {
+            sample: 72_000,
+            event: MidiEvent::NoteOff(57),
+        },
+    ];
+    let params = colophony::params::ColophonyParams::default();
+    let how = Performance {
+        setup: params.setup(),
+        bow: params.bow(),
+        gain: nice_plug::util::db_to_gain(params.gain.value()) as f64,
+        sample_rate_hz: FS,
+        block: BLOCK,
+    };
+    let offline = perform(&events, &how, |_, _| {}).unwrap();
+    let mut score = Score::new();
+    for e in &events {
+        let event = match e.event {
+            MidiEvent::NoteOn(n) => Event::note_on(n),
+            MidiEvent::NoteOff(n) => Event::note_off(n),
+            MidiEvent::PitchBend(raw) => Event::pitch_bend((raw as f64 - 8192.0) / 8192.0),
+        };
+        score.push(e.sample, event);
+    }
+    let frames = 96_000;
+    assert!(
+        offline.len() >= frames,
+        "offline render of {} frames",
+        offline.len()
+    );
+    let mut plugin = active_plugin(FS, BLOCK);
+    let hosted = plugin.render(frames, BLOCK, &score);
+    let differing = (0..frames)
+        .filter(|&i| hosted[0][i].to_bits() != offline[i].to_bits())
+        .count();
+    assert!(
+        rms(&channel_f64(&hosted, 0)) > 1e-3,
+        "the hosted plugin was silent"
+    );
+    assert_eq!(differing, 0, "{differing} of {frames} samples differ");
+}

@@ -249,3 +249,124 @@ fn quality_presets_render_and_the_draft_bows_the_references_pitch() {
     println!("draft against reference: {draft_error:+.3} cents");
     assert!(draft_error.abs() < 1.0, "{draft_error:+.3} cents");
 }
+
+/// A two-note MIDI file (format 1, tempo in track 0, notes in track 1) as bytes.
+fn two_note_midi() -> Vec<u8> {
+    use midly::num::{u15, u24, u28, u4, u7};
+    use midly::{
+        Format, Header, MetaMessage, MidiMessage, Smf, Timing, TrackEvent, TrackEventKind,
+    };
+    let ev = |delta: u32, kind| TrackEvent {
+        delta: u28::new(delta),
+        kind,
+    };
+    let note = |on: bool, key: u8| TrackEventKind::Midi {
+        channel: u4::new(0),
+        message: if on {
+            MidiMessage::NoteOn {
+                key: u7::new(key),
+                vel: u7::new(80),
+            }
+        } else {
+            MidiMessage::NoteOff {
+                key: u7::new(key),
+                vel: u7::new(0),
+            }
+        },
+    };
+    let mut smf = Smf::new(Header::new(
+        Format::Parallel,
+        Timing::Metrical(u15::new(480)),
+    ));
+    smf.tracks = vec![
+        // 60 bpm: a beat is a second.
+        vec![ev(
+            0,
+            TrackEventKind::Meta(MetaMessage::Tempo(u24::new(1_000_000))),
+        )],
+        vec![
+            ev(0, note(true, 50)),
+            ev(480, note(false, 50)),
+            ev(0, note(true, 57)),
+            ev(480, note(false, 57)),
+        ],
+    ];
+    let mut bytes = Vec::new();
+    smf.write_std(&mut bytes).unwrap();
+    bytes
+}
+
+/// `colophony render --midi MIDI --out OUT` with `extra` arguments.
+fn render_midi(midi: &std::path::Path, out: &std::path::Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "render",
+        "--midi",
+        midi.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    colophony(&args)
+}
+
+#[test]
+fn a_midi_file_renders_its_notes_at_their_times() {
+    let midi = scratch("two-notes.mid");
+    std::fs::write(&midi, two_note_midi()).unwrap();
+    let out = scratch("two-notes.wav");
+    let run = render_midi(&midi, &out, &[]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let mut reader = hound::WavReader::open(&out).unwrap();
+    let fs = reader.spec().sample_rate as f64;
+    let x: Vec<f64> = match reader.spec().sample_format {
+        hound::SampleFormat::Float => reader.samples::<f32>().map(|s| s.unwrap() as f64).collect(),
+        hound::SampleFormat::Int => reader.samples::<i32>().map(|s| s.unwrap() as f64).collect(),
+    };
+    // Two seconds of notes, then the ring-out.
+    assert!(x.len() as f64 >= 2.0 * fs, "{} frames", x.len());
+    let peak = |a: f64, b: f64| {
+        x[(a * fs) as usize..(b * fs) as usize]
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs()))
+    };
+    // Each second bows its note: D3 then A3 (the pitch within 50 cents of each).
+    use colophony::analysis::{cents, peak_frequency_hz};
+    for (from, note) in [(0.4, 50.0), (1.4, 57.0)] {
+        assert!(peak(from, from + 0.5) > 0.0, "silent at {from} s");
+        let w = &x[(from * fs) as usize..((from + 0.5) * fs) as usize];
+        let f = peak_frequency_hz(w, fs, midi_to_hz(note), 50.0);
+        let c = cents(f, midi_to_hz(note));
+        println!("note {note} at {from} s: {c:+.1} cents");
+        // 15 cents: the bowed pitch within a quarter second of a new note, before the
+        // attack has settled (the tuning itself is tested in tests/playing_space.rs).
+        assert!(c.abs() < 15.0, "note {note}: {c:+.1} cents");
+    }
+}
+
+#[test]
+fn broken_or_missing_midi_files_fail_in_one_line_with_no_file() {
+    let bad = scratch("bad.mid");
+    std::fs::write(&bad, b"MThd\x00\x00\x00\x06\x00").unwrap();
+    let missing = scratch("missing.mid");
+    for midi in [bad, missing] {
+        let out = scratch("never.wav");
+        let run = render_midi(&midi, &out, &[]);
+        let err = String::from_utf8_lossy(&run.stderr);
+        println!("{}", err.trim());
+        assert!(!run.status.success());
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert!(!out.exists() && !out.with_extension("wav.partial").exists());
+    }
+    // A track without notes.
+    let midi = scratch("tempo-only.mid");
+    std::fs::write(&midi, two_note_midi()).unwrap();
+    let out = scratch("never2.wav");
+    let run = render_midi(&midi, &out, &["--track", "0"]);
+    assert!(!run.status.success());
+    assert!(String::from_utf8_lossy(&run.stderr).contains("track 0 has no notes"));
+    assert!(!out.exists());
+}

@@ -1,0 +1,309 @@
+//! Standard MIDI files offline (`colophony render --midi FILE.mid`): the notes and pitch
+//! bends of a file, timed by its tempo map, played through the plugin's own performer
+//! ([`crate::performer`]) with the plugin's defaults, block by block as a host would call
+//! the plugin. Fed the same events at the same block size, the plugin gives the same bits
+//! (`tests/plugin_host.rs`).
+//!
+//! Controllers and pressure are not mapped yet (issue 18's performance layer): the bow
+//! plays at the constant velocity, force and position given.
+
+use crate::dsp::filters::{flush_tiny, safety_limit};
+use crate::dsp::instrument::BowControl;
+use crate::performer::{bend_semitones, Performer, Setup, Status};
+use midly::{MetaMessage, MidiMessage, Smf, Timing, TrackEventKind};
+
+/// What a MIDI file asks of the performer.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum MidiEvent {
+    NoteOn(u8),
+    NoteOff(u8),
+    /// The raw 14-bit value, 8192 = centre.
+    PitchBend(u16),
+}
+
+/// An event at an output sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Timed {
+    pub sample: u64,
+    pub event: MidiEvent,
+}
+
+/// The longest ring-out rendered after the last event, s.
+pub const MAX_TAIL_S: f64 = 10.0;
+/// The ring-out ends once the output has stayed below this for [`QUIET_S`] (-100 dBFS:
+/// below a 24-bit file's noise floor after dither, far below hearing)...
+pub const QUIET_LEVEL: f32 = 1e-5;
+/// ... seconds.
+pub const QUIET_S: f64 = 0.25;
+
+/// Reads the note and pitch-bend events of `bytes` (a standard MIDI file) at
+/// `sample_rate_hz`: every track merged, or only track `track` (0 = the first in the
+/// file). Tempo changes from any track time every track. Errors name what is wrong in one
+/// line.
+pub fn read_events(
+    bytes: &[u8],
+    track: Option<usize>,
+    sample_rate_hz: f64,
+) -> Result<Vec<Timed>, String> {
+    let smf = Smf::parse(bytes).map_err(|e| format!("not a standard MIDI file: {e}"))?;
+    if let Some(t) = track {
+        if t >= smf.tracks.len() {
+            return Err(format!(
+                "the file has {} track(s) (0..={}); there is no track {t}",
+                smf.tracks.len(),
+                smf.tracks.len().saturating_sub(1)
+            ));
+        }
+    }
+    // (tick, track, order in track, what): tempo changes from every track, notes from the
+    // chosen ones.
+    enum Item {
+        Tempo(u32),
+        Event(MidiEvent),
+    }
+    let mut items: Vec<(u64, usize, usize, Item)> = Vec::new();
+    for (t, events) in smf.tracks.iter().enumerate() {
+        let wanted = track.is_none_or(|w| w == t);
+        let mut tick = 0u64;
+        for (k, e) in events.iter().enumerate() {
+            tick += e.delta.as_int() as u64;
+            let item = match e.kind {
+                TrackEventKind::Meta(MetaMessage::Tempo(us)) => Some(Item::Tempo(us.as_int())),
+                TrackEventKind::Midi { message, .. } if wanted => match message {
+                    MidiMessage::NoteOn { key, vel } if vel.as_int() > 0 => {
+                        Some(Item::Event(MidiEvent::NoteOn(key.as_int())))
+                    }
+                    MidiMessage::NoteOn { key, .. } | MidiMessage::NoteOff { key, .. } => {
+                        Some(Item::Event(MidiEvent::NoteOff(key.as_int())))
+                    }
+                    MidiMessage::PitchBend { bend } => {
+                        Some(Item::Event(MidiEvent::PitchBend(bend.0.as_int())))
+                    }
+                    _ => None,
+                },
+                _ => None,
+            };
+            if let Some(item) = item {
+                items.push((tick, t, k, item));
+            }
+        }
+    }
+    items.sort_by_key(|(tick, t, k, _)| (*tick, *t, *k));
+    // Seconds per tick: metrical files follow the tempo (default 120 bpm), timecode files
+    // count frames.
+    let (ticks_per_beat, fixed_tick_s) = match smf.header.timing {
+        Timing::Metrical(tpb) => (tpb.as_int().max(1) as f64, None),
+        Timing::Timecode(fps, sub) => (1.0, Some(1.0 / (fps.as_f32() as f64 * sub.max(1) as f64))),
+    };
+    let mut tick_s = fixed_tick_s.unwrap_or(0.5 / ticks_per_beat);
+    let (mut last_tick, mut seconds) = (0u64, 0.0f64);
+    let mut out = Vec::new();
+    for (tick, _, _, item) in items {
+        seconds += (tick - last_tick) as f64 * tick_s;
+        last_tick = tick;
+        match item {
+            Item::Tempo(us) if fixed_tick_s.is_none() => {
+                tick_s = us.max(1) as f64 * 1e-6 / ticks_per_beat;
+            }
+            Item::Tempo(_) => {}
+            Item::Event(event) => out.push(Timed {
+                sample: (seconds * sample_rate_hz).round() as u64,
+                event,
+            }),
+        }
+    }
+    if !out.iter().any(|e| matches!(e.event, MidiEvent::NoteOn(_))) {
+        return Err(match track {
+            Some(t) => format!("track {t} has no notes"),
+            None => "the file has no notes".into(),
+        });
+    }
+    Ok(out)
+}
+
+/// How a file is played.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Performance {
+    pub setup: Setup,
+    pub bow: BowControl,
+    /// Linear output gain (the plugin's `gain` parameter).
+    pub gain: f64,
+    pub sample_rate_hz: f64,
+    /// Samples per block (the performer's setup and sleep are renewed each block).
+    pub block: usize,
+}
+
+/// Plays `events` and returns the output the plugin would give on each channel, through
+/// the last event and the ring-out (until silent or below [`QUIET_LEVEL`] for
+/// [`QUIET_S`], at most [`MAX_TAIL_S`]). `progress` is
+/// told the samples done and the total so far.
+pub fn perform(
+    events: &[Timed],
+    how: &Performance,
+    mut progress: impl FnMut(u64, u64),
+) -> Result<Vec<f32>, String> {
+    let block = how.block.max(1);
+    let mut performer = Performer::new(how.setup.instrument);
+    performer.activate(&how.setup, how.sample_rate_hz)?;
+    let last = events.last().map_or(0, |e| e.sample);
+    let hard_end = last + (MAX_TAIL_S * how.sample_rate_hz) as u64;
+    let mut out = Vec::with_capacity(last as usize + block);
+    let mut next = 0;
+    let mut done = 0u64;
+    let quiet_needed = (QUIET_S * how.sample_rate_hz) as u64;
+    let mut quiet = 0u64;
+    loop {
+        performer.configure(&how.setup);
+        for i in 0..block as u64 {
+            let now = done + i;
+            while next < events.len() && events[next].sample <= now {
+                match events[next].event {
+                    MidiEvent::NoteOn(n) => performer.note_on(n),
+                    MidiEvent::NoteOff(n) => performer.note_off(n),
+                    MidiEvent::PitchBend(raw) => {
+                        // As nice-plug hands it to the plugin: 0..1 in f32.
+                        performer.set_pitch_bend(bend_semitones(raw as f32 / 16383.0));
+                    }
+                }
+                next += 1;
+            }
+            let frame = performer.tick(how.bow);
+            let y = safety_limit(flush_tiny(frame.audio * how.gain)) as f32;
+            quiet = if y.abs() < QUIET_LEVEL { quiet + 1 } else { 0 };
+            out.push(y);
+        }
+        done += block as u64;
+        let status = performer.status(block);
+        progress(done, last.max(done));
+        let finished = next >= events.len() && done > last;
+        if finished && (status == Status::Normal || quiet >= quiet_needed || done >= hard_end) {
+            break;
+        }
+    }
+    Ok(out)
+}
+
+/// `colophony render --midi FILE`: reads `midi`, plays it as [`perform`] (blocks of 512),
+/// with a progress bar on a terminal, and writes `out` as the renderer does (no partial
+/// file on failure).
+pub fn render_file(
+    midi: &std::path::Path,
+    track: Option<usize>,
+    how: &Performance,
+    out: &std::path::Path,
+) -> Result<String, String> {
+    let bytes = std::fs::read(midi).map_err(|e| format!("cannot read {}: {e}", midi.display()))?;
+    let events = read_events(&bytes, track, how.sample_rate_hz)
+        .map_err(|e| format!("{}: {e}", midi.display()))?;
+    let bar = indicatif::ProgressBar::new(events.last().map_or(0, |e| e.sample));
+    if let Ok(style) = indicatif::ProgressStyle::with_template(
+        "{elapsed_precise} [{bar:40}] {percent} % of the file, eta {eta}",
+    ) {
+        bar.set_style(style);
+    }
+    let audio = perform(&events, how, |done, total| {
+        bar.set_length(total);
+        bar.set_position(done);
+    })?;
+    bar.finish_and_clear();
+    let seconds = audio.len() as f64 / how.sample_rate_hz;
+    let notes = events
+        .iter()
+        .filter(|e| matches!(e.event, MidiEvent::NoteOn(_)))
+        .count();
+    let rendered = crate::render::Rendered {
+        sample_rate_hz: how.sample_rate_hz,
+        audio: audio.into_iter().map(f64::from).collect(),
+        bow_point_velocity_m_per_s: Vec::new(),
+        friction_force_n: Vec::new(),
+        newton: Default::default(),
+    };
+    crate::render::write_wav(out, &rendered, false).map_err(|e| e.to_string())?;
+    Ok(format!(
+        "wrote {} ({notes} notes, {seconds:.1} s, from {})",
+        out.display(),
+        midi.display()
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use midly::num::{u15, u24, u28, u4, u7};
+    use midly::{Format, Header, TrackEvent};
+
+    fn file(timing: Timing, tracks: Vec<Vec<TrackEvent<'static>>>) -> Vec<u8> {
+        let mut smf = Smf::new(Header::new(Format::Parallel, timing));
+        smf.tracks = tracks;
+        let mut bytes = Vec::new();
+        smf.write_std(&mut bytes).unwrap();
+        bytes
+    }
+
+    fn ev(delta: u32, kind: TrackEventKind<'static>) -> TrackEvent<'static> {
+        TrackEvent {
+            delta: u28::new(delta),
+            kind,
+        }
+    }
+
+    fn note(on: bool, key: u8, vel: u8) -> TrackEventKind<'static> {
+        let (key, vel) = (u7::new(key), u7::new(vel));
+        TrackEventKind::Midi {
+            channel: u4::new(0),
+            message: if on {
+                MidiMessage::NoteOn { key, vel }
+            } else {
+                MidiMessage::NoteOff { key, vel }
+            },
+        }
+    }
+
+    #[test]
+    fn the_tempo_map_of_any_track_times_the_notes() {
+        // 480 ticks a beat; 120 bpm, then 60 bpm from beat 1 (set in track 0); notes in
+        // track 1 at beats 0, 1 and 2 fall at 0, 0.5 and 1.5 s.
+        let tempo = |us| TrackEventKind::Meta(MetaMessage::Tempo(u24::new(us)));
+        let bytes = file(
+            Timing::Metrical(u15::new(480)),
+            vec![
+                vec![ev(0, tempo(500_000)), ev(480, tempo(1_000_000))],
+                vec![
+                    ev(0, note(true, 50, 100)),
+                    ev(480, note(false, 50, 0)),
+                    ev(0, note(true, 52, 90)),
+                    ev(480, note(true, 52, 0)),
+                ],
+            ],
+        );
+        let got = read_events(&bytes, None, 48_000.0).unwrap();
+        let want = [
+            (0, MidiEvent::NoteOn(50)),
+            (24_000, MidiEvent::NoteOff(50)),
+            (24_000, MidiEvent::NoteOn(52)),
+            // A note-on of velocity 0 is a note-off.
+            (72_000, MidiEvent::NoteOff(52)),
+        ];
+        let got: Vec<(u64, MidiEvent)> = got.iter().map(|t| (t.sample, t.event)).collect();
+        assert_eq!(got, want);
+        // Track 0 alone has no notes; track 5 does not exist.
+        assert_eq!(
+            read_events(&bytes, Some(0), 48_000.0).unwrap_err(),
+            "track 0 has no notes"
+        );
+        assert!(read_events(&bytes, Some(5), 48_000.0)
+            .unwrap_err()
+            .contains("no track 5"));
+    }
+
+    #[test]
+    fn broken_files_are_refused_in_one_line() {
+        for bad in [&b""[..], b"MThd", b"RIFF0000WAVEfmt ", &[0xff; 64]] {
+            let e = read_events(bad, None, 48_000.0).unwrap_err();
+            assert!(
+                e.starts_with("not a standard MIDI file") && !e.contains('\n'),
+                "{e}"
+            );
+        }
+    }
+}
