@@ -69,6 +69,10 @@ impl Colophony {
             NoteEvent::MidiPitchBend { value, .. } => self
                 .performer
                 .set_pitch_bend(performer::bend_semitones(value)),
+            NoteEvent::MidiCC { cc, value, .. } => self.performer.set_controller(cc, value),
+            NoteEvent::MidiChannelPressure { pressure, .. } => {
+                self.performer.set_pressure(pressure)
+            }
             _ => {}
         }
     }
@@ -155,7 +159,8 @@ impl Plugin for Colophony {
             let gain = util::db_to_gain(p.gain.smoothed.next()) as f64;
             let frame = self.performer.tick(bow);
             if live {
-                let sample = editor::live::ContactSample::new(&frame, &bow);
+                let played = self.performer.bow();
+                let sample = editor::live::ContactSample::new(&frame, &played);
                 self.editor_link.scope.push(sample);
                 if let Some(string) = self.performer.probed_thermal_string() {
                     self.node_probe.add_string(string, &self.editor_link);

@@ -4,8 +4,9 @@
 //! the plugin. Fed the same events at the same block size, the plugin gives the same bits
 //! (`tests/plugin_host.rs`).
 //!
-//! Controllers and pressure are not mapped yet (issue 18's performance layer): the bow
-//! plays at the constant velocity, force and position given.
+//! Controllers reach the performer's performance layer as they would the plugin: CC11,
+//! CC2 and channel pressure set the dynamics, CC1 the vibrato depth. The bow's own
+//! velocity, force and position are the constants given.
 
 use crate::dsp::filters::{flush_tiny, safety_limit};
 use crate::dsp::instrument::BowControl;
@@ -19,6 +20,10 @@ pub enum MidiEvent {
     NoteOff(u8),
     /// The raw 14-bit value, 8192 = centre.
     PitchBend(u16),
+    /// Controller number and 7-bit value.
+    Controller(u8, u8),
+    /// Channel pressure, 7-bit.
+    Pressure(u8),
 }
 
 /// An event at an output sample.
@@ -78,6 +83,12 @@ pub fn read_events(
                     }
                     MidiMessage::PitchBend { bend } => {
                         Some(Item::Event(MidiEvent::PitchBend(bend.0.as_int())))
+                    }
+                    MidiMessage::Controller { controller, value } => Some(Item::Event(
+                        MidiEvent::Controller(controller.as_int(), value.as_int()),
+                    )),
+                    MidiMessage::ChannelAftertouch { vel } => {
+                        Some(Item::Event(MidiEvent::Pressure(vel.as_int())))
                     }
                     _ => None,
                 },
@@ -164,6 +175,8 @@ pub fn perform(
                         // As nice-plug hands it to the plugin: 0..1 in f32.
                         performer.set_pitch_bend(bend_semitones(raw as f32 / 16383.0));
                     }
+                    MidiEvent::Controller(cc, v) => performer.set_controller(cc, v as f32 / 127.0),
+                    MidiEvent::Pressure(v) => performer.set_pressure(v as f32 / 127.0),
                 }
                 next += 1;
             }

@@ -41,6 +41,23 @@ pub fn bend_semitones(value: f32) -> f64 {
     (value as f64 - 0.5) * 2.0 * PITCH_BEND_SEMITONES
 }
 
+/// The dynamics' range: expression 0 (CC11, CC2 or channel pressure at 0) plays the bow
+/// this many dB below expression 1 (the default, and the parameters' own bow).
+pub const DYNAMICS_RANGE_DB: f64 = 30.0;
+/// Time constant of the dynamics' smoothing, s (no zipper noise from 7-bit steps).
+pub const DYNAMICS_SMOOTHING_S: f64 = 0.01;
+/// Vibrato depth at the mod wheel's top, cents (peak, either side: players' wide vibrato).
+pub const MAX_VIBRATO_CENTS: f64 = 30.0;
+/// Vibrato rate, Hz (string players: 5-7 Hz).
+pub const VIBRATO_RATE_HZ: f64 = 5.5;
+/// The vibrato starts this long after a note lands, s...
+pub const VIBRATO_DELAY_S: f64 = 0.15;
+/// ... and fades in over this long, s.
+pub const VIBRATO_FADE_S: f64 = 0.3;
+/// Samples between two vibrato updates of the finger (a retune): 0.67 ms at 48 kHz,
+/// 0.1 % of a 5.5 Hz cycle.
+const VIBRATO_EVERY: u32 = 32;
+
 /// Samples between two tail estimates (see [`Performer::status`]).
 const TAIL_EVERY: usize = 2048;
 
@@ -145,6 +162,55 @@ pub struct Performer {
     /// estimate walks every delay line, so it is renewed only every [`TAIL_EVERY`] samples.
     tail: Option<(f64, usize)>,
     setup: Setup,
+    gesture: Gesture,
+    /// The bow of the last sample, as played (after the dynamics).
+    bow_now: BowControl,
+}
+
+/// What the player's controllers ask of the bow and the finger (the performance layer):
+/// dynamics (CC11 expression, CC2 breath, channel pressure) scale the bow's velocity and
+/// force together, which keeps the bow at the same place in Schelleng's window (both
+/// limits are proportional to the bow velocity) while the amplitude follows the velocity;
+/// the mod wheel (CC1) sets the depth of a finger vibrato.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Gesture {
+    /// The bow scale the asked expression (0..=1) gives: `10^(-range (1 - e) / 20)`.
+    target: f64,
+    /// The bow's present scale (smoothed toward `target`).
+    scale: f64,
+    smoothing: f64,
+    /// Vibrato depth, cents.
+    vibrato_cents: f64,
+    /// The MIDI pitch bend, semitones (the vibrato is added to it).
+    bend: f64,
+    /// The vibrato's present offset, semitones.
+    vibrato_now: f64,
+    phase: f64,
+    phase_step: f64,
+    /// Samples since the last note landed.
+    since_note: u64,
+    countdown: u32,
+}
+
+impl Gesture {
+    fn new(sample_rate_hz: f64) -> Self {
+        Self {
+            target: 1.0,
+            scale: 1.0,
+            smoothing: 1.0 - (-1.0 / (DYNAMICS_SMOOTHING_S * sample_rate_hz)).exp(),
+            vibrato_cents: 0.0,
+            bend: 0.0,
+            vibrato_now: 0.0,
+            phase: 0.0,
+            phase_step: VIBRATO_RATE_HZ / sample_rate_hz,
+            since_note: 0,
+            countdown: 0,
+        }
+    }
+
+    fn set_expression(&mut self, e: f64) {
+        self.target = 10f64.powf(-DYNAMICS_RANGE_DB * (1.0 - e.clamp(0.0, 1.0)) / 20.0);
+    }
 }
 
 impl Performer {
@@ -165,6 +231,8 @@ impl Performer {
                 instrument: kind,
                 ..Setup::default()
             },
+            gesture: Gesture::new(48_000.0),
+            bow_now: BowControl::default(),
         }
     }
 
@@ -192,6 +260,7 @@ impl Performer {
         self.held = [false; 128];
         self.sample_rate_hz = fs;
         self.tail = None;
+        self.gesture = Gesture::new(fs);
         Ok(())
     }
 
@@ -238,6 +307,7 @@ impl Performer {
     pub fn note_on(&mut self, note: u8) {
         // A bow lands: whatever tail was estimated no longer holds.
         self.tail = None;
+        self.gesture.since_note = 0;
         let key = note as usize & 127;
         match self.source {
             // Notes the instrument cannot play are ignored.
@@ -289,10 +359,85 @@ impl Performer {
         }
     }
 
-    /// Pitch bend in semitones, for every engine with pitch.
+    /// Pitch bend in semitones, for every engine with pitch (the vibrato adds to it).
     pub fn set_pitch_bend(&mut self, semitones: f64) {
+        self.gesture.bend = semitones;
+        self.bend_engines(semitones + self.gesture.vibrato_now);
+    }
+
+    fn bend_engines(&mut self, semitones: f64) {
         for engine in self.engines() {
             engine.set_pitch_bend(semitones);
+        }
+    }
+
+    /// A MIDI controller at `value` (0..=1, as nice-plug delivers it): CC1 (mod wheel)
+    /// sets the vibrato depth, CC11 (expression) and CC2 (breath) the dynamics; others
+    /// are ignored.
+    pub fn set_controller(&mut self, cc: u8, value: f32) {
+        if !value.is_finite() {
+            return;
+        }
+        let v = (value as f64).clamp(0.0, 1.0);
+        match cc {
+            1 => self.gesture.vibrato_cents = v * MAX_VIBRATO_CENTS,
+            2 | 11 => self.gesture.set_expression(v),
+            _ => {}
+        }
+    }
+
+    /// Channel pressure (aftertouch), 0..=1: the dynamics, as CC11.
+    pub fn set_pressure(&mut self, value: f32) {
+        if value.is_finite() {
+            self.gesture.set_expression(value as f64);
+        }
+    }
+
+    /// The vibrato's offset now, semitones: a sine at [`VIBRATO_RATE_HZ`], silent for
+    /// [`VIBRATO_DELAY_S`] after a note lands, then faded in over [`VIBRATO_FADE_S`].
+    fn vibrato_semitones(&self) -> f64 {
+        let t = self.gesture.since_note as f64 / self.sample_rate_hz - VIBRATO_DELAY_S;
+        let fade = (t / VIBRATO_FADE_S).clamp(0.0, 1.0);
+        fade * self.gesture.vibrato_cents / 100.0
+            * (2.0 * std::f64::consts::PI * self.gesture.phase).sin()
+    }
+
+    /// Advances the gesture one sample and returns the bow it shapes.
+    #[inline]
+    fn shape(&mut self, bow: BowControl) -> BowControl {
+        let g = &mut self.gesture;
+        g.since_note = g.since_note.saturating_add(1);
+        g.phase += g.phase_step;
+        if g.phase >= 1.0 {
+            g.phase -= 1.0;
+        }
+        if g.countdown == 0 {
+            g.countdown = VIBRATO_EVERY;
+            if g.vibrato_cents > 0.0 || g.vibrato_now != 0.0 {
+                let now = if g.vibrato_cents > 0.0 {
+                    self.vibrato_semitones()
+                } else {
+                    0.0
+                };
+                self.gesture.vibrato_now = now;
+                let bend = self.gesture.bend + now;
+                self.bend_engines(bend);
+            }
+        }
+        let g = &mut self.gesture;
+        g.countdown -= 1;
+        let target = g.target;
+        if g.scale == 1.0 && target == 1.0 {
+            return bow;
+        }
+        g.scale += g.smoothing * (target - g.scale);
+        if (g.scale - target).abs() < 1e-9 {
+            g.scale = target;
+        }
+        BowControl {
+            velocity_m_per_s: bow.velocity_m_per_s * g.scale,
+            force_n: bow.force_n * g.scale,
+            ..bow
         }
     }
 
@@ -308,6 +453,8 @@ impl Performer {
     /// rings on); the contact probe is the source's.
     #[inline]
     pub fn tick(&mut self, bow: BowControl) -> Frame {
+        let bow = self.shape(bow);
+        self.bow_now = bow;
         let mut frame = self.instrument.tick(bow);
         for (k, engine) in self.thermal.iter_mut().enumerate() {
             if engine.is_sounding() {
@@ -343,6 +490,12 @@ impl Performer {
 
     pub fn rubbed(&self) -> &RubbedInstrument {
         &self.rubbed
+    }
+
+    /// The bow of the last sample as played: the one given to [`Performer::tick`] shaped
+    /// by the dynamics.
+    pub fn bow(&self) -> BowControl {
+        self.bow_now
     }
 
     /// What the notes play now.
@@ -446,5 +599,116 @@ impl Performer {
             .clamp(1.0, (i32::MAX - 1) as f64);
         self.tail = Some((samples, 0));
         Status::Tail(samples as u32)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::editor::live::ContactSample;
+    use crate::editor::regime::{classify_regime, Regime};
+
+    const FS: f64 = 48_000.0;
+
+    fn cello() -> Performer {
+        let setup = Setup::default();
+        let mut p = Performer::new(InstrumentKind::Cello);
+        p.activate(&setup, FS).unwrap();
+        p.configure(&setup);
+        p
+    }
+
+    /// Bows cello D3 at the defaults with the expression at `e` from the start; returns
+    /// the RMS over 1.5..2 s and the regime of its last 8 periods on the probe.
+    fn bowed_at(e: f32) -> (f64, Option<Regime>) {
+        let mut p = cello();
+        p.set_controller(11, e);
+        p.note_on(50);
+        let bow = BowControl::default();
+        let n = (2.0 * FS) as usize;
+        let mut audio = Vec::with_capacity(n);
+        let mut probe = Vec::with_capacity(n);
+        for i in 0..n {
+            if i % 256 == 0 {
+                p.configure(&Setup::default());
+            }
+            let frame = p.tick(bow);
+            audio.push(frame.audio);
+            probe.push(ContactSample::new(&frame, &p.bow()));
+        }
+        let tail = &audio[(1.5 * FS) as usize..];
+        let rms = (tail.iter().map(|x| x * x).sum::<f64>() / tail.len() as f64).sqrt();
+        let f0 = midi_to_hz(50.0);
+        let window = (8.0 * FS / f0) as usize;
+        (
+            rms,
+            classify_regime(&probe[n - window..], FS as f32, f0 as f32),
+        )
+    }
+
+    #[test]
+    fn dynamics_raise_the_level_monotonically_and_keep_helmholtz_motion() {
+        let mut last = 0.0;
+        for e in [0.25, 0.5, 0.75, 1.0] {
+            let (rms, regime) = bowed_at(e);
+            println!("expression {e}: RMS {rms:.5}, {regime:?}");
+            assert!(rms > last, "expression {e}: RMS {rms} not above {last}");
+            // Velocity and force scale together, so the bow keeps its place in the window.
+            assert_eq!(regime, Some(Regime::Helmholtz), "expression {e}");
+            last = rms;
+        }
+        // The amplitude follows the bow velocity (Raman): 30 dB of range, so expression
+        // 0.5 plays 15 dB below full, within 3 dB (the corners round more at low force).
+        let ratio_db = 20.0 * (bowed_at(0.5).0 / bowed_at(1.0).0).log10();
+        assert!((ratio_db + 15.0).abs() < 3.0, "{ratio_db:.1} dB");
+    }
+
+    #[test]
+    fn the_mod_wheel_vibrato_moves_the_finger_at_its_rate_and_depth() {
+        let mut p = cello();
+        p.set_controller(1, 1.0);
+        let string = InstrumentKind::Cello.string_for_note(50).unwrap();
+        p.note_on(50);
+        let bow = BowControl::default();
+        let centre = p.strings().string(string).fundamental_hz();
+        let mut cents = Vec::new();
+        for _ in 0..(3.0 * FS) as usize {
+            p.tick(bow);
+            cents.push(1200.0 * (p.strings().string(string).fundamental_hz() / centre).log2());
+        }
+        // Silent through the onset delay.
+        let delay = (VIBRATO_DELAY_S * FS) as usize;
+        assert!(cents[..delay - 64].iter().all(|c| c.abs() < 1e-6));
+        // After the fade-in: depth and rate within 5 % of the setting.
+        let steady = &cents[((VIBRATO_DELAY_S + VIBRATO_FADE_S) * FS) as usize + 64..];
+        let depth = steady.iter().fold(0.0f64, |m, c| m.max(c.abs()));
+        let ups: Vec<usize> = steady
+            .windows(2)
+            .enumerate()
+            .filter(|(_, w)| w[0] < 0.0 && w[1] >= 0.0)
+            .map(|(i, _)| i)
+            .collect();
+        let rate = (ups.len() - 1) as f64 * FS / (ups[ups.len() - 1] - ups[0]) as f64;
+        println!("vibrato depth {depth:.2} cents, rate {rate:.3} Hz");
+        assert!(
+            (depth / MAX_VIBRATO_CENTS - 1.0).abs() < 0.05,
+            "depth {depth}"
+        );
+        assert!((rate / VIBRATO_RATE_HZ - 1.0).abs() < 0.05, "rate {rate}");
+    }
+
+    #[test]
+    fn without_controllers_the_bow_is_the_parameters_own() {
+        let mut p = cello();
+        p.note_on(50);
+        let bow = BowControl {
+            velocity_m_per_s: -0.37,
+            force_n: 2.5,
+            position_beta: 0.13,
+        };
+        for _ in 0..1000 {
+            p.tick(bow);
+            assert_eq!(p.bow(), bow);
+        }
     }
 }

@@ -875,38 +875,22 @@ fn assert_no_click_at(x: &[f64], switch_at: &[u64]) {
 #[test]
 fn a_midi_file_rendered_offline_gives_the_plugins_bits() {
     use colophony::midi_file::{perform, MidiEvent, Performance, Timed};
-    // The same notes and bends, at the same samples and block size, through the CLAP
-    // build in the host and through `colophony render --midi`'s performer.
+    // The same notes, bends and controllers, at the same samples and block size, through
+    // the CLAP build in the host and through `colophony render --midi`'s performer.
     let bend = |amount: f64| (8192.0 + amount * 8192.0).round().clamp(0.0, 16383.0) as u16;
+    let at = |sample: u64, event: MidiEvent| Timed { sample, event };
     let events = [
-        Timed {
-            sample: 0,
-            event: MidiEvent::NoteOn(50),
-        },
-        Timed {
-            sample: 24_000,
-            event: MidiEvent::PitchBend(bend(0.5)),
-        },
-        Timed {
-            sample: 36_001,
-            event: MidiEvent::PitchBend(bend(-1.0)),
-        },
-        Timed {
-            sample: 48_000,
-            event: MidiEvent::NoteOff(50),
-        },
-        Timed {
-            sample: 48_000,
-            event: MidiEvent::NoteOn(57),
-        },
-        Timed {
-            sample: 60_123,
-            event: MidiEvent::PitchBend(bend(0.0)),
-        },
-        Timed {
-            sample: 72_000,
-            event: MidiEvent::NoteOff(57),
-        },
+        at(0, MidiEvent::NoteOn(50)),
+        at(24_000, MidiEvent::PitchBend(bend(0.5))),
+        at(36_001, MidiEvent::PitchBend(bend(-1.0))),
+        at(48_000, MidiEvent::NoteOff(50)),
+        at(48_000, MidiEvent::NoteOn(57)),
+        // Dynamics down and back up (CC11), and the mod wheel's vibrato (CC1).
+        at(50_000, MidiEvent::Controller(11, 40)),
+        at(55_000, MidiEvent::Controller(1, 100)),
+        at(60_123, MidiEvent::PitchBend(bend(0.0))),
+        at(66_000, MidiEvent::Controller(11, 127)),
+        at(72_000, MidiEvent::NoteOff(57)),
     ];
     let params = colophony::params::ColophonyParams::default();
     let how = Performance {
@@ -923,6 +907,8 @@ fn a_midi_file_rendered_offline_gives_the_plugins_bits() {
             MidiEvent::NoteOn(n) => Event::note_on(n),
             MidiEvent::NoteOff(n) => Event::note_off(n),
             MidiEvent::PitchBend(raw) => Event::pitch_bend((raw as f64 - 8192.0) / 8192.0),
+            MidiEvent::Controller(cc, value) => host::Event::Controller { cc, value },
+            MidiEvent::Pressure(_) => unreachable!("not in this score"),
         };
         score.push(e.sample, event);
     }
@@ -941,5 +927,9 @@ fn a_midi_file_rendered_offline_gives_the_plugins_bits() {
         rms(&channel_f64(&hosted, 0)) > 1e-3,
         "the hosted plugin was silent"
     );
-    assert_eq!(differing, 0, "{differing} of {frames} samples differ");
+    let first = (0..frames).find(|&i| hosted[0][i].to_bits() != offline[i].to_bits());
+    assert_eq!(
+        differing, 0,
+        "{differing} of {frames} samples differ, the first at {first:?}"
+    );
 }

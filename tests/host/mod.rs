@@ -76,6 +76,11 @@ pub enum Event {
     NoteOff {
         key: u8,
     },
+    /// A MIDI control change: controller number and 7-bit value.
+    Controller {
+        cc: u8,
+        value: u8,
+    },
     /// Pitch-bend wheel position, -1 (down) ..= 1 (up), sent as a 14-bit MIDI pitch bend.
     PitchBend {
         amount: f64,
@@ -516,6 +521,9 @@ fn push_event(buffer: &mut EventBuffer, t: u32, event: Event, port: u16, clap_no
             buffer.push(&MidiEvent::new(t, port, [0x90, key & 0x7f, v]))
         }
         Event::NoteOff { key } => buffer.push(&MidiEvent::new(t, port, [0x80, key & 0x7f, 0])),
+        Event::Controller { cc, value } => {
+            buffer.push(&MidiEvent::new(t, port, [0xb0, cc & 0x7f, value & 0x7f]))
+        }
         Event::PitchBend { amount } => {
             let v = (8192.0 + amount * 8192.0).round().clamp(0.0, 16383.0) as u16;
             buffer.push(&MidiEvent::new(
