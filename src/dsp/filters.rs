@@ -54,19 +54,20 @@ impl Allpass1 {
         1.0 - 2.0 * (a * w.sin()).atan2(1.0 + a * w.cos()) / w
     }
 
-    /// The coefficient whose phase delay at `w` is exactly `delay` samples, by bisection
-    /// (phase delay falls monotonically as `a` grows). `delay` should lie in [0.5, 2.5].
+    /// The coefficient whose phase delay at `w` is exactly `delay` samples, in closed
+    /// form: with `psi = (1 - delay) w / 2`, [`Allpass1::phase_delay`] asks
+    /// `atan2(a sin w, 1 + a cos w) = psi`, i.e. `a = sin psi / sin(w - psi)` (at low `w`,
+    /// Thiran's `(1 - delay) / (1 + delay)`). `delay` should lie in [0.5, 2.5]; the result
+    /// is kept within +-0.99. Cheap enough for a vibrato that retunes every few hundred
+    /// samples.
     pub fn coefficient_for_delay(delay: f64, w: f64) -> f64 {
-        let (mut lo, mut hi) = (-0.99, 0.99);
-        for _ in 0..60 {
-            let mid = 0.5 * (lo + hi);
-            if Self::phase_delay(mid, w) > delay {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
+        let psi = 0.5 * (1.0 - delay) * w;
+        let a = psi.sin() / (w - psi).sin();
+        if a.is_finite() {
+            a.clamp(-0.99, 0.99)
+        } else {
+            0.0
         }
-        0.5 * (lo + hi)
     }
 }
 
@@ -308,11 +309,22 @@ mod tests {
 
     #[test]
     fn thiran_coefficient_gives_the_requested_phase_delay() {
-        let w = 2.0 * PI * 147.0 / 48_000.0;
-        for &d in &[0.5, 0.9, 1.37, 2.4] {
-            let a = Allpass1::coefficient_for_delay(d, w);
-            // bisection to 60 halvings: far below a micro-sample
-            assert!((Allpass1::phase_delay(a, w) - d).abs() < 1e-9, "d = {d}");
+        // From 30 Hz at 384 kHz to a loop of 6 samples (w = 1; the strings' loops are
+        // longer), every delay the strings ask for.
+        for w in [
+            2.0 * PI * 30.0 / 384_000.0,
+            2.0 * PI * 147.0 / 48_000.0,
+            0.3,
+            0.7,
+            1.0,
+        ] {
+            for &d in &[0.5, 0.9, 1.0, 1.37, 2.0, 2.4, 2.5] {
+                let a = Allpass1::coefficient_for_delay(d, w);
+                // Closed form: exact but for rounding (1e-9 samples is far below any pitch
+                // a player hears).
+                let got = Allpass1::phase_delay(a, w);
+                assert!((got - d).abs() < 1e-9, "w {w}, d {d}: {got}");
+            }
         }
     }
 
