@@ -3,6 +3,14 @@
 //! strings, so it cannot make the loop gain energy. The mode data are generic (violin
 //! signature modes A0, CBR, B1-, B1+ and a bridge hill, docs/parameters.md §2, scaled down for
 //! the larger instruments), not measured.
+//!
+//! ```
+//! use colophony::dsp::body::{BodyMode, BodyModes};
+//! let modes = [BodyMode { freq_hz: 275.0, q: 12.0, gain: 0.8 }];
+//! let mut body = BodyModes::new(&modes, 1.0, 48_000.0);
+//! let impulse: Vec<f64> = (0..4800).map(|i| body.tick(if i == 0 { 1.0 } else { 0.0 })).collect();
+//! assert!(impulse.iter().all(|x| x.is_finite()));
+//! ```
 
 use super::filters::Bandpass;
 

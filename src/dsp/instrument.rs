@@ -11,6 +11,15 @@
 //! note off lifts it (the force ramps down) and the string rings on, still stopped, and
 //! decays. A string whose energy falls below [`SLEEP_ENERGY_J`] with the bow lifted is
 //! cleared and skipped until the next note on it.
+//!
+//! ```
+//! use colophony::dsp::instrument::{BowControl, Instrument, InstrumentKind};
+//! let mut cello = Instrument::new(InstrumentKind::Cello, 48_000.0);
+//! assert_eq!(cello.note_on(50), Some(2)); // D3 on the D string
+//! let bow = BowControl { velocity_m_per_s: 0.1, force_n: 1.0, position_beta: 0.1 };
+//! let peak = (0..24_000).map(|_| cello.tick(bow).audio.abs()).fold(0.0, f64::max);
+//! assert!(peak > 0.01 && peak < 1.0);
+//! ```
 
 use super::body::{BodyMode, BodyModes};
 use super::friction::bristle::{BristleParams, SolverStats};

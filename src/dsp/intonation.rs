@@ -19,6 +19,15 @@
 //! `assets/intonation.csv` and compiled in. Between semitones (pitch bend, vibrato) it is
 //! interpolated linearly. The change of pitch with force and bow position is left as the
 //! physics gives it.
+//!
+//! ```
+//! use colophony::dsp::instrument::InstrumentKind;
+//! use colophony::dsp::intonation::{model_index, shipped};
+//! // How far the cello's D string is tuned from equal temperament for F#3 (4 semitones
+//! // up) under the hyperbolic law, so that it sounds in tune bowed.
+//! let c = shipped().correction_cents(model_index("hyperbolic"), InstrumentKind::Cello, 2, 4.0);
+//! assert!(c.abs() < 50.0);
+//! ```
 
 use super::instrument::{InstrumentKind, MAX_STOP_SEMITONES, STRINGS};
 use std::sync::OnceLock;
