@@ -1,9 +1,12 @@
 //! Colophony: a physically modelled bowed-string instrument.
 //!
-//! This file is only the plugin glue (CLAP and VST3 through nice-plug): parameters and
-//! MIDI in, the DSP core ([`dsp`]) in the middle, stereo out. The DSP core never imports the
-//! plugin framework. [`render`] is the offline renderer behind the `colophony` binary and
-//! [`analysis`] the signal measurements the tests and tools share.
+//! This file is only the plugin glue (CLAP and VST3 through nice-plug): parameters
+//! ([`params`], read once per block into a [`performer::Setup`]) and MIDI events in, the
+//! framework-free [`performer`] in the middle (source switching, held keys, dynamics and
+//! vibrato, the host tail) driving the engines of [`dsp`], stereo out. Neither the
+//! performer nor the DSP core imports the plugin framework. [`render`] and [`midi_file`]
+//! are the offline renderer behind the `colophony` binary, which plays through the same
+//! performer, and [`analysis`] the signal measurements the tests and tools share.
 
 pub mod admittance_fit;
 pub mod analysis;
