@@ -4,9 +4,10 @@
 //! ([`params`], read once per block into a [`performer::Setup`]) and MIDI events in, the
 //! framework-free [`performer`] in the middle (source switching, held keys, dynamics and
 //! vibrato, the host tail) driving the engines of [`dsp`], stereo out. Neither the
-//! performer nor the DSP core imports the plugin framework. [`render`] and [`midi_file`]
-//! are the offline renderer behind the `colophony` binary, which plays through the same
-//! performer, and [`analysis`] the signal measurements the tests and tools share.
+//! performer nor the DSP core imports the plugin framework. [`render`] (one bowed note on
+//! an engine) and [`midi_file`] (a MIDI file through the same performer) are the offline
+//! renderer behind the `colophony` binary, and [`analysis`] the signal measurements the
+//! tests and tools share.
 
 pub mod admittance_fit;
 pub mod analysis;
