@@ -7,6 +7,13 @@
 //! peak for the failure message, in `tests/golden/renders.txt`. A change meant to be
 //! audible re-records them: `COLOPHONY_RECORD_GOLDEN=1 cargo test --test golden`, and the
 //! commit says why.
+//!
+//! Bits are comparable only where the math library takes the same code paths: glibc picks
+//! its `sin`, `exp`, `pow` variants by the CPU's features (FMA or not), which can change
+//! last bits that a bowed string's chaotic moments then amplify. The file records the
+//! features it was made on; on a machine that differs the test compares each render's
+//! RMS and peak within 2 % instead (the rounding changes of this repository's own history
+//! moved them by 0.2 % at most) and says so.
 
 mod host;
 
@@ -120,6 +127,28 @@ fn render(scene: &Scene) -> Vec<f32> {
     out[0].clone()
 }
 
+/// The CPU features that choose the math library's code paths.
+fn machine() -> String {
+    #[cfg(target_arch = "x86_64")]
+    {
+        format!(
+            "# machine: x86_64 fma={} avx2={}",
+            std::is_x86_feature_detected!("fma"),
+            std::is_x86_feature_detected!("avx2")
+        )
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        format!("# machine: {}", std::env::consts::ARCH)
+    }
+}
+
+/// RMS and peak of a golden line.
+fn levels(line: &str) -> (f64, f64) {
+    let f: Vec<&str> = line.split_whitespace().collect();
+    (f[3].parse().unwrap(), f[5].parse().unwrap())
+}
+
 fn line(scene: &Scene, x: &[f32]) -> String {
     let y = channel_f64(&[x.to_vec()], 0);
     let rms = (y.iter().map(|v| v * v).sum::<f64>() / y.len() as f64).sqrt();
@@ -143,21 +172,39 @@ fn every_source_renders_the_same_bits_as_recorded() {
     }
     if std::env::var_os("COLOPHONY_RECORD_GOLDEN").is_some() {
         std::fs::create_dir_all("tests/golden").unwrap();
-        std::fs::write(GOLDEN, &got).unwrap();
+        std::fs::write(GOLDEN, format!("{}\n{got}", machine())).unwrap();
         println!("recorded {GOLDEN}:\n{got}");
         return;
     }
-    let want = std::fs::read_to_string(GOLDEN).expect("tests/golden/renders.txt (record it first)");
+    let file = std::fs::read_to_string(GOLDEN).expect("tests/golden/renders.txt (record it first)");
+    let recorded_on = file
+        .lines()
+        .find(|l| l.starts_with("# machine:"))
+        .unwrap_or("");
+    let want: Vec<&str> = file.lines().filter(|l| !l.starts_with('#')).collect();
+    assert_eq!(
+        got.lines().count(),
+        want.len(),
+        "scene count changed:\n{got}"
+    );
+    let same_machine = recorded_on == machine();
+    if !same_machine {
+        println!(
+            "recorded on '{recorded_on}', running on '{}': comparing levels",
+            machine()
+        );
+    }
     let mut diffs = Vec::new();
-    for (g, w) in got.lines().zip(want.lines()) {
-        if g != w {
+    for (g, w) in got.lines().zip(&want) {
+        let differs = if same_machine {
+            g != *w
+        } else {
+            let ((gr, gp), (wr, wp)) = (levels(g), levels(w));
+            (gr / wr - 1.0).abs() > 0.02 || (gp / wp - 1.0).abs() > 0.02
+        };
+        if differs {
             diffs.push(format!("  now {g}\n  was {w}"));
         }
     }
-    assert_eq!(
-        got.lines().count(),
-        want.lines().count(),
-        "scene count changed:\n{got}"
-    );
     assert!(diffs.is_empty(), "renders changed:\n{}", diffs.join("\n"));
 }
