@@ -54,8 +54,8 @@ pub const VIBRATO_RATE_HZ: f64 = 5.5;
 pub const VIBRATO_DELAY_S: f64 = 0.15;
 /// ... and fades in over this long, s.
 pub const VIBRATO_FADE_S: f64 = 0.3;
-/// Samples between two vibrato updates of the finger (a retune, about 2 us): 1.3 ms at
-/// 48 kHz, steps of at most 1.4 cents at the widest vibrato.
+/// Samples between two vibrato updates of the finger (a retune of the sounding strings):
+/// 1.3 ms at 48 kHz, steps of at most 1.4 cents at the widest vibrato.
 const VIBRATO_EVERY: u32 = 64;
 
 /// Samples between two tail estimates (see [`Performer::status`]).

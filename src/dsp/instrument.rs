@@ -422,12 +422,15 @@ impl Instrument {
     /// The free-decay pitch string `string` is stopped at for `note`: equal temperament
     /// under the bend and reference, moved by the intonation table.
     fn tuned_hz(&self, string: usize, note: u8) -> f64 {
-        let open = self.kind.open_notes()[string.min(STRINGS - 1)] as f64;
-        let played = note as f64 + self.bend_semitones;
-        let correction = self.intonation.map_or(0.0, |t| {
-            t.correction_cents(self.intonation_model, self.kind, string, played - open)
-        });
-        midi_to_hz(played + self.reference_semitones - correction / 100.0)
+        intonation::tuned_hz(
+            self.intonation,
+            self.intonation_model,
+            self.kind,
+            string,
+            note,
+            self.bend_semitones,
+            self.reference_semitones,
+        )
     }
 
     /// Tunes by the bowed sound with `table` (the default is the shipped one), or by the

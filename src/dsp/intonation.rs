@@ -42,6 +42,30 @@ const SEMITONES: usize = MAX_STOP_SEMITONES as usize + 1;
 /// The models the table covers, in file order.
 pub const MODEL_NAMES: [&str; 5] = ["hyperbolic", "static", "lugre", "elasto-plastic", "thermal"];
 
+/// The thermal model's row (paper B's bow).
+pub const THERMAL_ROW: usize = 4;
+
+/// The free-decay pitch, Hz, that `string` of `kind` is stopped at to play MIDI `note`
+/// bent by `bend` semitones under a reference `reference` semitones from A4 = 440 Hz:
+/// equal temperament moved by `table`'s correction for `row` at the bent note's place on
+/// the string (`None`: tuned by the free decay). Both string instruments tune by it.
+pub fn tuned_hz(
+    table: Option<&IntonationTable>,
+    row: usize,
+    kind: InstrumentKind,
+    string: usize,
+    note: u8,
+    bend: f64,
+    reference: f64,
+) -> f64 {
+    let open = kind.open_notes()[string.min(STRINGS - 1)] as f64;
+    let played = note as f64 + bend;
+    let correction = table.map_or(0.0, |t| {
+        t.correction_cents(row, kind, string, played - open)
+    });
+    super::instrument::midi_to_hz(played + reference - correction / 100.0)
+}
+
 /// The table row of a model named as [`MODEL_NAMES`] (the friction models' `name()`, and
 /// "thermal"); an unknown name reads the first row.
 pub fn model_index(name: &str) -> usize {
@@ -184,6 +208,11 @@ mod tests {
     fn the_shipped_table_parses_and_stays_within_its_bound() {
         let t = shipped();
         assert!(t.cents.iter().all(|c| c.abs() <= MAX_CORRECTION_CENTS));
+    }
+
+    #[test]
+    fn the_thermal_row_is_the_thermal_model() {
+        assert_eq!(model_index("thermal"), THERMAL_ROW);
     }
 
     #[test]
