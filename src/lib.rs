@@ -60,8 +60,9 @@ impl Colophony {
         match event {
             NoteEvent::NoteOn {
                 key: Key::Number(note),
+                velocity,
                 ..
-            } => self.performer.note_on(note),
+            } => self.performer.note_on(note, velocity),
             NoteEvent::NoteOff {
                 key: Key::Number(note),
                 ..
@@ -70,9 +71,7 @@ impl Colophony {
                 key: Key::Wildcard, ..
             }
             | NoteEvent::Choke { .. } => self.performer.all_notes_off(),
-            NoteEvent::MidiPitchBend { value, .. } => self
-                .performer
-                .set_pitch_bend(performer::bend_semitones(value)),
+            NoteEvent::MidiPitchBend { value, .. } => self.performer.set_pitch_wheel(value),
             NoteEvent::MidiCC { cc, value, .. } => self.performer.set_controller(cc, value),
             NoteEvent::MidiChannelPressure { pressure, .. } => {
                 self.performer.set_pressure(pressure)
@@ -98,6 +97,15 @@ impl Plugin for Colophony {
     // `MidiCCs`: pitch bend arrives as `MidiPitchBend` only at this level.
     const MIDI_INPUT: MidiConfig = MidiConfig::MidiCCs;
     const SAMPLE_ACCURATE_AUTOMATION: bool = true;
+    /// Room for every event a host may send in one block, allocated at construction.
+    /// nice-plug's VST3 wrapper turns every point of its 16 x 130 hidden MIDI-controller
+    /// parameters (`MidiConfig::MidiCCs`: 128 CCs, channel pressure and pitch bend per
+    /// channel) into a note event, and keeps the block's events in a buffer of this
+    /// capacity (its default 1024). A DAW that flushes its parameter state (Ardour does at
+    /// transport start and locate) sends all 2080 of them at once: with 1024 the wrapper
+    /// allocated on the audio thread ("Input note event buffer filled up!"). 8192 holds
+    /// such a flush three times over with our own parameters' automation and the notes.
+    const INPUT_EVENT_CAPACITY: usize = 8192;
 
     type Editor = editor::ColophonyEditor;
     type SysExMessage = ();
@@ -149,6 +157,21 @@ impl Plugin for Colophony {
         // The editor's live views are fed only while an editor shows them.
         let live = self.editor_link.is_listening();
         let mut next_event = context.next_event();
+        let p = &self.params;
+        let settled = !(p.bow_velocity.smoothed.is_smoothing()
+            || p.bow_force.smoothed.is_smoothing()
+            || p.bow_position.smoothed.is_smoothing()
+            || p.gain.smoothed.is_smoothing());
+        if next_event.is_none() && settled && self.performer.is_asleep() {
+            // Nothing sounds and nothing lands in this block: silence, without a per-sample
+            // call (the performer's gesture clocks still advance).
+            for channel in buffer.as_slice() {
+                channel.fill(0.0);
+            }
+            self.performer.skip(buffer.samples(), p.bow());
+            self.editor_link.set_note(self.performer.last_note());
+            return host_status(self.performer.status(buffer.samples()));
+        }
         for (sample, mut channels) in buffer.iter_samples().enumerate() {
             while let Some(event) = next_event.filter(|e| e.timing() <= sample as u32) {
                 self.handle_event(event);
@@ -181,11 +204,16 @@ impl Plugin for Colophony {
             next_event = context.next_event();
         }
         self.editor_link.set_note(self.performer.last_note());
-        match self.performer.status(buffer.samples()) {
-            Status::KeepAlive => ProcessStatus::KeepAlive,
-            Status::Tail(samples) => ProcessStatus::Tail(samples),
-            Status::Normal => ProcessStatus::Normal,
-        }
+        host_status(self.performer.status(buffer.samples()))
+    }
+}
+
+/// The performer's status in nice-plug's words.
+fn host_status(status: Status) -> ProcessStatus {
+    match status {
+        Status::KeepAlive => ProcessStatus::KeepAlive,
+        Status::Tail(samples) => ProcessStatus::Tail(samples),
+        Status::Normal => ProcessStatus::Normal,
     }
 }
 

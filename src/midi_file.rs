@@ -10,13 +10,14 @@
 
 use crate::dsp::filters::{flush_tiny, safety_limit};
 use crate::dsp::instrument::BowControl;
-use crate::performer::{bend_semitones, Performer, Setup, Status};
+use crate::performer::{Performer, Setup, Status};
 use midly::{MetaMessage, MidiMessage, Smf, Timing, TrackEventKind};
 
 /// What a MIDI file asks of the performer.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum MidiEvent {
-    NoteOn(u8),
+    /// Key and 7-bit velocity.
+    NoteOn(u8, u8),
     NoteOff(u8),
     /// The raw 14-bit value, 8192 = centre.
     PitchBend(u16),
@@ -76,7 +77,7 @@ pub fn read_events(
                 TrackEventKind::Meta(MetaMessage::Tempo(us)) => Some(Item::Tempo(us.as_int())),
                 TrackEventKind::Midi { message, .. } if wanted => match message {
                     MidiMessage::NoteOn { key, vel } if vel.as_int() > 0 => {
-                        Some(Item::Event(MidiEvent::NoteOn(key.as_int())))
+                        Some(Item::Event(MidiEvent::NoteOn(key.as_int(), vel.as_int())))
                     }
                     MidiMessage::NoteOn { key, .. } | MidiMessage::NoteOff { key, .. } => {
                         Some(Item::Event(MidiEvent::NoteOff(key.as_int())))
@@ -123,7 +124,7 @@ pub fn read_events(
             }),
         }
     }
-    if !out.iter().any(|e| matches!(e.event, MidiEvent::NoteOn(_))) {
+    if !out.iter().any(|e| matches!(e.event, MidiEvent::NoteOn(..))) {
         return Err(match track {
             Some(t) => format!("track {t} has no notes"),
             None => "the file has no notes".into(),
@@ -165,25 +166,35 @@ pub fn perform(
     let mut quiet = 0u64;
     loop {
         performer.configure(&how.setup);
-        for i in 0..block as u64 {
-            let now = done + i;
-            while next < events.len() && events[next].sample <= now {
-                match events[next].event {
-                    MidiEvent::NoteOn(n) => performer.note_on(n),
-                    MidiEvent::NoteOff(n) => performer.note_off(n),
-                    MidiEvent::PitchBend(raw) => {
-                        // As nice-plug hands it to the plugin: 0..1 in f32.
-                        performer.set_pitch_bend(bend_semitones(raw as f32 / 16383.0));
+        let event_in_block = next < events.len() && events[next].sample < done + block as u64;
+        if !event_in_block && performer.is_asleep() {
+            // As the plugin: a silent block with nothing landing is skipped.
+            performer.skip(block, how.bow);
+            out.resize(out.len() + block, 0.0);
+            quiet += block as u64;
+        } else {
+            for i in 0..block as u64 {
+                let now = done + i;
+                while next < events.len() && events[next].sample <= now {
+                    match events[next].event {
+                        MidiEvent::NoteOn(n, v) => performer.note_on(n, v as f32 / 127.0),
+                        MidiEvent::NoteOff(n) => performer.note_off(n),
+                        MidiEvent::PitchBend(raw) => {
+                            // As nice-plug hands it to the plugin: 0..1 in f32.
+                            performer.set_pitch_wheel(raw as f32 / 16383.0);
+                        }
+                        MidiEvent::Controller(cc, v) => {
+                            performer.set_controller(cc, v as f32 / 127.0)
+                        }
+                        MidiEvent::Pressure(v) => performer.set_pressure(v as f32 / 127.0),
                     }
-                    MidiEvent::Controller(cc, v) => performer.set_controller(cc, v as f32 / 127.0),
-                    MidiEvent::Pressure(v) => performer.set_pressure(v as f32 / 127.0),
+                    next += 1;
                 }
-                next += 1;
+                let frame = performer.tick(how.bow);
+                let y = safety_limit(flush_tiny(frame.audio * how.gain)) as f32;
+                quiet = if y.abs() < QUIET_LEVEL { quiet + 1 } else { 0 };
+                out.push(y);
             }
-            let frame = performer.tick(how.bow);
-            let y = safety_limit(flush_tiny(frame.audio * how.gain)) as f32;
-            quiet = if y.abs() < QUIET_LEVEL { quiet + 1 } else { 0 };
-            out.push(y);
         }
         done += block as u64;
         let status = performer.status(block);
@@ -222,7 +233,7 @@ pub fn render_file(
     let seconds = audio.len() as f64 / how.sample_rate_hz;
     let notes = events
         .iter()
-        .filter(|e| matches!(e.event, MidiEvent::NoteOn(_)))
+        .filter(|e| matches!(e.event, MidiEvent::NoteOn(..)))
         .count();
     let rendered = crate::render::Rendered {
         sample_rate_hz: how.sample_rate_hz,
@@ -291,9 +302,9 @@ mod tests {
         );
         let got = read_events(&bytes, None, 48_000.0).unwrap();
         let want = [
-            (0, MidiEvent::NoteOn(50)),
+            (0, MidiEvent::NoteOn(50, 100)),
             (24_000, MidiEvent::NoteOff(50)),
-            (24_000, MidiEvent::NoteOn(52)),
+            (24_000, MidiEvent::NoteOn(52, 90)),
             // A note-on of velocity 0 is a note-off.
             (72_000, MidiEvent::NoteOff(52)),
         ];

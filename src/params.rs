@@ -113,6 +113,32 @@ impl ResonatorChoice {
     }
 }
 
+/// The direction of each new bow stroke ([`crate::performer::stroke`]): alternating, as
+/// in détaché, or always one way (the bow velocity parameter's sign is down).
+#[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StrokeChoice {
+    #[id = "alternate"]
+    #[name = "Alternate (down, up)"]
+    Alternate,
+    #[id = "down"]
+    #[name = "Down only"]
+    Down,
+    #[id = "up"]
+    #[name = "Up only"]
+    Up,
+}
+
+impl StrokeChoice {
+    pub fn mode(self) -> crate::performer::stroke::StrokeMode {
+        use crate::performer::stroke::StrokeMode;
+        match self {
+            StrokeChoice::Alternate => StrokeMode::Alternate,
+            StrokeChoice::Down => StrokeMode::Down,
+            StrokeChoice::Up => StrokeMode::Up,
+        }
+    }
+}
+
 /// Which string a note goes to: the usual choice (the highest string that reaches it,
 /// the lowest hand position) or one the player names, as in "sul G". Strings are counted
 /// from the highest: I is the violin's E and the viola's and cello's A, IV the lowest. A
@@ -205,6 +231,10 @@ pub struct ColophonyParams {
     pub quality: EnumParam<QualityChoice>,
     #[id = "reference_pitch"]
     pub reference_pitch: FloatParam,
+    #[id = "bow_strokes"]
+    pub bow_strokes: EnumParam<StrokeChoice>,
+    #[id = "bend_range"]
+    pub bend_range: FloatParam,
     /// The editor window's size, saved with the plugin state (not a parameter).
     #[persist = "editor-state"]
     pub editor_state: crate::editor::EditorState,
@@ -302,6 +332,19 @@ impl Default for ColophonyParams {
             .with_unit(" Hz")
             .with_step_size(0.1)
             .with_value_to_string(formatters::v2s_f32_rounded(1)),
+            bow_strokes: EnumParam::new("Bow Strokes", StrokeChoice::Alternate),
+            // Not smoothed: a change re-bends the sounding notes at the next block.
+            bend_range: FloatParam::new(
+                "Pitch Bend Range",
+                crate::dsp::instrument::PITCH_BEND_SEMITONES as f32,
+                FloatRange::Linear {
+                    min: 0.0,
+                    max: crate::dsp::instrument::MAX_BEND_RANGE_SEMITONES as f32,
+                },
+            )
+            .with_unit(" st")
+            .with_step_size(0.01)
+            .with_value_to_string(formatters::v2s_f32_rounded(2)),
             editor_state: Default::default(),
         }
     }
@@ -332,6 +375,8 @@ impl ColophonyParams {
             },
             bow_width_m: self.bow_width_mm.value() as f64 * 1e-3,
             bow_position_beta: self.bow_position.value() as f64,
+            bow_strokes: self.bow_strokes.value().mode(),
+            bend_range_semitones: self.bend_range.value() as f64,
         }
     }
 

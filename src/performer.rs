@@ -18,27 +18,34 @@
 //! let mut performer = Performer::new(InstrumentKind::Cello);
 //! performer.activate(&setup, 48_000.0).unwrap();
 //! performer.configure(&setup);
-//! performer.note_on(50);
+//! performer.note_on(50, 0.8);
 //! let bow = BowControl::default();
 //! let peak = (0..9600).map(|_| performer.tick(bow).audio.abs()).fold(0.0, f64::max);
 //! assert!(peak > 0.0);
 //! ```
 
+pub mod stroke;
+
 use crate::admittance_fit;
 use crate::dsp::engine::Engine;
 use crate::dsp::friction::FrictionModel;
 use crate::dsp::instrument::{
-    midi_to_hz, BowControl, Frame, Instrument, InstrumentKind, PITCH_BEND_SEMITONES,
+    midi_to_hz, BowControl, Frame, Instrument, InstrumentKind, MAX_BEND_RANGE_SEMITONES,
+    PITCH_BEND_SEMITONES,
 };
 use crate::dsp::rubbed::{RubbedInstrument, RubbedPreset};
 use crate::dsp::thermal::ThermalString;
 use crate::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
 use crate::quality::{self, Quality};
+use stroke::{Stroke, StrokeMode};
 
-/// Semitones of pitch bend for a MIDI pitch-bend wheel at `value` (0 = down, 0.5 =
-/// centre, 1 = up, as nice-plug delivers it).
-pub fn bend_semitones(value: f32) -> f64 {
-    (value as f64 - 0.5) * 2.0 * PITCH_BEND_SEMITONES
+/// The pitch-bend wheel's position, -1..=1, for a MIDI pitch-bend value `value` (0 =
+/// down, 0.5 = centre, 1 = up, as nice-plug delivers it); a NaN is the centre.
+pub fn wheel_position(value: f32) -> f64 {
+    if value.is_nan() {
+        return 0.0;
+    }
+    ((value as f64 - 0.5) * 2.0).clamp(-1.0, 1.0)
 }
 
 /// The dynamics' range: expression 0 (CC11, CC2 or channel pressure at 0) plays the bow
@@ -57,6 +64,9 @@ pub const VIBRATO_FADE_S: f64 = 0.3;
 /// Samples between two vibrato updates of the finger (a retune of the sounding strings):
 /// 1.3 ms at 48 kHz, steps of at most 1.4 cents at the widest vibrato.
 const VIBRATO_EVERY: u32 = 64;
+
+/// MIDI's null registered parameter number (CC101 and CC100 at 127).
+const RPN_NULL: u8 = 127;
 
 /// Samples between two tail estimates (see [`Performer::status`]).
 const TAIL_EVERY: usize = 2048;
@@ -88,6 +98,10 @@ pub struct Setup {
     pub bow_width_m: f64,
     /// Bow position, for the automatic node count at a note-on.
     pub bow_position_beta: f64,
+    /// The direction of each new bow stroke.
+    pub bow_strokes: StrokeMode,
+    /// Semitones the pitch-bend wheel bends at its ends (0..=12; MIDI RPN 0 overrides it).
+    pub bend_range_semitones: f64,
 }
 
 impl Default for Setup {
@@ -102,6 +116,8 @@ impl Default for Setup {
             thermal_nodes: ThermalNodes::Fixed(quality::GOOD_NODES),
             bow_width_m: 0.01,
             bow_position_beta: 0.1,
+            bow_strokes: StrokeMode::Alternate,
+            bend_range_semitones: PITCH_BEND_SEMITONES,
         }
     }
 }
@@ -163,7 +179,10 @@ pub struct Performer {
     tail: Option<(f64, usize)>,
     setup: Setup,
     gesture: Gesture,
-    /// The bow of the last sample, as played (after the dynamics).
+    stroke: Stroke,
+    /// Whether [`Performer::configure`] has run since the engines were built.
+    configured: bool,
+    /// The bow of the last sample, as played (after the stroke and the dynamics).
     bow_now: BowControl,
 }
 
@@ -183,6 +202,12 @@ struct Gesture {
     vibrato_cents: f64,
     /// The MIDI pitch bend, semitones (the vibrato is added to it).
     bend: f64,
+    /// The pitch-bend wheel, -1..=1.
+    wheel: f64,
+    /// The bend range MIDI RPN 0 set, semitones (overrides the setup's).
+    rpn_bend_range: Option<f64>,
+    /// The registered parameter number CC101/CC100 selected ([`RPN_NULL`]: none).
+    rpn: (u8, u8),
     /// The vibrato's present offset, semitones.
     vibrato_now: f64,
     phase: f64,
@@ -200,6 +225,9 @@ impl Gesture {
             smoothing: 1.0 - (-1.0 / (DYNAMICS_SMOOTHING_S * sample_rate_hz)).exp(),
             vibrato_cents: 0.0,
             bend: 0.0,
+            wheel: 0.0,
+            rpn_bend_range: None,
+            rpn: (RPN_NULL, RPN_NULL),
             vibrato_now: 0.0,
             phase: 0.0,
             phase_step: VIBRATO_RATE_HZ / sample_rate_hz,
@@ -232,6 +260,8 @@ impl Performer {
                 ..Setup::default()
             },
             gesture: Gesture::new(48_000.0),
+            stroke: Stroke::new(48_000.0),
+            configured: false,
             bow_now: BowControl::default(),
         }
     }
@@ -261,13 +291,28 @@ impl Performer {
         self.sample_rate_hz = fs;
         self.tail = None;
         self.gesture = Gesture::new(fs);
+        self.stroke = Stroke::new(fs);
+        self.configured = false;
         Ok(())
     }
 
     /// Applies a block's setup: instrument, laws, tolerances, tuning, string choice, the
     /// thermal bow's settings and the source; then what is quiet sleeps.
     pub fn configure(&mut self, setup: &Setup) {
+        // The same setup as the last block: every setting below would be a no-op (the
+        // strings' kind is the one condition that waits on the engines' state).
+        if self.configured && *setup == self.setup && self.instrument.kind() == setup.instrument {
+            for engine in self.engines() {
+                engine.update_sleep();
+            }
+            return;
+        }
+        self.configured = true;
+        let range_was = self.bend_range();
         self.setup = *setup;
+        if self.bend_range() != range_was {
+            self.set_bend(self.gesture.wheel * self.bend_range());
+        }
         let wanted = Source::of(setup);
         // The waveguide strings change instrument at once (silenced) only while they are
         // what the notes play; ringing on behind another source, they finish first.
@@ -304,7 +349,22 @@ impl Performer {
             .chain(std::iter::once(&mut self.rubbed as &mut dyn Engine))
     }
 
-    pub fn note_on(&mut self, note: u8) {
+    /// A key goes down with `velocity` (0..=1). A note that lands while no key is held
+    /// starts a new bow stroke ([`stroke`]: direction by the setup's stroke mode, attack
+    /// by the velocity); one that lands while another is held is legato (the stroke goes
+    /// on; on the same string the finger moves and the bow stays on).
+    pub fn note_on(&mut self, note: u8, velocity: f32) {
+        let separate = !self.held.iter().any(|&h| h);
+        self.land(note);
+        // A note the source refused moves no bow.
+        if separate && self.held[note as usize & 127] {
+            self.stroke
+                .start(self.setup.bow_strokes, stroke::velocity_step(velocity));
+        }
+    }
+
+    /// The note reaches the source (no new stroke).
+    fn land(&mut self, note: u8) {
         // A bow lands: whatever tail was estimated no longer holds.
         self.tail = None;
         self.gesture.since_note = 0;
@@ -359,8 +419,28 @@ impl Performer {
         }
     }
 
+    /// The pitch-bend wheel at `value` (0..=1, 0.5 = centre, as nice-plug delivers it):
+    /// bends by the bend range at its ends.
+    pub fn set_pitch_wheel(&mut self, value: f32) {
+        self.gesture.wheel = wheel_position(value);
+        self.set_bend(self.gesture.wheel * self.bend_range());
+    }
+
+    /// The pitch-bend range, semitones: MIDI RPN 0's if one came, else the setup's
+    /// (clamped to 0..=[`MAX_BEND_RANGE_SEMITONES`]).
+    pub fn bend_range(&self) -> f64 {
+        let range = self
+            .gesture
+            .rpn_bend_range
+            .unwrap_or(self.setup.bend_range_semitones);
+        if range.is_nan() {
+            return PITCH_BEND_SEMITONES;
+        }
+        range.clamp(0.0, MAX_BEND_RANGE_SEMITONES)
+    }
+
     /// Pitch bend in semitones, for every engine with pitch (the vibrato adds to it).
-    pub fn set_pitch_bend(&mut self, semitones: f64) {
+    fn set_bend(&mut self, semitones: f64) {
         self.gesture.bend = semitones;
         self.bend_engines(semitones + self.gesture.vibrato_now);
     }
@@ -372,16 +452,32 @@ impl Performer {
     }
 
     /// A MIDI controller at `value` (0..=1, as nice-plug delivers it): CC1 (mod wheel)
-    /// sets the vibrato depth, CC11 (expression) and CC2 (breath) the dynamics; others
-    /// are ignored.
+    /// sets the vibrato depth, CC11 (expression) and CC2 (breath) the dynamics; CC101 and
+    /// CC100 select a registered parameter and CC6 / CC38 set it (RPN 0: the pitch-bend
+    /// range, semitones and cents); others are ignored.
     pub fn set_controller(&mut self, cc: u8, value: f32) {
         if !value.is_finite() {
             return;
         }
         let v = (value as f64).clamp(0.0, 1.0);
+        // The 7-bit value of a data byte.
+        let byte = (v * 127.0).round() as u8;
         match cc {
             1 => self.gesture.vibrato_cents = v * MAX_VIBRATO_CENTS,
             2 | 11 => self.gesture.set_expression(v),
+            101 => self.gesture.rpn.0 = byte,
+            100 => self.gesture.rpn.1 = byte,
+            6 | 38 if self.gesture.rpn == (0, 0) => {
+                let range = self.bend_range();
+                let (semitones, cents) = (range.trunc(), (range.fract() * 100.0).round());
+                let range = if cc == 6 {
+                    byte as f64 + cents / 100.0
+                } else {
+                    semitones + byte.min(99) as f64 / 100.0
+                };
+                self.gesture.rpn_bend_range = Some(range.min(MAX_BEND_RANGE_SEMITONES));
+                self.set_bend(self.gesture.wheel * self.bend_range());
+            }
             _ => {}
         }
     }
@@ -402,24 +498,32 @@ impl Performer {
             * (2.0 * std::f64::consts::PI * self.gesture.phase).sin()
     }
 
-    /// Advances the gesture one sample and returns the bow it shapes. With the mod wheel
-    /// and the dynamics at rest it costs two comparisons.
+    /// Advances the gesture one sample and returns the bow it shapes: the stroke (its
+    /// direction and attack), then the dynamics. With the mod wheel and the dynamics at
+    /// rest and a down stroke under way it costs a few comparisons.
     #[inline]
     fn shape(&mut self, bow: BowControl) -> BowControl {
         if self.gesture.vibrato_cents > 0.0 || self.gesture.vibrato_now != 0.0 {
             self.advance_vibrato();
         }
+        let (speed, landing) = if self.stroke.is_settled() {
+            (self.stroke.direction(), 1.0)
+        } else {
+            self.stroke.tick()
+        };
         let g = &mut self.gesture;
-        if g.scale == 1.0 && g.target == 1.0 {
+        if g.scale == 1.0 && g.target == 1.0 && speed == 1.0 && landing == 1.0 {
             return bow;
         }
-        g.scale += g.smoothing * (g.target - g.scale);
-        if (g.scale - g.target).abs() < 1e-9 {
-            g.scale = g.target;
+        if g.scale != g.target {
+            g.scale += g.smoothing * (g.target - g.scale);
+            if (g.scale - g.target).abs() < 1e-9 {
+                g.scale = g.target;
+            }
         }
         BowControl {
-            velocity_m_per_s: bow.velocity_m_per_s * g.scale,
-            force_n: bow.force_n * g.scale,
+            velocity_m_per_s: bow.velocity_m_per_s * g.scale * speed,
+            force_n: bow.force_n * g.scale * landing,
             ..bow
         }
     }
@@ -450,6 +554,32 @@ impl Performer {
             }
         }
         self.gesture.countdown -= 1;
+    }
+
+    /// Whether every engine is asleep: [`Performer::tick`] would give silence (a zero
+    /// frame) and change nothing but the gesture's clocks until a note lands.
+    pub fn is_asleep(&self) -> bool {
+        self.instrument.is_skipping()
+            && !self.instrument.is_ringing()
+            && self.thermal.iter().all(|e| !e.is_ringing())
+            && !self.rubbed.is_sounding()
+    }
+
+    /// Stands in for `n` calls of [`Performer::tick`] with `bow` while
+    /// [`Performer::is_asleep`]: the output would be `n` zeros, so only the gesture
+    /// advances (sample by sample while a vibrato, an attack or the dynamics move, so the
+    /// result is the same bits; once, at rest). What makes a silent block cost nothing.
+    pub fn skip(&mut self, n: usize, bow: BowControl) {
+        debug_assert!(self.is_asleep());
+        let g = &self.gesture;
+        let at_rest = g.vibrato_cents == 0.0
+            && g.vibrato_now == 0.0
+            && g.scale == g.target
+            && self.stroke.is_settled();
+        let steps = if at_rest { n.min(1) } else { n };
+        for _ in 0..steps {
+            self.bow_now = self.shape(bow);
+        }
     }
 
     /// Silences every engine and forgets the held notes (the source and the controllers
@@ -542,7 +672,7 @@ impl Performer {
         }
         for (note, down) in held.iter().enumerate() {
             if *down {
-                self.note_on(note as u8);
+                self.land(note as u8);
             }
         }
     }
@@ -635,7 +765,7 @@ mod tests {
     fn bowed_at(e: f32) -> (f64, Option<Regime>) {
         let mut p = cello();
         p.set_controller(11, e);
-        p.note_on(50);
+        p.note_on(50, 0.8);
         let bow = BowControl::default();
         let n = (2.0 * FS) as usize;
         let mut audio = Vec::with_capacity(n);
@@ -680,7 +810,7 @@ mod tests {
         let mut p = cello();
         p.set_controller(1, 1.0);
         let string = InstrumentKind::Cello.string_for_note(50).unwrap();
-        p.note_on(50);
+        p.note_on(50, 0.8);
         let bow = BowControl::default();
         let centre = p.strings().string(string).fundamental_hz();
         let mut cents = Vec::new();
@@ -710,17 +840,206 @@ mod tests {
     }
 
     #[test]
-    fn without_controllers_the_bow_is_the_parameters_own() {
+    fn without_controllers_a_down_stroke_settles_on_the_parameters_own_bow() {
         let mut p = cello();
-        p.note_on(50);
+        p.note_on(50, 0.5);
         let bow = BowControl {
             velocity_m_per_s: -0.37,
             force_n: 2.5,
             position_beta: 0.13,
         };
+        // The attack: from rest to the asked speed, the force landing as asked (no accent
+        // at half velocity).
+        p.tick(bow);
+        assert!(p.bow().velocity_m_per_s.abs() < 0.01 && p.bow().force_n == bow.force_n);
+        let attack = (stroke::ATTACK_SLOWEST_S * FS) as usize;
+        for _ in 0..attack {
+            p.tick(bow);
+        }
         for _ in 0..1000 {
             p.tick(bow);
             assert_eq!(p.bow(), bow);
         }
+    }
+
+    /// The probe's velocity while the string sticks to the bow, averaged over samples
+    /// `from..to` of a render where `events` happen at their samples.
+    fn stick_velocity(p: &mut Performer, from: usize, to: usize) -> f64 {
+        let bow = BowControl::default();
+        let mut sum = 0.0;
+        let mut n = 0;
+        for i in 0..to {
+            let frame = p.tick(bow);
+            let rel = frame.bow_point_velocity_m_per_s - p.bow().velocity_m_per_s;
+            if i >= from && rel.abs() < 0.1 * bow.velocity_m_per_s {
+                sum += frame.bow_point_velocity_m_per_s;
+                n += 1;
+            }
+        }
+        sum / n.max(1) as f64
+    }
+
+    #[test]
+    fn skipping_silent_blocks_gives_the_same_bits_as_ticking_them() {
+        // A phrase with gaps long enough for the strings to fall asleep, vibrato and
+        // dynamics moving through the silences; one performer ticks every sample, the
+        // other skips blocks while asleep, as the plugin does.
+        // (A lifted string sleeps once its energy falls 120 dB or so: about 15 s for D3.)
+        let events: [(usize, u8, Option<f32>); 4] = [
+            (0, 50, Some(1.0)),
+            (4_800, 50, None),
+            (20 * 48_000, 69, Some(0.3)),
+            (20 * 48_000 + 9_600, 69, None),
+        ];
+        let render = |skipping: bool| {
+            let mut p = cello();
+            p.set_controller(1, 0.7);
+            let bow = BowControl::default();
+            let (block, frames) = (512, 40 * 48_000);
+            let mut out = Vec::with_capacity(frames);
+            let mut skipped = 0;
+            let mut next = 0;
+            while out.len() < frames {
+                let start = out.len();
+                if start == 3 * 48_000 {
+                    p.set_controller(11, 0.4);
+                }
+                let lands = next < events.len() && events[next].0 < start + block;
+                if skipping && !lands && p.is_asleep() {
+                    p.skip(block, bow);
+                    out.resize(start + block, 0.0);
+                    skipped += 1;
+                    continue;
+                }
+                for i in start..start + block {
+                    while next < events.len() && events[next].0 == i {
+                        match events[next] {
+                            (_, n, Some(v)) => p.note_on(n, v),
+                            (_, n, None) => p.note_off(n),
+                        }
+                        next += 1;
+                    }
+                    out.push(p.tick(bow).audio);
+                }
+                p.configure(&Setup::default());
+            }
+            (out, skipped)
+        };
+        let (ticked, _) = render(false);
+        let (skipped, blocks) = render(true);
+        assert!(blocks > 100, "only {blocks} blocks skipped");
+        assert!(ticked.iter().any(|x| x.abs() > 1e-3));
+        let differing = ticked
+            .iter()
+            .zip(&skipped)
+            .filter(|(a, b)| a.to_bits() != b.to_bits())
+            .count();
+        assert_eq!(differing, 0);
+    }
+
+    #[test]
+    fn alternate_bow_strokes_reverse_the_stick_velocity() {
+        let mut p = cello();
+        let mut sticks = Vec::new();
+        for note in [50, 52, 53, 55] {
+            p.note_on(note, 0.8);
+            // 0.3 s into each 0.5 s note: past the attack.
+            sticks.push(stick_velocity(
+                &mut p,
+                (0.3 * FS) as usize,
+                (0.5 * FS) as usize,
+            ));
+            p.note_off(note);
+        }
+        println!("stick velocities {sticks:?}");
+        // The string sticks to the bow, which moves at 0.1 m/s down, up, down, up (10 %:
+        // the probe's velocity while sticking includes small ripples).
+        for (k, v) in sticks.iter().enumerate() {
+            let want = if k % 2 == 0 { 0.1 } else { -0.1 };
+            assert!((v - want).abs() < 0.01, "note {k}: {v}");
+        }
+    }
+
+    #[test]
+    fn a_legato_note_on_one_string_keeps_the_stroke_and_the_bow_on() {
+        let mut p = cello();
+        let bow = BowControl::default();
+        p.note_on(50, 0.8);
+        // Past the attack and its accent.
+        for _ in 0..(0.4 * FS) as usize {
+            p.tick(bow);
+        }
+        let string = InstrumentKind::Cello.string_for_note(50).unwrap();
+        // E3 lands before D3 lifts: the same string, so the finger moves and the bow goes
+        // on: no new attack (the played bow stays the parameters'), no force dip.
+        p.note_on(52, 0.8);
+        p.note_off(50);
+        assert_eq!(InstrumentKind::Cello.string_for_note(52), Some(string));
+        for _ in 0..(0.3 * FS) as usize {
+            p.tick(bow);
+            assert_eq!(p.bow(), bow);
+            assert_eq!(p.strings().bow_gain(string), 1.0);
+        }
+        // A separate note after both lift starts an up-bow from rest.
+        p.note_off(52);
+        p.note_on(53, 0.8);
+        p.tick(bow);
+        assert!(p.bow().velocity_m_per_s.abs() < 0.01);
+        for _ in 0..(0.2 * FS) as usize {
+            p.tick(bow);
+        }
+        assert_eq!(p.bow().velocity_m_per_s, -bow.velocity_m_per_s);
+    }
+
+    #[test]
+    fn the_bend_range_follows_the_setup_and_midi_rpn_0() {
+        let string = InstrumentKind::Cello.string_for_note(50).unwrap();
+        // The pitch `note` sounds at when stopped on D3's string, unbent.
+        let stopped_hz = |note: u8| {
+            let setup = Setup {
+                preferred_string: Some(string),
+                ..Setup::default()
+            };
+            let mut p = Performer::new(InstrumentKind::Cello);
+            p.activate(&setup, FS).unwrap();
+            p.configure(&setup);
+            p.note_on(note, 0.8);
+            p.strings().string(string).fundamental_hz()
+        };
+        let mut p = cello();
+        p.note_on(50, 0.8);
+        let hz = |p: &Performer| p.strings().string(string).fundamental_hz();
+        let same = |a: f64, b: f64| (1200.0 * (a / b).log2()).abs() < 0.01;
+        p.set_pitch_wheel(1.0);
+        assert!(same(hz(&p), stopped_hz(52)), "default range: two semitones");
+        let setup = Setup {
+            bend_range_semitones: 7.0,
+            ..Setup::default()
+        };
+        p.configure(&setup);
+        assert!(
+            same(hz(&p), stopped_hz(57)),
+            "the parameter: seven semitones"
+        );
+        // RPN 0 (CC101 0, CC100 0, CC6 12, CC38 0): twelve semitones, over the parameter.
+        for (cc, v) in [(101, 0), (100, 0), (6, 12), (38, 0)] {
+            p.set_controller(cc, v as f32 / 127.0);
+        }
+        assert!(same(hz(&p), stopped_hz(62)), "RPN 0: twelve semitones");
+        // Down: D3 is the open D string, which a bend cannot take further below its open
+        // pitch than the tuning margin (within 10 cents: the intonation table moves each
+        // place on the string by a few cents).
+        p.set_pitch_wheel(0.0);
+        let open = midi_to_hz(50.0);
+        let cents = 1200.0 * (hz(&p) / open).log2();
+        assert!(
+            (cents + 100.0 * PITCH_BEND_SEMITONES).abs() < 10.0,
+            "{cents}"
+        );
+        // A data entry for another RPN changes nothing.
+        for (cc, v) in [(101, 0), (100, 1), (6, 3)] {
+            p.set_controller(cc, v as f32 / 127.0);
+        }
+        assert_eq!(p.bend_range(), 12.0);
     }
 }

@@ -444,6 +444,34 @@ fn processing_does_not_allocate_through_notes_parameter_changes_and_instrument_s
 }
 
 #[test]
+fn a_block_with_a_full_controller_flush_does_not_allocate() {
+    // A VST3 host that flushes nice-plug's 16 x 130 hidden MIDI-controller parameters
+    // hands the plugin 2080 events in one block; CLAP delivers controllers as events
+    // through the same capacity (`Plugin::INPUT_EVENT_CAPACITY`). Here 2080 controller
+    // changes (with a note among them) land in one 512-sample block, twice; the library
+    // aborts this process on any allocation inside `process`.
+    let mut plugin = active_plugin(FS, BLOCK);
+    let mut score = Score::new().at(0, Event::note_on(50));
+    for block in [1u64, 3] {
+        for i in 0..16 * 130u64 {
+            // Controllers the performer ignores, and expression and the mod wheel.
+            let cc = [20u8, 1, 11, 74][(i % 4) as usize];
+            let value = (i % 128) as u8;
+            score.push(
+                block * BLOCK as u64 + i % BLOCK as u64,
+                Event::Controller { cc, value },
+            );
+        }
+    }
+    let out = plugin.render(6 * BLOCK, BLOCK, &score);
+    assert!(out.iter().flatten().all(|x| x.is_finite()));
+    assert!(
+        rms(&channel_f64(&out, 0)) > 0.0,
+        "the note sounded through the storm"
+    );
+}
+
+#[test]
 fn notes_outside_the_instruments_range_are_ignored_silently() {
     let mut plugin = active_plugin(FS, BLOCK);
     for kind in InstrumentKind::ALL {
@@ -880,11 +908,11 @@ fn a_midi_file_rendered_offline_gives_the_plugins_bits() {
     let bend = |amount: f64| (8192.0 + amount * 8192.0).round().clamp(0.0, 16383.0) as u16;
     let at = |sample: u64, event: MidiEvent| Timed { sample, event };
     let events = [
-        at(0, MidiEvent::NoteOn(50)),
+        at(0, MidiEvent::NoteOn(50, 100)),
         at(24_000, MidiEvent::PitchBend(bend(0.5))),
         at(36_001, MidiEvent::PitchBend(bend(-1.0))),
         at(48_000, MidiEvent::NoteOff(50)),
-        at(48_000, MidiEvent::NoteOn(57)),
+        at(48_000, MidiEvent::NoteOn(57, 127)),
         // Dynamics down and back up (CC11), and the mod wheel's vibrato (CC1).
         at(50_000, MidiEvent::Controller(11, 40)),
         at(55_000, MidiEvent::Controller(1, 100)),
@@ -904,7 +932,10 @@ fn a_midi_file_rendered_offline_gives_the_plugins_bits() {
     let mut score = Score::new();
     for e in &events {
         let event = match e.event {
-            MidiEvent::NoteOn(n) => Event::note_on(n),
+            MidiEvent::NoteOn(key, v) => Event::NoteOn {
+                key,
+                velocity: v as f64 / 127.0,
+            },
             MidiEvent::NoteOff(n) => Event::note_off(n),
             MidiEvent::PitchBend(raw) => Event::pitch_bend((raw as f64 - 8192.0) / 8192.0),
             MidiEvent::Controller(cc, value) => host::Event::Controller { cc, value },

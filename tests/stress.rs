@@ -426,11 +426,12 @@ impl Rig {
     fn apply(&mut self, op: Op) {
         let before = self.setup;
         match (self.engine, op) {
-            (_, Op::NoteOn(n)) => self.performer.note_on(n),
+            (_, Op::NoteOn(n)) => self.performer.note_on(n, 0.8),
             (_, Op::NoteOff(n)) => self.performer.note_off(n),
             (_, Op::AllOff) => self.performer.all_notes_off(),
             (Engine::Strings(..) | Engine::Thermal(..), Op::Bend(b)) => {
-                self.performer.set_pitch_bend(b)
+                // Semitones at the default two-semitone range, as the wheel sends them.
+                self.performer.set_pitch_wheel((0.5 + b / 4.0) as f32)
             }
             (Engine::Strings(..) | Engine::Rubbed(..), Op::Law(Law::Point(m))) => {
                 self.setup.point_law = Some(m)

@@ -32,8 +32,12 @@ pub const STRINGS: usize = 4;
 pub const MAX_STOP_SEMITONES: u8 = 31;
 /// Bow landing and lifting time, s.
 pub const BOW_RAMP_S: f64 = 0.02;
-/// Pitch-bend range, semitones either way.
+/// Default pitch-bend range, semitones either way; also how far a bend may take a note
+/// below its open string or above the highest note (the tuning margins below).
 pub const PITCH_BEND_SEMITONES: f64 = 2.0;
+/// Widest pitch-bend range, semitones either way (the finger slides; a bend still stops
+/// at [`PITCH_BEND_SEMITONES`] below the open string and above the highest note).
+pub const MAX_BEND_RANGE_SEMITONES: f64 = 12.0;
 /// Reference pitch A4, Hz: lowest (baroque pitch), default and highest (Venetian high
 /// pitch). Every note, open strings included, is tuned from it.
 pub const REFERENCE_HZ_MIN: f64 = 415.0;
@@ -388,9 +392,13 @@ impl Instrument {
         self.preferred_string = preferred.filter(|&p| p < STRINGS);
     }
 
-    /// Pitch bend in semitones (clamped to the bend range): moves every stopping point.
+    /// Pitch bend in semitones (clamped to [`MAX_BEND_RANGE_SEMITONES`]): moves every
+    /// stopping point, as far as the string reaches ([`intonation::tuned_hz`]).
     pub fn set_pitch_bend(&mut self, semitones: f64) {
-        let semitones = semitones.clamp(-PITCH_BEND_SEMITONES, PITCH_BEND_SEMITONES);
+        if semitones.is_nan() {
+            return;
+        }
+        let semitones = semitones.clamp(-MAX_BEND_RANGE_SEMITONES, MAX_BEND_RANGE_SEMITONES);
         if semitones == self.bend_semitones {
             return;
         }
@@ -442,6 +450,12 @@ impl Instrument {
     }
 
     /// The string a note was sent to, with its current tuning (for tests and tools).
+    /// How far the bow rests on string `index`: 0 lifted, 1 fully on (it ramps between
+    /// over [`BOW_RAMP_S`]); 0 for a string that does not exist.
+    pub fn bow_gain(&self, index: usize) -> f64 {
+        self.voices.get(index).map_or(0.0, |v| v.bow_gain)
+    }
+
     pub fn string(&self, index: usize) -> &WaveguideString {
         &self.voices[index].string
     }
@@ -561,6 +575,11 @@ impl Instrument {
     /// to measure what skipping saves and changes: `colophony bench scenes`.
     pub fn set_skipping(&mut self, skipping: bool) {
         self.skipping = skipping;
+    }
+
+    /// Whether sleeping strings are skipped (the default; see [`Instrument::set_skipping`]).
+    pub fn is_skipping(&self) -> bool {
+        self.skipping
     }
 
     /// Strings computed on the next sample.

@@ -59,7 +59,12 @@ pub fn tuned_hz(
     reference: f64,
 ) -> f64 {
     let open = kind.open_notes()[string.min(STRINGS - 1)] as f64;
-    let played = note as f64 + bend;
+    // A bend slides the finger as far as the string reaches: down to a detuned open string,
+    // up past the end of the fingerboard by as much (the delay lines and the thermal rate
+    // floor are sized for these ends).
+    let margin = super::instrument::PITCH_BEND_SEMITONES;
+    let top = open + MAX_STOP_SEMITONES as f64;
+    let played = (note as f64 + bend).clamp(open - margin, top + margin);
     let correction = table.map_or(0.0, |t| {
         t.correction_cents(row, kind, string, played - open)
     });

@@ -48,7 +48,7 @@ use super::bridge::{solve_junction, BridgeMode, ModalBridge};
 use super::filters::flush_tiny;
 use super::instrument::{
     midi_to_hz, reference_semitones, BowControl, Frame, InstrumentKind, BOW_RAMP_S,
-    HIGHEST_TUNING_SEMITONES, LOWEST_TUNING_SEMITONES, PITCH_BEND_SEMITONES, SLEEP_ENERGY_J,
+    HIGHEST_TUNING_SEMITONES, LOWEST_TUNING_SEMITONES, MAX_BEND_RANGE_SEMITONES, SLEEP_ENERGY_J,
     STRINGS,
 };
 use super::intonation::{self, IntonationTable};
@@ -465,7 +465,10 @@ impl ThermalInstrument {
 
     /// Pitch bend in semitones (clamped to the bend range).
     pub fn set_pitch_bend(&mut self, semitones: f64) {
-        let semitones = semitones.clamp(-PITCH_BEND_SEMITONES, PITCH_BEND_SEMITONES);
+        if semitones.is_nan() {
+            return;
+        }
+        let semitones = semitones.clamp(-MAX_BEND_RANGE_SEMITONES, MAX_BEND_RANGE_SEMITONES);
         if semitones == self.bend_semitones {
             return;
         }
