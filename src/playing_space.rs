@@ -25,6 +25,7 @@
 //! 15 % of beta and the string sticks at the bow velocity (within 10 %).
 
 use crate::analysis::{cents, peak_frequency_hz, slip_stats};
+use crate::dsp::friction::bristle::BristleIntegrator;
 use crate::dsp::friction::FrictionModel;
 use crate::dsp::instrument::{midi_to_hz, BowControl, Frame, Instrument, InstrumentKind, STRINGS};
 use crate::dsp::intonation::{self, IntonationTable};
@@ -156,6 +157,8 @@ pub struct Cell {
     pub string: Option<usize>,
     /// The intonation the engine tunes by (the shipped table unless a tool says otherwise).
     pub intonation: Option<&'static IntonationTable>,
+    /// The bristle laws' time discretisation (the plugin's: the trapezoid).
+    pub integrator: BristleIntegrator,
 }
 
 impl Cell {
@@ -221,6 +224,7 @@ impl Cell {
             seconds,
             string,
             intonation: Some(intonation::shipped()),
+            integrator: BristleIntegrator::Trapezoid,
         }
     }
 
@@ -271,6 +275,7 @@ pub fn render_cell(cell: &Cell) -> Result<(Vec<f64>, Vec<ContactSample>), String
             engine.set_newton_tolerance(Quality::Good.newton_tolerance_m_per_s());
             engine.set_intonation(cell.intonation);
             engine.set_preferred_string(cell.string);
+            engine.set_bristle_integrator(cell.integrator);
             engine.note_on(cell.note);
             for i in 0..n {
                 if i % BLOCK == 0 {

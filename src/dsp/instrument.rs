@@ -636,6 +636,18 @@ impl Instrument {
         }
     }
 
+    /// Sets every string's bristle integrator (see
+    /// [`crate::dsp::friction::bristle::BristleIntegrator`]); after
+    /// [`Self::set_bristle_params`], which rebuilds the contacts with the trapezoid.
+    pub fn set_bristle_integrator(
+        &mut self,
+        integrator: crate::dsp::friction::bristle::BristleIntegrator,
+    ) {
+        for voice in &mut self.voices {
+            voice.contact.bristle_mut().set_integrator(integrator);
+        }
+    }
+
     /// Most dispersion allpass sections each string's fit may use (refits the strings;
     /// see [`super::waveguide::WaveguideString::set_dispersion_cap`]). For the
     /// work-precision bench, not the audio thread.

@@ -155,6 +155,20 @@ impl BristleParams {
     }
 }
 
+/// How the bristle equation is discretised in time (the K-method's `z = z~ + k2 y`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum BristleIntegrator {
+    /// Paper A's trapezoidal rule: `z(n) = z(n-1) + (T/2) (y(n-1) + y(n))`. Second order,
+    /// A-stable but not L-stable: a bristle relaxing much faster than a sample (slipping,
+    /// `sigma0 |v| / h(v)` above `2 / T`) flips sign from sample to sample instead of
+    /// settling.
+    #[default]
+    Trapezoid,
+    /// Backward Euler: `z(n) = z(n-1) + T y(n)`. First order, L-stable: a bristle faster
+    /// than a sample settles onto its steady state within the sample.
+    BackwardEuler,
+}
+
 /// Which bristle law: LuGre (`alpha = 1`) or elasto-plastic (adhesion map).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BristleLaw {
@@ -199,6 +213,7 @@ pub struct BristleFriction {
     params: BristleParams,
     law: BristleLaw,
     half_period_s: f64,
+    integrator: BristleIntegrator,
     /// Mean bristle displacement `z(n-1)`, m.
     z_m: f64,
     /// `zdot(n-1)`, m/s.
@@ -285,12 +300,23 @@ impl BristleFriction {
             params,
             law,
             half_period_s: 0.5 / sample_rate_hz,
+            integrator: BristleIntegrator::Trapezoid,
             z_m: 0.0,
             y_m_per_s: 0.0,
             v_m_per_s: 0.0,
             newton_tolerance_m_per_s: Y_TOLERANCE_M_PER_S,
             stats: SolverStats::default(),
         })
+    }
+
+    /// Chooses the time discretisation of the bristle equation (real-time safe; the state
+    /// carries over).
+    pub fn set_integrator(&mut self, integrator: BristleIntegrator) {
+        self.integrator = integrator;
+    }
+
+    pub fn integrator(&self) -> BristleIntegrator {
+        self.integrator
     }
 
     /// Sets the Newton convergence tolerance on the step (m/s, relative above 1 m/s;
@@ -479,8 +505,13 @@ impl FrictionContact for BristleFriction {
         }
         let p = self.params;
         let curve = self.curve(f_n);
-        let k2 = self.half_period_s;
-        let z_tilde = self.z_m + k2 * self.y_m_per_s;
+        let (k2, z_tilde) = match self.integrator {
+            BristleIntegrator::Trapezoid => (
+                self.half_period_s,
+                self.z_m + self.half_period_s * self.y_m_per_s,
+            ),
+            BristleIntegrator::BackwardEuler => (2.0 * self.half_period_s, self.z_m),
+        };
         let denominator = 1.0 + admittance * p.sigma2_kg_per_s;
         let v_tilde = (v_free - admittance * p.sigma0_n_per_m * z_tilde) / denominator;
         let k1 = -admittance * (p.sigma0_n_per_m * k2 + p.sigma1_kg_per_s) / denominator;
@@ -572,13 +603,69 @@ mod tests {
     }
 
     #[test]
+    fn a_bristle_faster_than_a_sample_settles_with_backward_euler_and_rings_with_the_trapezoid() {
+        // LuGre sliding steadily at 0.5 m/s against a stiff load (no string motion): the
+        // bristle relaxes in h / (sigma0 |v|) = 4 us, a fifth of a sample at 48 kHz. Its
+        // steady state is z_ss = h / sigma0; the trapezoid overshoots and alternates about
+        // it (its factor for a relaxation faster than 2/T is negative), backward Euler
+        // approaches it from one side.
+        let deviations = |integrator| {
+            let mut c = BristleFriction::new(
+                BristleParams::waveguide_string(),
+                BristleLaw::LuGre,
+                48_000.0,
+            )
+            .unwrap();
+            c.set_integrator(integrator);
+            let load = LoadLine {
+                free_velocity_m_per_s: 0.0,
+                admittance_s_per_kg: 1e-6,
+            };
+            let bow = BowInput {
+                velocity_m_per_s: 0.5,
+                normal_force_n: 1.0,
+            };
+            let z_ss = 0.2 / 1e5; // h(0.5 m/s) = f_c (the Stribeck term is e^-25), / sigma0
+            (0..8)
+                .map(|_| {
+                    c.solve(load, bow);
+                    c.z_m / z_ss - 1.0
+                })
+                .collect::<Vec<f64>>()
+        };
+        let trapezoid = deviations(BristleIntegrator::Trapezoid);
+        let backward = deviations(BristleIntegrator::BackwardEuler);
+        println!("trapezoid {trapezoid:?}\nbackward Euler {backward:?}");
+        // Per sample the deviation is multiplied by 1 / (1 + x) for backward Euler and by
+        // (1 - x/2) / (1 + x/2) for the trapezoid, x = T sigma0 |v| / h ~ 5.2 here: backward
+        // Euler decays monotonically by more than 5x a sample; the trapezoid flips sign
+        // every sample (and would tend to -1, undamped, as x grows).
+        for w in backward.windows(2) {
+            assert!(w[0] * w[1] > 0.0 && w[1].abs() < 0.2 * w[0].abs(), "{w:?}");
+        }
+        for w in trapezoid.windows(2) {
+            assert!(w[0] * w[1] < 0.0, "{w:?}");
+        }
+    }
+
+    #[test]
     fn the_solution_satisfies_the_discretised_bristle_equation() {
+        for integrator in [
+            BristleIntegrator::Trapezoid,
+            BristleIntegrator::BackwardEuler,
+        ] {
+            solution_satisfies_the_discretised_equation(integrator);
+        }
+    }
+
+    fn solution_satisfies_the_discretised_equation(integrator: BristleIntegrator) {
         let mut c = BristleFriction::new(
             BristleParams::waveguide_string(),
             BristleLaw::ElastoPlastic,
             48_000.0,
         )
         .unwrap();
+        c.set_integrator(integrator);
         let load_y = 1.0 / (2.0 * 0.506);
         for n in 0..2000 {
             let v_h = 0.8 * (n as f64 * 0.01).sin();
@@ -595,12 +682,16 @@ mod tests {
                 },
                 bow,
             );
-            // trapezoid, force law and load line all hold to rounding
+            // the integrator, force law and load line all hold to rounding
             let p = c.params;
             let z = c.z_m;
             let y = c.y_m_per_s;
             let v = c.v_m_per_s;
-            assert!((z - (z_prev + c.half_period_s * (y_prev + y))).abs() < 1e-15);
+            let step = match integrator {
+                BristleIntegrator::Trapezoid => c.half_period_s * (y_prev + y),
+                BristleIntegrator::BackwardEuler => 2.0 * c.half_period_s * y,
+            };
+            assert!((z - (z_prev + step)).abs() < 1e-15);
             let curve = c.curve(1.1);
             assert!((curve.eval(v, z).0 - y).abs() < 1e-8, "sample {n}");
             assert!(
