@@ -4,26 +4,18 @@
 //! ([`params`], read once per block into a [`performer::Setup`]) and MIDI events in, the
 //! framework-free [`performer`] in the middle (source switching, held keys, dynamics and
 //! vibrato, the host tail) driving the engines of [`dsp`], stereo out. Neither the
-//! performer nor the DSP core imports the plugin framework. [`render`] (one bowed note on
-//! an engine) and [`midi_file`] (a MIDI file through the same performer) are the offline
-//! renderer behind the `colophony` binary, and [`analysis`] the signal measurements the
-//! tests and tools share.
+//! performer nor the DSP core imports the plugin framework. [`analysis`] holds the signal
+//! measurements the tests and tools share. The tools (the `colophony` command: the
+//! offline renderer, MIDI files, figures, benches, the precision bench and the
+//! playing-space map, bridge fitting) are the workspace's other crate, `colophony-lab`
+//! (`lab/`), which plays through this crate's performer and engines.
 
-pub mod admittance_fit;
 pub mod analysis;
-pub mod bench;
 pub mod dsp;
 pub mod editor;
-pub mod figures;
-pub mod intonation_fit;
-pub mod midi_file;
 pub mod params;
 pub mod performer;
-pub mod playing_space;
-pub mod playing_space_figure;
-pub mod precision;
 pub mod quality;
-pub mod render;
 
 use dsp::instrument::{BowControl, InstrumentKind};
 use nice_plug::midi::Key;

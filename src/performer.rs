@@ -26,7 +26,7 @@
 
 pub mod stroke;
 
-use crate::admittance_fit;
+use crate::dsp::bridge_data;
 use crate::dsp::engine::Engine;
 use crate::dsp::friction::FrictionModel;
 use crate::dsp::instrument::{
@@ -275,10 +275,10 @@ impl Performer {
         self.thermal.clear();
         for kind in InstrumentKind::ALL {
             let bridge = match kind {
-                InstrumentKind::Cello => admittance_fit::shipped_cello_bridge(),
+                InstrumentKind::Cello => bridge_data::shipped_cello_bridge(),
                 // The viola borrows the violin's generic bridge (no viola data shipped).
                 InstrumentKind::Violin | InstrumentKind::Viola => {
-                    admittance_fit::shipped_violin_bridge()
+                    bridge_data::shipped_violin_bridge()
                 }
             };
             let engine = ThermalInstrument::new(kind, &bridge.modes, fs, settings)

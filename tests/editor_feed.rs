@@ -3,7 +3,7 @@
 //! `Colophony::process` does while an open editor listens. The host tests cannot open an
 //! editor, so this drives the same calls with a counting allocator.
 
-use colophony::admittance_fit::shipped_cello_bridge;
+use colophony::dsp::bridge_data::shipped_cello_bridge;
 use colophony::dsp::instrument::{BowControl, InstrumentKind};
 use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
 use colophony::editor::live::ContactSample;

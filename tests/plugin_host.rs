@@ -733,7 +733,7 @@ fn thermal_model_plays_in_tune_and_survives_bow_changes_and_switches_during_note
     }
     // After the note off, A3 (moved to the violin's G string by the instrument switch)
     // rings at its pitch: 5 cents, about the smallest difference players notice on
-    // sustained tones (the bowed pitch flattens with force: tests/paper_b.rs).
+    // sustained tones (the bowed pitch flattens with force: lab/tests/paper_b.rs).
     // The violin G string, 2 semitones up, tuned by the thermal model's intonation.
     let nominal = tuned_hz(InstrumentKind::Violin, "thermal", 0, 57.0);
     let error = cents(
@@ -870,69 +870,4 @@ fn assert_no_click_at(x: &[f64], switch_at: &[u64]) {
         // 1.5x: a step no larger than the waveform's own corners is not a click.
         assert!(at_switch <= 1.5 * before.max(1e-4), "click at sample {at}");
     }
-}
-
-#[test]
-fn a_midi_file_rendered_offline_gives_the_plugins_bits() {
-    use colophony::midi_file::{perform, MidiEvent, Performance, Timed};
-    // The same notes, bends and controllers, at the same samples and block size, through
-    // the CLAP build in the host and through `colophony render --midi`'s performer.
-    let bend = |amount: f64| (8192.0 + amount * 8192.0).round().clamp(0.0, 16383.0) as u16;
-    let at = |sample: u64, event: MidiEvent| Timed { sample, event };
-    let events = [
-        at(0, MidiEvent::NoteOn(50, 100)),
-        at(24_000, MidiEvent::PitchBend(bend(0.5))),
-        at(36_001, MidiEvent::PitchBend(bend(-1.0))),
-        at(48_000, MidiEvent::NoteOff(50)),
-        at(48_000, MidiEvent::NoteOn(57, 127)),
-        // Dynamics down and back up (CC11), and the mod wheel's vibrato (CC1).
-        at(50_000, MidiEvent::Controller(11, 40)),
-        at(55_000, MidiEvent::Controller(1, 100)),
-        at(60_123, MidiEvent::PitchBend(bend(0.0))),
-        at(66_000, MidiEvent::Controller(11, 127)),
-        at(72_000, MidiEvent::NoteOff(57)),
-    ];
-    let params = colophony::params::ColophonyParams::default();
-    let how = Performance {
-        setup: params.setup(),
-        bow: params.bow(),
-        gain: nice_plug::util::db_to_gain(params.gain.value()) as f64,
-        sample_rate_hz: FS,
-        block: BLOCK,
-    };
-    let offline = perform(&events, &how, |_, _| {}).unwrap();
-    let mut score = Score::new();
-    for e in &events {
-        let event = match e.event {
-            MidiEvent::NoteOn(key, v) => Event::NoteOn {
-                key,
-                velocity: v as f64 / 127.0,
-            },
-            MidiEvent::NoteOff(n) => Event::note_off(n),
-            MidiEvent::PitchBend(raw) => Event::pitch_bend((raw as f64 - 8192.0) / 8192.0),
-            MidiEvent::Controller(cc, value) => host::Event::Controller { cc, value },
-            MidiEvent::Pressure(_) => unreachable!("not in this score"),
-        };
-        score.push(e.sample, event);
-    }
-    let frames = 96_000;
-    assert!(
-        offline.len() >= frames,
-        "offline render of {} frames",
-        offline.len()
-    );
-    let mut plugin = active_plugin(FS, BLOCK);
-    let hosted = plugin.render(frames, BLOCK, &score);
-    let differing = (0..frames)
-        .filter(|&i| hosted[0][i].to_bits() != offline[i].to_bits())
-        .count();
-    assert!(
-        rms(&channel_f64(&hosted, 0)) > 1e-3,
-        "the hosted plugin was silent"
-    );
-    let first = (0..frames).find(|&i| hosted[0][i].to_bits() != offline[i].to_bits());
-    assert_eq!(
-        differing, 0,
-        "{differing} of {frames} samples differ, the first at {first:?}"
-    );
 }

@@ -15,7 +15,7 @@
 //! note is moved so that bowing it at nominal (the plugin's defaults, 0.1 m/s, 1 N,
 //! beta 0.1, and the geometric middle of the note's Schelleng window) sounds at equal
 //! temperament. It is measured through the same engines the plugin plays by
-//! `colophony bench intonation` (`src/intonation_fit.rs`), written to
+//! `colophony bench intonation` (`lab/src/intonation_fit.rs`), written to
 //! `assets/intonation.csv` and compiled in. Between semitones (pitch bend, vibrato) it is
 //! interpolated linearly. The change of pitch with force and bow position is left as the
 //! physics gives it.

@@ -6,6 +6,7 @@
 
 pub mod body;
 pub mod bridge;
+pub mod bridge_data;
 pub mod engine;
 pub mod filters;
 pub mod friction;

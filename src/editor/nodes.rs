@@ -488,7 +488,7 @@ mod tests {
         use crate::dsp::thermal::ThermalParams;
         use crate::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
         let fs = 48_000.0;
-        let bridge = crate::admittance_fit::shipped_cello_bridge().modes;
+        let bridge = crate::dsp::bridge_data::shipped_cello_bridge().modes;
         let settings = ThermalSettings::default();
         let mut cello =
             ThermalInstrument::new(InstrumentKind::Cello, &bridge, fs, settings).unwrap();

@@ -152,7 +152,7 @@ fn repeats_every_period(onsets: &[usize], n: usize, period: f32) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::admittance_fit::shipped_cello_bridge;
+    use crate::dsp::bridge_data::shipped_cello_bridge;
     use crate::dsp::friction::FrictionModel;
     use crate::dsp::instrument::{midi_to_hz, BowControl, Instrument, InstrumentKind};
     use crate::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};

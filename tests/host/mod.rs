@@ -543,47 +543,65 @@ pub fn channel_f64(out: &[Vec<f32>], c: usize) -> Vec<f64> {
     out[c].iter().map(|&x| x as f64).collect()
 }
 
-/// The workspace's target directory: `CARGO_TARGET_DIR` if set, else `target/` next to the
-/// nearest `Cargo.lock` above this crate's manifest (the workspace root).
-pub fn target_dir() -> PathBuf {
-    if let Some(dir) = std::env::var_os("CARGO_TARGET_DIR") {
-        return PathBuf::from(dir);
-    }
+/// The workspace root: the nearest directory with a `Cargo.lock` above the manifest of
+/// the crate these tests belong to (the plugin's, or the tools' in `lab/`).
+pub fn workspace_root() -> PathBuf {
     let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
     manifest
         .ancestors()
         .find(|d| d.join("Cargo.lock").exists())
         .unwrap_or(manifest)
-        .join("target")
+        .to_path_buf()
+}
+
+/// The workspace's target directory: `CARGO_TARGET_DIR` if set, else `target/` at the
+/// workspace root.
+pub fn target_dir() -> PathBuf {
+    if let Some(dir) = std::env::var_os("CARGO_TARGET_DIR") {
+        return PathBuf::from(dir);
+    }
+    workspace_root().join("target")
 }
 
 /// Builds the plugin library for the tests, once per process, and returns its path.
 ///
 /// `cargo test` builds the crate's cdylib without the `assert_process_allocs` feature and
-/// leaves it in `deps/`, so this runs `$CARGO build --lib --features assert_process_allocs`
-/// (dev profile, same target directory) and loads `target/debug/libcolophony.so`. With
-/// debug assertions on, any allocation inside the plugin's `process` then aborts the test
-/// process.
+/// leaves it in `deps/`, so this runs `$CARGO build -p colophony --lib --features
+/// assert_process_allocs` (dev profile, in `target/host-plugin/`) and loads
+/// `target/host-plugin/debug/libcolophony.so`. With debug assertions on, any allocation inside the
+/// plugin's `process` then aborts the test process.
 pub fn test_plugin_path() -> &'static Path {
     static PATH: OnceLock<PathBuf> = OnceLock::new();
     PATH.get_or_init(|| {
         let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
-        let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let root = workspace_root();
+        // A target directory of its own: this feature set's `libcolophony` beside the
+        // workspace's would leave two candidates for the tools crate's doctests (E0460),
+        // and one build would overwrite the other's unhashed output.
+        let target = target_dir().join("host-plugin");
         let status = Command::new(&cargo)
-            .current_dir(manifest)
-            .args(["build", "--lib", "--features", "assert_process_allocs"])
+            .current_dir(&root)
+            .args([
+                "build",
+                "-p",
+                "colophony",
+                "--lib",
+                "--features",
+                "assert_process_allocs",
+            ])
             .arg("--manifest-path")
-            .arg(manifest.join("Cargo.toml"))
+            .arg(root.join("Cargo.toml"))
+            .arg("--target-dir")
+            .arg(&target)
             .status()
             .unwrap_or_else(|e| panic!("running {cargo:?}: {e}"));
         assert!(status.success(), "building the plugin library failed");
         let name = format!(
-            "{}{}{}",
+            "{}colophony{}",
             std::env::consts::DLL_PREFIX,
-            env!("CARGO_PKG_NAME").replace('-', "_"),
             std::env::consts::DLL_SUFFIX
         );
-        let path = target_dir().join("debug").join(name);
+        let path = target.join("debug").join(name);
         assert!(path.exists(), "{} was not built", path.display());
         // cargo gives this crate's lib and cdylib outputs no hash suffix, so a build of
         // another feature set can overwrite them while leaving this one's fingerprint fresh;

@@ -4,10 +4,10 @@
 //! docs/precision.md, so nothing here claims it does), a deterministic reference, the
 //! metric pipeline on signals whose answer is known, and the CSV's shape.
 
-use colophony::precision::{
+use colophony_lab::precision::{
     compute, csv, errors, measure, Plan, Report, Scenario, Series, ANALYSIS_RATE_HZ, CSV_HEADER,
 };
-use colophony::render::Rendered;
+use colophony_lab::render::Rendered;
 use std::f64::consts::PI;
 use std::sync::OnceLock;
 
@@ -58,7 +58,7 @@ fn a_reference_rendered_twice_has_zero_error() {
     let short = Plan {
         seconds: 0.5,
         timing_runs: 1,
-        groups: vec![colophony::precision::Group {
+        groups: vec![colophony_lab::precision::Group {
             configs: vec![group.reference.clone()],
             ..group.clone()
         }],

@@ -24,17 +24,19 @@
 //! **Helmholtz** when the classifier says one slip per period, the slip fraction is within
 //! 15 % of beta and the string sticks at the bow velocity (within 10 %).
 
-use crate::analysis::{cents, peak_frequency_hz, slip_stats};
-use crate::dsp::friction::bristle::BristleIntegrator;
-use crate::dsp::friction::FrictionModel;
-use crate::dsp::instrument::{midi_to_hz, BowControl, Frame, Instrument, InstrumentKind, STRINGS};
-use crate::dsp::intonation::{self, IntonationTable};
-use crate::dsp::thermal::ThermalParams;
-use crate::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
-use crate::editor::live::ContactSample;
-use crate::editor::mapping::SchellengWindow;
-use crate::editor::regime::{classify_regime, Regime};
-use crate::quality::{Quality, GOOD_NODES};
+use colophony::analysis::{cents, peak_frequency_hz, slip_stats};
+use colophony::dsp::friction::bristle::BristleIntegrator;
+use colophony::dsp::friction::FrictionModel;
+use colophony::dsp::instrument::{
+    midi_to_hz, BowControl, Frame, Instrument, InstrumentKind, STRINGS,
+};
+use colophony::dsp::intonation::{self, IntonationTable};
+use colophony::dsp::thermal::ThermalParams;
+use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
+use colophony::editor::live::ContactSample;
+use colophony::editor::mapping::SchellengWindow;
+use colophony::editor::regime::{classify_regime, Regime};
+use colophony::quality::{Quality, GOOD_NODES};
 use rayon::prelude::*;
 use std::fmt::Write as _;
 use std::path::Path;

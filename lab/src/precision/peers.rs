@@ -14,14 +14,14 @@
 //! force (their controls are 0-1 or 0-128 values), and neither outputs the string velocity.
 
 use super::{Errors, Measured, Row, ANALYSIS_RATE_HZ};
-use crate::analysis::{cents, peak_frequency_hz, rms};
-use crate::dsp::instrument::midi_to_hz;
+use colophony::analysis::{cents, peak_frequency_hz, rms};
+use colophony::dsp::instrument::midi_to_hz;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-const STK_SOURCE: &str = include_str!("../../assets/peers/stk_bowed.cpp");
-const FAUST_DSP: &str = include_str!("../../assets/peers/faust_violin.dsp");
-const FAUST_DRIVER: &str = include_str!("../../assets/peers/faust_driver.cpp");
+const STK_SOURCE: &str = include_str!("../../../assets/peers/stk_bowed.cpp");
+const FAUST_DSP: &str = include_str!("../../../assets/peers/faust_violin.dsp");
+const FAUST_DRIVER: &str = include_str!("../../../assets/peers/faust_driver.cpp");
 
 /// The pitch both peers play: A4.
 const NOTE: f64 = 69.0;

@@ -1,16 +1,16 @@
 //! Offline rendering straight from the DSP core (no plugin host), and WAV output.
 //!
 //! ```
-//! use colophony::render::{render, RenderSettings};
+//! use colophony_lab::render::{render, RenderSettings};
 //! let settings = RenderSettings { seconds: 0.05, ..RenderSettings::default() };
 //! let out = render(&settings).unwrap();
 //! assert_eq!(out.audio.len(), (0.05f64 * 48_000.0).round() as usize);
 //! ```
 
-use crate::dsp::friction::bristle::{BristleParams, SolverStats};
-use crate::dsp::friction::FrictionModel;
-use crate::dsp::instrument::{BowControl, Instrument, InstrumentKind};
-use crate::dsp::rubbed::{RubbedPreset, RubbedScene};
+use colophony::dsp::friction::bristle::{BristleParams, SolverStats};
+use colophony::dsp::friction::FrictionModel;
+use colophony::dsp::instrument::{BowControl, Instrument, InstrumentKind};
+use colophony::dsp::rubbed::{RubbedPreset, RubbedScene};
 use std::fmt;
 use std::path::Path;
 
@@ -35,7 +35,7 @@ pub struct RenderSettings {
     /// purely transverse string).
     pub torsion: bool,
     /// Whether notes are tuned by the bowed sound (the plugin's tuning,
-    /// [`crate::dsp::intonation`]); off, by the free decay (paper A's string).
+    /// [`colophony::dsp::intonation`]); off, by the free decay (paper A's string).
     pub intonation: bool,
 }
 
@@ -50,7 +50,7 @@ impl Default for RenderSettings {
             release_s: None,
             friction: FrictionModel::Hyperbolic,
             bristle: BristleParams::waveguide_string(),
-            reference_hz: crate::dsp::instrument::REFERENCE_HZ_DEFAULT,
+            reference_hz: colophony::dsp::instrument::REFERENCE_HZ_DEFAULT,
             torsion: true,
             intonation: true,
         }
@@ -131,7 +131,7 @@ pub fn check(settings: &RenderSettings) -> Result<(), RenderError> {
             settings.sample_rate_hz
         ));
     }
-    use crate::dsp::instrument::{REFERENCE_HZ_MAX, REFERENCE_HZ_MIN};
+    use colophony::dsp::instrument::{REFERENCE_HZ_MAX, REFERENCE_HZ_MIN};
     if !(settings.reference_hz.is_finite()
         && (REFERENCE_HZ_MIN..=REFERENCE_HZ_MAX).contains(&settings.reference_hz))
     {
@@ -192,7 +192,11 @@ pub fn render_with(
         .map_err(RenderError::BadSetting)?;
     instrument.set_friction_model(settings.friction);
     instrument.set_torsion(settings.torsion);
-    instrument.set_intonation(settings.intonation.then(crate::dsp::intonation::shipped));
+    instrument.set_intonation(
+        settings
+            .intonation
+            .then(colophony::dsp::intonation::shipped),
+    );
     instrument.set_reference_pitch(settings.reference_hz);
     configure(&mut instrument);
     instrument.note_on(settings.note);
@@ -224,8 +228,8 @@ pub fn render_thermal(
     nodes: usize,
     width_m: f64,
 ) -> Result<Rendered, RenderError> {
-    use crate::dsp::resample::Resampler;
-    use crate::dsp::thermal::ThermalBowControl;
+    use colophony::dsp::resample::Resampler;
+    use colophony::dsp::thermal::ThermalBowControl;
     let mut string = thermal_string(settings, nodes, width_m)?;
     let fs = settings.sample_rate_hz;
     let mut resampler =
@@ -294,16 +298,17 @@ pub fn thermal_string(
     settings: &RenderSettings,
     nodes: usize,
     width_m: f64,
-) -> Result<crate::dsp::thermal::ThermalString, RenderError> {
-    use crate::dsp::thermal::{HairParams, ThermalParams, ThermalString, ThermalStringSpec};
+) -> Result<colophony::dsp::thermal::ThermalString, RenderError> {
+    use colophony::dsp::thermal::{HairParams, ThermalParams, ThermalString, ThermalStringSpec};
     check(settings)?;
     let kind = settings.instrument;
     let index = kind
         .string_for_note(settings.note)
         .expect("check() accepted the note");
     let open = kind.strings()[index];
-    let f0 = crate::dsp::instrument::midi_to_hz(
-        settings.note as f64 + crate::dsp::instrument::reference_semitones(settings.reference_hz),
+    let f0 = colophony::dsp::instrument::midi_to_hz(
+        settings.note as f64
+            + colophony::dsp::instrument::reference_semitones(settings.reference_hz),
     );
     let spec = ThermalStringSpec {
         f0_hz: f0,

@@ -1,7 +1,7 @@
 //! Measures the intonation table (`colophony bench intonation --out FILE`): for every
 //! friction model, instrument, string and semitone above the open string, the cents by
 //! which the bowed note misses equal temperament at nominal bowing, folded into the
-//! table the engines tune by ([`crate::dsp::intonation`]).
+//! table the engines tune by ([`colophony::dsp::intonation`]).
 //!
 //! Each pass bows every entry twice through the engines the plugin plays
 //! ([`crate::playing_space::render_cell`]): with the plugin's defaults (0.1 m/s, 1 N,
@@ -16,10 +16,10 @@
 //! corrects what the previous one's correction changed (a string tuned lower slips a
 //! little differently).
 
-use crate::dsp::instrument::{InstrumentKind, MAX_STOP_SEMITONES, STRINGS};
-use crate::dsp::intonation::{model_index, IntonationTable};
-use crate::editor::regime::Regime;
 use crate::playing_space::{measure, Bowing, Cell, Model};
+use colophony::dsp::instrument::{InstrumentKind, MAX_STOP_SEMITONES, STRINGS};
+use colophony::dsp::intonation::{model_index, IntonationTable};
+use colophony::editor::regime::Regime;
 use rayon::prelude::*;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -235,7 +235,7 @@ pub fn fit(
 pub fn run(out: &Path, models: &[Model], rate_hz: f64, passes: usize) -> Result<String, String> {
     let (table, report) = fit(models, rate_hz, passes)?;
     // Models not fitted keep the shipped entries.
-    let mut merged = crate::dsp::intonation::shipped().clone();
+    let mut merged = colophony::dsp::intonation::shipped().clone();
     for &model in models {
         let row = model_index(model.name());
         for kind in InstrumentKind::ALL {

@@ -2,10 +2,10 @@
 //! `cargo run --release -- bench friction`). Ratios are measured in one run, side by side,
 //! because absolute times on a shared machine are noisy; each case takes the best of three.
 
-use crate::dsp::friction::FrictionModel;
-use crate::dsp::instrument::{BowControl, InstrumentKind};
-use crate::dsp::rubbed::RubbedPreset;
 use crate::render::{render, render_rubbed, RenderSettings};
+use colophony::dsp::friction::FrictionModel;
+use colophony::dsp::instrument::{BowControl, InstrumentKind};
+use colophony::dsp::rubbed::RubbedPreset;
 use std::time::Instant;
 
 const SECONDS: f64 = 10.0;
@@ -91,7 +91,7 @@ pub fn friction_table() -> Result<String, String> {
 /// bowed (paper B's Figure 6 bow), resampled to 48 kHz; and a double stop (C and G bowed).
 pub fn table1() -> Result<String, String> {
     use crate::admittance_fit::shipped_cello_bridge;
-    use crate::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
+    use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
     let paper = [
         (3, 4.3),
         (6, 9.2),
@@ -159,7 +159,7 @@ pub fn table1() -> Result<String, String> {
 /// not sound (sleeping strings), and the error skipping introduces against computing
 /// everything, from one run. Cello, defaults, 4 s at 48 kHz, blocks of 256.
 pub fn scenes() -> Result<String, String> {
-    use crate::dsp::instrument::Instrument;
+    use colophony::dsp::instrument::Instrument;
     let fs = 48_000.0;
     let seconds = 4.0;
     let s = |t: f64| (t * fs) as usize;
@@ -217,7 +217,7 @@ pub fn scenes() -> Result<String, String> {
     let bridge = crate::admittance_fit::shipped_cello_bridge().modes;
     let render = |score: &Score, skipping: bool, thermal: bool, frames: usize| -> (Vec<f64>, f64) {
         if thermal {
-            let inst = crate::dsp::thermal_instrument::ThermalInstrument::new(
+            let inst = colophony::dsp::thermal_instrument::ThermalInstrument::new(
                 InstrumentKind::Cello,
                 &bridge,
                 fs,
@@ -293,8 +293,8 @@ pub fn scenes() -> Result<String, String> {
     // Through the performer in the plugin's blocks: a silent block with nothing landing
     // is skipped whole (`Performer::skip`).
     let performer_run = |bowed: bool| {
-        let setup = crate::performer::Setup::default();
-        let mut p = crate::performer::Performer::new(InstrumentKind::Cello);
+        let setup = colophony::performer::Setup::default();
+        let mut p = colophony::performer::Performer::new(InstrumentKind::Cello);
         p.activate(&setup, fs).expect("the default setup activates");
         p.configure(&setup);
         if bowed {
@@ -374,7 +374,7 @@ trait SceneInstrument {
     fn update_sleep(&mut self);
     fn note_on(&mut self, note: u8);
     fn note_off(&mut self, note: u8);
-    fn tick(&mut self, bow: BowControl) -> crate::dsp::instrument::Frame;
+    fn tick(&mut self, bow: BowControl) -> colophony::dsp::instrument::Frame;
     /// The share of the strings (point bow) or polarisations (thermal) asleep now.
     fn asleep_share(&self) -> f64;
 }
@@ -395,7 +395,7 @@ macro_rules! scene_instrument {
                 <$t>::note_off(self, note)
             }
             #[inline]
-            fn tick(&mut self, bow: BowControl) -> crate::dsp::instrument::Frame {
+            fn tick(&mut self, bow: BowControl) -> colophony::dsp::instrument::Frame {
                 <$t>::tick(self, bow)
             }
             fn asleep_share(&self) -> f64 {
@@ -406,14 +406,14 @@ macro_rules! scene_instrument {
 }
 
 scene_instrument!(
-    crate::dsp::instrument::Instrument,
-    |i: &crate::dsp::instrument::Instrument| {
-        1.0 - i.awake_strings() as f64 / crate::dsp::instrument::STRINGS as f64
+    colophony::dsp::instrument::Instrument,
+    |i: &colophony::dsp::instrument::Instrument| {
+        1.0 - i.awake_strings() as f64 / colophony::dsp::instrument::STRINGS as f64
     }
 );
 scene_instrument!(
-    crate::dsp::thermal_instrument::ThermalInstrument,
-    |i: &crate::dsp::thermal_instrument::ThermalInstrument| {
-        i.asleep_polarisations() as f64 / (2 * crate::dsp::instrument::STRINGS) as f64
+    colophony::dsp::thermal_instrument::ThermalInstrument,
+    |i: &colophony::dsp::thermal_instrument::ThermalInstrument| {
+        i.asleep_polarisations() as f64 / (2 * colophony::dsp::instrument::STRINGS) as f64
     }
 );

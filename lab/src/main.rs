@@ -5,7 +5,7 @@ use colophony::dsp::friction::FrictionModel;
 use colophony::dsp::instrument::{BowControl, InstrumentKind};
 use colophony::dsp::rubbed::RubbedPreset;
 use colophony::quality::Quality;
-use colophony::render::{parse_note, render_with, write_wav, RenderSettings};
+use colophony_lab::render::{parse_note, render_with, write_wav, RenderSettings};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -241,7 +241,7 @@ fn main() -> ExitCode {
                     ));
                 }
                 return report(
-                    colophony::render::render_rubbed_with(
+                    colophony_lab::render::render_rubbed_with(
                         preset,
                         friction_or_default(friction),
                         seconds,
@@ -274,7 +274,7 @@ fn main() -> ExitCode {
             };
             let started = std::time::Instant::now();
             let rendered = if thermal {
-                colophony::render::render_thermal(&settings, nodes, bow_width)
+                colophony_lab::render::render_thermal(&settings, nodes, bow_width)
             } else {
                 render_with(&settings, |instrument| {
                     if let Some(t) = tolerance {
@@ -306,11 +306,11 @@ fn main() -> ExitCode {
         } => report(match name.as_str() {
             "bridge-fit" => match (input, fit) {
                 (Some(input), Some(fit)) => {
-                    colophony::admittance_fit::draw_figure(&input, &fit, &out)
+                    colophony_lab::admittance_fit::draw_figure(&input, &fit, &out)
                 }
                 _ => Err("bridge-fit needs --in DATA.csv and --fit FIT.json".into()),
             },
-            other => colophony::figures::draw(other, &out),
+            other => colophony_lab::figures::draw(other, &out),
         }),
         Command::Bench {
             what,
@@ -321,23 +321,23 @@ fn main() -> ExitCode {
             models,
             passes,
         } => report(match what.as_str() {
-            "friction" => colophony::bench::friction_table(),
-            "table1" => colophony::bench::table1(),
-            "scenes" => colophony::bench::scenes(),
+            "friction" => colophony_lab::bench::friction_table(),
+            "table1" => colophony_lab::bench::table1(),
+            "scenes" => colophony_lab::bench::scenes(),
             "precision" => match out {
-                Some(dir) => colophony::precision::run(&dir, quick),
+                Some(dir) => colophony_lab::precision::run(&dir, quick),
                 None => Err("bench precision needs --out DIR".into()),
             },
             "playing-space" => match out {
-                Some(dir) => colophony::playing_space::Plan::from_options(quick, &rates, step, &models)
-                    .and_then(|plan| colophony::playing_space::run(&dir, &plan)),
+                Some(dir) => colophony_lab::playing_space::Plan::from_options(quick, &rates, step, &models)
+                    .and_then(|plan| colophony_lab::playing_space::run(&dir, &plan)),
                 None => Err("bench playing-space needs --out DIR".into()),
             },
             "intonation" => match out {
-                Some(file) => colophony::playing_space::Plan::from_options(false, &rates, None, &models)
+                Some(file) => colophony_lab::playing_space::Plan::from_options(false, &rates, None, &models)
                     .and_then(|plan| {
                         let rate = if rates.is_empty() { 48_000.0 } else { plan.rates_hz[0] };
-                        colophony::intonation_fit::run(&file, &plan.models, rate, passes.unwrap_or(2))
+                        colophony_lab::intonation_fit::run(&file, &plan.models, rate, passes.unwrap_or(2))
                     }),
                 None => Err("bench intonation needs --out FILE (the shipped one: assets/intonation.csv)".into()),
             },
@@ -346,7 +346,7 @@ fn main() -> ExitCode {
             )),
         }),
         Command::FitBridge { input, modes, out } => {
-            report(colophony::admittance_fit::run_cli(&input, modes, &out))
+            report(colophony_lab::admittance_fit::run_cli(&input, modes, &out))
         }
     }
 }
@@ -368,7 +368,7 @@ fn render_midi(
     reference_pitch: f64,
 ) -> Result<String, String> {
     use colophony::performer::ThermalNodes;
-    colophony::render::check(&RenderSettings {
+    colophony_lab::render::check(&RenderSettings {
         instrument,
         note: instrument.note_range().0,
         bow,
@@ -404,14 +404,14 @@ fn render_midi(
     if let Some(q) = quality {
         setup.newton_tolerance_m_per_s = q.newton_tolerance_m_per_s();
     }
-    let how = colophony::midi_file::Performance {
+    let how = colophony_lab::midi_file::Performance {
         setup,
         bow,
         gain: nice_plug::util::db_to_gain(params.gain.value()) as f64,
         sample_rate_hz: sample_rate,
         block: 512,
     };
-    colophony::midi_file::render_file(midi, track, &how, out)
+    colophony_lab::midi_file::render_file(midi, track, &how, out)
 }
 
 /// `--friction` defaults to hyperbolic for strings; rubbed presets use elasto-plastic

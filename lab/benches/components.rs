@@ -4,7 +4,6 @@
 //! bridge junction solve (four strings, the shipped 14-mode cello bridge). Whole-model
 //! costs against precision are `colophony bench precision`.
 
-use colophony::admittance_fit::shipped_cello_bridge;
 use colophony::dsp::bridge::{solve_junction, ModalBridge};
 use colophony::dsp::friction::bristle::{BristleFriction, BristleLaw, BristleParams};
 use colophony::dsp::friction::stribeck::StribeckFriction;
@@ -16,6 +15,7 @@ use colophony::dsp::thermal::{
     HairParams, ThermalBowControl, ThermalParams, ThermalString, ThermalStringSpec,
 };
 use colophony::dsp::waveguide::WaveguideString;
+use colophony_lab::admittance_fit::shipped_cello_bridge;
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
 

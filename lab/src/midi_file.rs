@@ -1,6 +1,6 @@
 //! Standard MIDI files offline (`colophony render --midi FILE.mid`): the notes and pitch
 //! bends of a file, timed by its tempo map, played through the plugin's own performer
-//! ([`crate::performer`]) with the plugin's defaults, block by block as a host would call
+//! ([`colophony::performer`]) with the plugin's defaults, block by block as a host would call
 //! the plugin. Fed the same events at the same block size, the plugin gives the same bits
 //! (`tests/plugin_host.rs`).
 //!
@@ -8,9 +8,9 @@
 //! CC2 and channel pressure set the dynamics, CC1 the vibrato depth. The bow's own
 //! velocity, force and position are the constants given.
 
-use crate::dsp::filters::{flush_tiny, safety_limit};
-use crate::dsp::instrument::BowControl;
-use crate::performer::{Performer, Setup, Status};
+use colophony::dsp::filters::{flush_tiny, safety_limit};
+use colophony::dsp::instrument::BowControl;
+use colophony::performer::{Performer, Setup, Status};
 use midly::{MetaMessage, MidiMessage, Smf, Timing, TrackEventKind};
 
 /// What a MIDI file asks of the performer.

@@ -4,7 +4,7 @@
 
 use colophony::analysis::{cents, peak_frequency_hz, rms, slip_stats};
 use colophony::dsp::instrument::{midi_to_hz, BowControl, InstrumentKind};
-use colophony::render::{render, RenderSettings};
+use colophony_lab::render::{render, RenderSettings};
 
 const FS: f64 = 48_000.0;
 

@@ -7,7 +7,7 @@ use colophony::dsp::friction::{BowInput, FrictionContact, FrictionModel, LoadLin
 use colophony::dsp::instrument::{midi_to_hz, BowControl, Instrument, InstrumentKind};
 use colophony::dsp::modal::{ModalObject, ModeSpec};
 use colophony::dsp::rubbed::{RubbedPreset, RubbedScene};
-use colophony::render::{render, RenderSettings};
+use colophony_lab::render::{render, RenderSettings};
 
 const FS: f64 = 48_000.0;
 

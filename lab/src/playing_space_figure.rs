@@ -3,8 +3,8 @@
 //! grid at `2 F_min`, the middle and `F_max / 2`), each cell coloured by the regime the
 //! probe showed, with the bowed pitch in cents printed where the motion is Helmholtz.
 
-use crate::editor::regime::Regime;
 use crate::playing_space::{notes, Cell, Measured, Model, Plan};
+use colophony::editor::regime::Regime;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;

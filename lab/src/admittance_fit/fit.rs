@@ -6,7 +6,7 @@
 //! the largest magnitude in the file), so the fit minimises relative error, close to the
 //! dB and degree errors it reports, and troughs count as much as peaks.
 
-use super::bridge::{mode_response, nearest_psd, BridgeMode, BridgeModes, C64};
+use super::bridge::{mode_response, nearest_psd, Admittance, BridgeMode, BridgeModes, C64};
 use super::data::{entry_position, AdmittanceData};
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{

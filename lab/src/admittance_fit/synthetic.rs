@@ -3,7 +3,7 @@
 //! mode tables below are plausible values seeded from published signature-mode
 //! frequencies (docs/models.md §B, docs/parameters.md §2), not any instrument's data.
 
-use super::bridge::{BridgeMode, BridgeModes, C64};
+use super::bridge::{Admittance, BridgeMode, BridgeModes, C64};
 use super::data::{entry_position, AdmittanceData};
 use std::f64::consts::TAU;
 

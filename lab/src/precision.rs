@@ -36,15 +36,15 @@
 //! - waveform: RMS of the difference over the first [`WAVEFORM_PERIODS`] nominal periods
 //!   (the attack, before phase drift dominates) over the reference's RMS there, in dB.
 
-use crate::analysis::{cents, partial_amplitude, peak_frequency_hz, rms, slip_stats};
-use crate::dsp::friction::FrictionModel;
-use crate::dsp::instrument::{midi_to_hz, BowControl, InstrumentKind};
-use crate::dsp::resample::{resample_whole_from, Resampler};
-use crate::dsp::rubbed::RubbedPreset;
-use crate::dsp::waveguide::MAX_DISPERSION_STAGES;
 use crate::render::{
     render_rubbed_with, render_thermal, render_with, thermal_string, RenderSettings, Rendered,
 };
+use colophony::analysis::{cents, partial_amplitude, peak_frequency_hz, rms, slip_stats};
+use colophony::dsp::friction::FrictionModel;
+use colophony::dsp::instrument::{midi_to_hz, BowControl, InstrumentKind};
+use colophony::dsp::resample::{resample_whole_from, Resampler};
+use colophony::dsp::rubbed::RubbedPreset;
+use colophony::dsp::waveguide::MAX_DISPERSION_STAGES;
 use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Instant;
@@ -254,7 +254,7 @@ const REFERENCE_RATE_HZ: f64 = 768_000.0;
 const TOLERANCES_M_PER_S: [f64; 5] = [1e-2, 1e-4, 1e-6, 1e-8, 1e-10];
 const NODES: [usize; 8] = [3, 6, 10, 15, 20, 30, 40, 60];
 /// The waveguide's filter-order series: dispersion allpass sections at 48 kHz (the default
-/// is [`crate::dsp::waveguide::DEFAULT_DISPERSION_STAGES`], the references use
+/// is [`colophony::dsp::waveguide::DEFAULT_DISPERSION_STAGES`], the references use
 /// [`MAX_DISPERSION_STAGES`]).
 const DISPERSION_STAGES: [usize; 5] = [2, 4, 8, 16, 32];
 const REFERENCE_NODES: usize = 120;

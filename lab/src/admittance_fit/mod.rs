@@ -46,7 +46,9 @@
 //! `assets/bridges/README.md`.
 //!
 //! ```no_run
-//! use colophony::admittance_fit::{fit_bridge, load_bridge, read_admittance_csv, write_bridge};
+//! use colophony_lab::admittance_fit::{
+//!     fit_bridge, load_bridge, read_admittance_csv, write_bridge, Admittance,
+//! };
 //! use std::path::Path;
 //!
 //! let data = read_admittance_csv(Path::new("measured.csv"))?;
@@ -69,7 +71,8 @@ pub mod synthetic;
 
 pub use bridge::{
     bridge_json, load_bridge, load_bridge_ports, mode_response, parse_bridge, shipped_cello_bridge,
-    shipped_violin_bridge, symmetric_eigenvalues, write_bridge, BridgeMode, BridgeModes, C64,
+    shipped_violin_bridge, symmetric_eigenvalues, write_bridge, Admittance, BridgeMode,
+    BridgeModes, C64,
 };
 pub use data::{
     admittance_csv, entry_names, entry_position, parse_admittance_csv, read_admittance_csv,

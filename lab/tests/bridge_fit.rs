@@ -2,13 +2,13 @@
 //! bad input, the `colophony fit-bridge` command as a user runs it, and the shipped
 //! generic bridges.
 
-use colophony::admittance_fit::synthetic::{
+use colophony_lab::admittance_fit::synthetic::{
     add_relative_noise, log_grid_hz, random_modes, sample, GenericInstrument,
 };
-use colophony::admittance_fit::{
+use colophony_lab::admittance_fit::{
     admittance_csv, bridge_json, draw_figure, fit_bridge, fit_errors, load_bridge,
     load_bridge_ports, parse_admittance_csv, read_admittance_csv, symmetric_eigenvalues,
-    write_admittance_csv, write_bridge, AdmittanceData, BridgeModes,
+    write_admittance_csv, write_bridge, Admittance, AdmittanceData, BridgeModes,
 };
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -29,7 +29,8 @@ fn colophony(args: &[&str]) -> Output {
 }
 
 fn repo(path: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(path)
+    // The repository root, where the assets and docs are (this crate is lab/).
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(path)
 }
 
 /// Synthetic measurement: `count` random modes over 50-5000 Hz, 600 log-spaced points
@@ -102,7 +103,7 @@ fn assert_recovers(label: &str, truth: &BridgeModes, fit: &BridgeModes) {
 
 /// 1 % complex noise is 0.061 dB and 0.41 degrees RMS in each of magnitude and phase; a
 /// fit that reaches the noise floor stays within 1.5 times that.
-fn assert_fits_to_noise(fit_errors: &[colophony::admittance_fit::EntryError]) {
+fn assert_fits_to_noise(fit_errors: &[colophony_lab::admittance_fit::EntryError]) {
     for e in fit_errors {
         assert!(
             e.magnitude_db_rms < 0.09 && e.phase_deg_rms < 0.6,

@@ -1,56 +1,32 @@
-//! The modal bridge admittance: the mode type, its response, and the JSON file format
-//! (`{"modes": [{"freq_hz", "bandwidth_hz", "gain"}]}`) with a validating loader.
+//! Bridge data: the modal bridge's modes and their JSON file format
+//! (`{"modes": [{"freq_hz", "bandwidth_hz", "gain"}]}`) with a validating loader, and the
+//! shipped bridges the thermal instrument plays. The fitter that writes such files and
+//! the admittance responses it compares are in the tools crate (`colophony-lab`,
+//! `admittance_fit`).
+//!
+//! ```
+//! use colophony::dsp::bridge_data::{parse_bridge, shipped_cello_bridge};
+//! let cello = shipped_cello_bridge();
+//! assert!(!cello.modes.is_empty());
+//! let (one, ports) = parse_bridge(
+//!     r#"{"modes": [{"freq_hz": 300, "bandwidth_hz": 20, "gain": [[0.5]]}]}"#,
+//! )
+//! .unwrap();
+//! assert_eq!((one.modes.len(), ports), (1, 1));
+//! ```
 
-use nalgebra::Complex;
 use serde::{Deserialize, Serialize};
-use std::f64::consts::TAU;
 use std::path::Path;
-
-/// A complex admittance value (s/kg).
-pub type C64 = Complex<f64>;
 
 /// One mode of the bridge's driving-point admittance,
 /// `gain * s / (s^2 + 2 pi bandwidth_hz s + (2 pi freq_hz)^2)`: the DSP core's type, which
 /// the physical bridge ([`crate::dsp::bridge::ModalBridge`]) runs.
-pub use crate::dsp::bridge::BridgeMode;
+pub use super::bridge::BridgeMode;
 
 /// A bridge: its modes, as loaded by [`load_bridge`].
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct BridgeModes {
     pub modes: Vec<BridgeMode>,
-}
-
-/// The response of one mode per unit gain at `freq_hz`:
-/// `s / (s^2 + 2 pi b s + (2 pi f)^2)` at `s = j 2 pi freq_hz`, in seconds (times a gain in
-/// 1/kg gives s/kg).
-pub fn mode_response(mode_freq_hz: f64, bandwidth_hz: f64, freq_hz: f64) -> C64 {
-    let w = TAU * freq_hz;
-    let w0 = TAU * mode_freq_hz;
-    let beta = TAU * bandwidth_hz;
-    C64::new(0.0, w) / C64::new(w0 * w0 - w * w, w * beta)
-}
-
-impl BridgeMode {
-    /// `s / (s^2 + 2 pi b s + (2 pi f)^2)` at `s = j 2 pi freq_hz`.
-    pub fn response(&self, freq_hz: f64) -> C64 {
-        mode_response(self.freq_hz, self.bandwidth_hz, freq_hz)
-    }
-}
-
-impl BridgeModes {
-    /// The 2x2 admittance matrix Y(j 2 pi freq_hz) in s/kg, (horizontal, vertical).
-    pub fn admittance_s_per_kg(&self, freq_hz: f64) -> [[C64; 2]; 2] {
-        let mut y = [[C64::new(0.0, 0.0); 2]; 2];
-        for mode in &self.modes {
-            let h = mode.response(freq_hz);
-            for (row, gain_row) in y.iter_mut().zip(&mode.gain) {
-                for (yij, gij) in row.iter_mut().zip(gain_row) {
-                    *yij += h * *gij;
-                }
-            }
-        }
-        y
-    }
 }
 
 /// Eigenvalues (ascending) of the symmetric 2x2 matrix `[[a, b], [b, c]]`.
@@ -62,7 +38,7 @@ pub fn symmetric_eigenvalues(a: f64, b: f64, c: f64) -> [f64; 2] {
 
 /// The nearest (Frobenius) positive semidefinite matrix to `[[a, b], [b, c]]`: negative
 /// eigenvalues set to zero.
-pub(crate) fn nearest_psd(a: f64, b: f64, c: f64) -> [[f64; 2]; 2] {
+pub fn nearest_psd(a: f64, b: f64, c: f64) -> [[f64; 2]; 2] {
     let [lo, hi] = symmetric_eigenvalues(a, b, c);
     if lo >= 0.0 {
         return [[a, b], [b, c]];
@@ -209,7 +185,7 @@ pub fn write_bridge(path: &Path, bridge: &BridgeModes, ports: usize) -> Result<(
 }
 
 /// Writes `bytes` to a temporary file beside `path`, then renames it to `path`.
-pub(crate) fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), String> {
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), String> {
     let name = path
         .file_name()
         .ok_or_else(|| format!("{}: not a file path", path.display()))?;

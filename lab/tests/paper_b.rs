@@ -272,7 +272,7 @@ fn one_slip_per_period_inside_the_schelleng_window() {
 fn the_thermal_bow_renders_at_the_host_rate_in_tune_and_bounded() {
     use colophony::analysis::rms;
     use colophony::dsp::instrument::{BowControl, InstrumentKind};
-    use colophony::render::{render_thermal, RenderSettings};
+    use colophony_lab::render::{render_thermal, RenderSettings};
     // Forces inside each string's Schelleng window at 0.15 m/s and beta 0.1.
     for (kind, note, force_n) in [
         (InstrumentKind::Cello, 36, 3.0),
@@ -308,9 +308,9 @@ fn the_thermal_bow_renders_at_the_host_rate_in_tune_and_bounded() {
 
 #[test]
 fn bowing_one_string_makes_the_open_strings_ring_through_the_bridge() {
-    use colophony::admittance_fit::shipped_cello_bridge;
     use colophony::dsp::instrument::{BowControl, InstrumentKind};
     use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
+    use colophony_lab::admittance_fit::shipped_cello_bridge;
     let run = |bridge: &[colophony::dsp::bridge::BridgeMode]| {
         let settings = ThermalSettings {
             nodes: 6,
@@ -348,10 +348,10 @@ fn bowing_one_string_makes_the_open_strings_ring_through_the_bridge() {
 
 #[test]
 fn the_thermal_instrument_rings_in_tune_and_flattens_with_bow_force() {
-    use colophony::admittance_fit::shipped_cello_bridge;
     use colophony::analysis::{cents, peak_frequency_hz, rms};
     use colophony::dsp::instrument::{midi_to_hz, BowControl, InstrumentKind};
     use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
+    use colophony_lab::admittance_fit::shipped_cello_bridge;
     let bridge = shipped_cello_bridge().modes;
     let mut g_string = Vec::new();
     for (note, force_n) in [
@@ -475,7 +475,7 @@ fn largest_difference_db(a: &[f64], b: &[f64], peak: f64) -> f64 {
 
 #[test]
 fn quiet_polarisations_sleep_while_others_ring_and_waking_matches_never_sleeping() {
-    use colophony::admittance_fit::shipped_cello_bridge;
+    use colophony_lab::admittance_fit::shipped_cello_bridge;
     // On a rigid bridge nothing reaches the open strings: while C is bowed, their six
     // polarisations sleep, and the output is the same bits as computing them.
     let score = [(0, true, 36u8)];
@@ -575,9 +575,9 @@ fn the_lone_strings_fundamental_decays_at_its_q1_terminations_included() {
 /// for the whole bow plays with the nodes that fit, at the same total force.
 #[test]
 fn every_note_speaks_with_every_bow_setting_at_every_host_rate() {
-    use colophony::admittance_fit::{shipped_cello_bridge, shipped_violin_bridge};
     use colophony::dsp::instrument::{BowControl, InstrumentKind};
     use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
+    use colophony_lab::admittance_fit::{shipped_cello_bridge, shipped_violin_bridge};
     let bow = BowControl {
         velocity_m_per_s: 0.1,
         force_n: 0.5,

@@ -342,7 +342,7 @@ fn a_midi_file_renders_its_notes_at_their_times() {
         let c = cents(f, midi_to_hz(note));
         println!("note {note} at {from} s: {c:+.1} cents");
         // 15 cents: the bowed pitch within a quarter second of a new note, before the
-        // attack has settled (the tuning itself is tested in tests/playing_space.rs).
+        // attack has settled (the tuning itself is tested in lab/tests/playing_space.rs).
         assert!(c.abs() < 15.0, "note {note}: {c:+.1} cents");
     }
 }

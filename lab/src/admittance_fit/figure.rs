@@ -1,7 +1,7 @@
 //! The bridge-fit figure, like paper B's Figure 5: magnitude (dB re 1 s/kg) and phase
 //! (degrees) of data (dots) and model (line) for each entry, on a log frequency axis.
 
-use super::bridge::{load_bridge_ports, BridgeModes};
+use super::bridge::{load_bridge_ports, Admittance, BridgeModes};
 use super::data::{entry_position, read_admittance_csv, AdmittanceData};
 use super::fit::fit_errors;
 use plotters::prelude::*;

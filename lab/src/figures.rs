@@ -8,11 +8,11 @@
 //! - `serafin-modal`: paper A's modal scenario (the authors' script): a 50 g bow pushed
 //!   into two 140/280 Hz modes: velocities, friction force, bristle state.
 
-use crate::dsp::friction::bristle::BristleParams;
-use crate::dsp::friction::FrictionModel;
-use crate::dsp::instrument::{BowControl, InstrumentKind};
-use crate::dsp::rubbed::{RubbedPreset, RubbedScene};
 use crate::render::{render, RenderSettings};
+use colophony::dsp::friction::bristle::BristleParams;
+use colophony::dsp::friction::FrictionModel;
+use colophony::dsp::instrument::{BowControl, InstrumentKind};
+use colophony::dsp::rubbed::{RubbedPreset, RubbedScene};
 use plotters::prelude::*;
 use plotters::style::{register_font, FontStyle};
 use std::path::Path;
@@ -227,7 +227,7 @@ pub fn serafin_modal(out: &Path) -> Result<String, String> {
 /// two periods from [`SETTLE_S`] on.
 pub fn maestre_fig6(out: &Path) -> Result<String, String> {
     const SETTLE_S: f64 = 1.5;
-    use crate::dsp::thermal::{
+    use colophony::dsp::thermal::{
         HairParams, ThermalBowControl, ThermalParams, ThermalString, ThermalStringSpec,
     };
     fonts();
@@ -246,7 +246,7 @@ pub fn maestre_fig6(out: &Path) -> Result<String, String> {
     };
     let fs = s.internal_rate_hz();
     // The bow starts in a double-slip regime and settles into Helmholtz motion after about
-    // a second (tests/paper_b.rs): two periods of the steady motion from 1.5 s.
+    // a second (lab/tests/paper_b.rs): two periods of the steady motion from 1.5 s.
     for _ in 0..(SETTLE_S * fs) as usize {
         s.tick(bow);
     }
@@ -456,7 +456,7 @@ pub fn maestre_fig6(out: &Path) -> Result<String, String> {
 }
 
 /// One value per node, as f64.
-fn widen(x: &[crate::dsp::thermal::NodeReal]) -> Vec<f64> {
+fn widen(x: &[colophony::dsp::thermal::NodeReal]) -> Vec<f64> {
     x.iter().map(|v| f64::from(*v)).collect()
 }
 
@@ -483,10 +483,12 @@ struct NodeMovie {
 /// over 1 cm) with `hair`, settles for 1.5 s, then records two periods of each per-node
 /// quantity `take` returns (one value per node), and the total normal force.
 fn fig6_movie(
-    hair: crate::dsp::thermal::HairParams,
-    takes: &[&dyn Fn(&crate::dsp::thermal::ThermalString) -> Vec<f64>],
+    hair: colophony::dsp::thermal::HairParams,
+    takes: &[&dyn Fn(&colophony::dsp::thermal::ThermalString) -> Vec<f64>],
 ) -> Result<(Vec<NodeMovie>, Vec<(f64, f64)>), String> {
-    use crate::dsp::thermal::{ThermalBowControl, ThermalParams, ThermalString, ThermalStringSpec};
+    use colophony::dsp::thermal::{
+        ThermalBowControl, ThermalParams, ThermalString, ThermalStringSpec,
+    };
     let mut s = ThermalString::new(
         ThermalStringSpec::cello_c(),
         60,
@@ -583,7 +585,7 @@ fn node_map(
 /// Paper B, Figure 7: the friction force and the hair's relative (sliding) velocity over
 /// the bow's width and two periods of the Figure 6 motion, seen from the nut side.
 pub fn maestre_fig7(out: &Path) -> Result<String, String> {
-    use crate::dsp::thermal::{HairParams, ThermalString};
+    use colophony::dsp::thermal::{HairParams, ThermalString};
     fonts();
     let force = |s: &ThermalString| widen(s.node_forces());
     let sliding = |s: &ThermalString| widen(s.node_sliding_velocities());
@@ -608,7 +610,7 @@ pub fn maestre_fig7(out: &Path) -> Result<String, String> {
 /// Figure 6 motion, with the default hair and with ten times its vertical damping, and
 /// the total normal force of both.
 pub fn maestre_fig8(out: &Path) -> Result<String, String> {
-    use crate::dsp::thermal::{HairParams, ThermalString};
+    use colophony::dsp::thermal::{HairParams, ThermalString};
     fonts();
     let normal = |s: &ThermalString| widen(s.node_normal_forces());
     let default_hair = HairParams::default();

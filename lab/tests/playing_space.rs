@@ -1,10 +1,10 @@
 //! The playing-space map's coarse subset (issue 16, item 6): every model, every instrument,
 //! every fifth semitone from the lowest open string to two octaves above the highest, at
-//! 44.1 and 96 kHz, through the engines the plugin plays (`colophony::playing_space`).
+//! 44.1 and 96 kHz, through the engines the plugin plays (`colophony_lab::playing_space`).
 
 use colophony::dsp::instrument::InstrumentKind;
 use colophony::editor::regime::Regime;
-use colophony::playing_space::{
+use colophony_lab::playing_space::{
     measure, notes, regime_name, run_plan, Bowing, Cell, Measured, Model, Plan,
 };
 use rayon::prelude::*;
