@@ -24,9 +24,10 @@
 //! assert!(peak > 0.0);
 //! ```
 
+pub mod direct;
 pub mod stroke;
 
-use crate::dsp::bridge_data;
+use crate::dsp::bridge_data::{self, BridgeModes};
 use crate::dsp::engine::Engine;
 use crate::dsp::friction::FrictionModel;
 use crate::dsp::instrument::{
@@ -37,6 +38,7 @@ use crate::dsp::rubbed::{RubbedInstrument, RubbedPreset};
 use crate::dsp::thermal::ThermalString;
 use crate::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
 use crate::quality::{self, Quality};
+use direct::DirectBow;
 use stroke::{Stroke, StrokeMode};
 
 /// The pitch-bend wheel's position, -1..=1, for a MIDI pitch-bend value `value` (0 =
@@ -180,6 +182,10 @@ pub struct Performer {
     setup: Setup,
     gesture: Gesture,
     stroke: Stroke,
+    /// The bow controls MIDI controllers hold (CC21-23).
+    direct: DirectBow,
+    /// Bridges the player chose for the thermal instrument of each kind.
+    user_bridges: [Option<BridgeModes>; 3],
     /// Whether [`Performer::configure`] has run since the engines were built.
     configured: bool,
     /// The bow of the last sample, as played (after the stroke and the dynamics).
@@ -261,8 +267,20 @@ impl Performer {
             },
             gesture: Gesture::new(48_000.0),
             stroke: Stroke::new(48_000.0),
+            direct: DirectBow::new(48_000.0),
+            user_bridges: [None, None, None],
             configured: false,
             bow_now: BowControl::default(),
+        }
+    }
+
+    /// Plays paper B's thermal instrument of `kind` on `bridge` (a fitted or measured
+    /// modal bridge, [`crate::dsp::bridge_data`]) instead of the shipped one; `None` goes
+    /// back to the shipped bridge. Takes effect at the next [`Performer::activate`] (it
+    /// builds the engines: not for the audio thread).
+    pub fn set_user_bridge(&mut self, kind: InstrumentKind, bridge: Option<BridgeModes>) {
+        if let Some(k) = InstrumentKind::ALL.iter().position(|&x| x == kind) {
+            self.user_bridges[k] = bridge;
         }
     }
 
@@ -273,12 +291,18 @@ impl Performer {
         self.instrument = Instrument::new(setup.instrument, fs);
         let settings = self.thermal_settings();
         self.thermal.clear();
-        for kind in InstrumentKind::ALL {
-            let bridge = match kind {
-                InstrumentKind::Cello => bridge_data::shipped_cello_bridge(),
+        for (k, kind) in InstrumentKind::ALL.into_iter().enumerate() {
+            let shipped;
+            let bridge = match (&self.user_bridges[k], kind) {
+                (Some(user), _) => user,
+                (None, InstrumentKind::Cello) => {
+                    shipped = bridge_data::shipped_cello_bridge();
+                    &shipped
+                }
                 // The viola borrows the violin's generic bridge (no viola data shipped).
-                InstrumentKind::Violin | InstrumentKind::Viola => {
-                    bridge_data::shipped_violin_bridge()
+                (None, InstrumentKind::Violin | InstrumentKind::Viola) => {
+                    shipped = bridge_data::shipped_violin_bridge();
+                    &shipped
                 }
             };
             let engine = ThermalInstrument::new(kind, &bridge.modes, fs, settings)
@@ -292,6 +316,7 @@ impl Performer {
         self.tail = None;
         self.gesture = Gesture::new(fs);
         self.stroke = Stroke::new(fs);
+        self.direct = DirectBow::new(fs);
         self.configured = false;
         Ok(())
     }
@@ -454,12 +479,16 @@ impl Performer {
     /// A MIDI controller at `value` (0..=1, as nice-plug delivers it): CC1 (mod wheel)
     /// sets the vibrato depth, CC11 (expression) and CC2 (breath) the dynamics; CC101 and
     /// CC100 select a registered parameter and CC6 / CC38 set it (RPN 0: the pitch-bend
-    /// range, semitones and cents); others are ignored.
+    /// range, semitones and cents); CC21, CC22 and CC23 the bow's speed, force and position
+    /// ([`direct`]); others are ignored.
     pub fn set_controller(&mut self, cc: u8, value: f32) {
         if !value.is_finite() {
             return;
         }
         let v = (value as f64).clamp(0.0, 1.0);
+        if self.direct.set_controller(cc, v) {
+            return;
+        }
         // The 7-bit value of a data byte.
         let byte = (v * 127.0).round() as u8;
         match cc {
@@ -498,14 +527,16 @@ impl Performer {
             * (2.0 * std::f64::consts::PI * self.gesture.phase).sin()
     }
 
-    /// Advances the gesture one sample and returns the bow it shapes: the stroke (its
-    /// direction and attack), then the dynamics. With the mod wheel and the dynamics at
+    /// Advances the gesture one sample and returns the bow it shapes: the direct bow
+    /// controllers in place of the parameters they hold, the stroke (its direction and
+    /// attack), then the dynamics. With the mod wheel and the dynamics at
     /// rest and a down stroke under way it costs a few comparisons.
     #[inline]
     fn shape(&mut self, bow: BowControl) -> BowControl {
         if self.gesture.vibrato_cents > 0.0 || self.gesture.vibrato_now != 0.0 {
             self.advance_vibrato();
         }
+        let bow = self.direct.apply(bow);
         let (speed, landing) = if self.stroke.is_settled() {
             (self.stroke.direction(), 1.0)
         } else {
@@ -575,7 +606,8 @@ impl Performer {
         let at_rest = g.vibrato_cents == 0.0
             && g.vibrato_now == 0.0
             && g.scale == g.target
-            && self.stroke.is_settled();
+            && self.stroke.is_settled()
+            && self.direct.is_settled();
         let steps = if at_rest { n.min(1) } else { n };
         for _ in 0..steps {
             self.bow_now = self.shape(bow);
@@ -935,6 +967,30 @@ mod tests {
             .filter(|(a, b)| a.to_bits() != b.to_bits())
             .count();
         assert_eq!(differing, 0);
+    }
+
+    #[test]
+    fn direct_bow_controllers_move_the_played_bow_until_the_parameter_moves() {
+        let mut p = cello();
+        p.note_on(50, 0.5);
+        let bow = BowControl::default();
+        for _ in 0..(0.2 * FS) as usize {
+            p.tick(bow);
+        }
+        // CC22 at 100: the force knob's curve, 10 (100/127)^4 = 3.8 N.
+        p.set_controller(direct::CC_BOW_FORCE, 100.0 / 127.0);
+        for _ in 0..(0.2 * FS) as usize {
+            p.tick(bow);
+        }
+        let want = direct::force_at((100.0f32 / 127.0) as f64);
+        assert!((p.bow().force_n - want).abs() < 1e-9, "{:?}", p.bow());
+        // The parameter moves (automation): the force is the parameter's again.
+        let automated = BowControl {
+            force_n: 2.0,
+            ..bow
+        };
+        p.tick(automated);
+        assert_eq!(p.bow().force_n, 2.0);
     }
 
     #[test]

@@ -83,6 +83,11 @@ enum Command {
         /// With --midi: only this track (0 = the first in the file); default all.
         #[arg(long)]
         track: Option<usize>,
+        /// With --friction thermal: play the instrument on this bridge (JSON, as
+        /// `colophony fit-bridge` writes) instead of the shipped one, through the
+        /// plugin's thermal instrument (four strings, modal bridge, resampler).
+        #[arg(long)]
+        bridge: Option<PathBuf>,
     },
     /// Draw a figure as PNG: serafin-fig7, serafin-modal, bridge-fit.
     Figure {
@@ -203,16 +208,40 @@ fn main() -> ExitCode {
             preset,
             midi,
             track,
+            bridge,
         } => {
-            if let Some(midi) = midi {
-                return report(render_midi(
-                    &midi, track, &out, instrument, friction, quality, nodes, bow_width,
-                    BowControl {
-                        velocity_m_per_s: bow_velocity,
-                        force_n: bow_force,
-                        position_beta: bow_position,
-                    },
-                    sample_rate, reference_pitch,
+            let bridge = match bridge {
+                None => None,
+                Some(_) if friction != FrictionArg::Thermal => {
+                    return report(Err(
+                        "--bridge is for the thermal model's bridge: add --friction thermal"
+                            .into(),
+                    ))
+                }
+                Some(path) => match colophony::dsp::bridge_data::load_bridge(&path) {
+                    Ok(b) => Some(b),
+                    Err(e) => return report(Err(e)),
+                },
+            };
+            let bow = BowControl {
+                velocity_m_per_s: bow_velocity,
+                force_n: bow_force,
+                position_beta: bow_position,
+            };
+            let source = match (midi, bridge.is_some()) {
+                (Some(midi), _) => Some(Score::File(midi, track)),
+                // A note on a chosen bridge plays through the plugin's thermal instrument.
+                (None, true) => Some(Score::Note {
+                    note,
+                    seconds,
+                    release,
+                }),
+                (None, false) => None,
+            };
+            if let Some(source) = source {
+                return report(render_performed(
+                    source, &out, instrument, friction, quality, nodes, bow_width, bow,
+                    sample_rate, reference_pitch, bridge,
                 ));
             }
             let tolerance = quality.map(|q| q.newton_tolerance_m_per_s());
@@ -354,9 +383,22 @@ fn main() -> ExitCode {
 /// `colophony render --midi`: the plugin's default setup with the command line's
 /// instrument, law, quality, reference pitch and bow.
 #[allow(clippy::too_many_arguments)]
-fn render_midi(
-    midi: &std::path::Path,
-    track: Option<usize>,
+/// What [`render_performed`] plays.
+enum Score {
+    /// A MIDI file, all tracks or one.
+    File(PathBuf, Option<usize>),
+    /// One note held for `seconds` (lifted at `release` if given).
+    Note {
+        note: u8,
+        seconds: f64,
+        release: Option<f64>,
+    },
+}
+
+/// Plays a MIDI file or one note through the plugin's performer and writes the WAV.
+#[allow(clippy::too_many_arguments)]
+fn render_performed(
+    score: Score,
     out: &std::path::Path,
     instrument: InstrumentKind,
     friction: FrictionArg,
@@ -366,6 +408,7 @@ fn render_midi(
     bow: BowControl,
     sample_rate: f64,
     reference_pitch: f64,
+    bridge: Option<colophony::dsp::bridge_data::BridgeModes>,
 ) -> Result<String, String> {
     use colophony::performer::ThermalNodes;
     colophony_lab::render::check(&RenderSettings {
@@ -410,8 +453,48 @@ fn render_midi(
         gain: nice_plug::util::db_to_gain(params.gain.value()) as f64,
         sample_rate_hz: sample_rate,
         block: 512,
+        bridge,
     };
-    colophony_lab::midi_file::render_file(midi, track, &how, out)
+    match score {
+        Score::File(midi, track) => colophony_lab::midi_file::render_file(&midi, track, &how, out),
+        Score::Note {
+            note,
+            seconds,
+            release,
+        } => {
+            use colophony_lab::midi_file::{render_events, MidiEvent, Timed};
+            if !(seconds.is_finite() && seconds > 0.0 && seconds <= 3600.0) {
+                return Err(format!("--seconds must be within 0..=3600, got {seconds}"));
+            }
+            if instrument.string_for_note(note).is_none() {
+                let (lo, hi) = instrument.note_range();
+                return Err(format!(
+                    "the {} plays MIDI notes {lo}..={hi}; {note} is outside",
+                    instrument.name()
+                ));
+            }
+            let at = |t: f64| (t * sample_rate).round() as u64;
+            let lift = release.unwrap_or(seconds).clamp(0.0, seconds);
+            let events = [
+                Timed {
+                    sample: 0,
+                    event: MidiEvent::NoteOn(note, 100),
+                },
+                Timed {
+                    sample: at(lift),
+                    event: MidiEvent::NoteOff(note),
+                },
+            ];
+            let frames = at(seconds) as usize;
+            let (written, peak) = render_events(&events, &how, Some(frames), out)?;
+            Ok(format!(
+                "wrote {} ({written:.1} s, peak {:.1} dBFS, the plugin's thermal {} on the given bridge)",
+                out.display(),
+                20.0 * (peak.max(1e-30) as f64).log10(),
+                instrument.name()
+            ))
+        }
+    }
 }
 
 /// `--friction` defaults to hyperbolic for strings; rubbed presets use elasto-plastic

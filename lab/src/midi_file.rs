@@ -134,7 +134,7 @@ pub fn read_events(
 }
 
 /// How a file is played.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Performance {
     pub setup: Setup,
     pub bow: BowControl,
@@ -143,6 +143,9 @@ pub struct Performance {
     pub sample_rate_hz: f64,
     /// Samples per block (the performer's setup and sleep are renewed each block).
     pub block: usize,
+    /// A bridge for the thermal model of `setup.instrument` instead of the shipped one
+    /// (`render --bridge`).
+    pub bridge: Option<colophony::dsp::bridge_data::BridgeModes>,
 }
 
 /// Plays `events` and returns the output the plugin would give on each channel, through
@@ -156,6 +159,7 @@ pub fn perform(
 ) -> Result<Vec<f32>, String> {
     let block = how.block.max(1);
     let mut performer = Performer::new(how.setup.instrument);
+    performer.set_user_bridge(how.setup.instrument, how.bridge.clone());
     performer.activate(&how.setup, how.sample_rate_hz)?;
     let last = events.last().map_or(0, |e| e.sample);
     let hard_end = last + (MAX_TAIL_S * how.sample_rate_hz) as u64;
@@ -219,22 +223,43 @@ pub fn render_file(
     let bytes = std::fs::read(midi).map_err(|e| format!("cannot read {}: {e}", midi.display()))?;
     let events = read_events(&bytes, track, how.sample_rate_hz)
         .map_err(|e| format!("{}: {e}", midi.display()))?;
+    let notes = events
+        .iter()
+        .filter(|e| matches!(e.event, MidiEvent::NoteOn(..)))
+        .count();
+    let (seconds, _) = render_events(&events, how, None, out)?;
+    Ok(format!(
+        "wrote {} ({notes} notes, {seconds:.1} s, from {})",
+        out.display(),
+        midi.display()
+    ))
+}
+
+/// Plays `events` as [`perform`] with a progress bar, cut to `frames` samples if given,
+/// and writes the WAV to `out` (no partial file on error). Returns the seconds written and
+/// the peak sample.
+pub fn render_events(
+    events: &[Timed],
+    how: &Performance,
+    frames: Option<usize>,
+    out: &std::path::Path,
+) -> Result<(f64, f32), String> {
     let bar = indicatif::ProgressBar::new(events.last().map_or(0, |e| e.sample));
     if let Ok(style) = indicatif::ProgressStyle::with_template(
         "{elapsed_precise} [{bar:40}] {percent} % of the file, eta {eta}",
     ) {
         bar.set_style(style);
     }
-    let audio = perform(&events, how, |done, total| {
+    let mut audio = perform(events, how, |done, total| {
         bar.set_length(total);
         bar.set_position(done);
     })?;
     bar.finish_and_clear();
+    if let Some(n) = frames {
+        audio.truncate(n);
+    }
     let seconds = audio.len() as f64 / how.sample_rate_hz;
-    let notes = events
-        .iter()
-        .filter(|e| matches!(e.event, MidiEvent::NoteOn(..)))
-        .count();
+    let peak = audio.iter().fold(0.0f32, |m, x| m.max(x.abs()));
     let rendered = crate::render::Rendered {
         sample_rate_hz: how.sample_rate_hz,
         audio: audio.into_iter().map(f64::from).collect(),
@@ -243,11 +268,7 @@ pub fn render_file(
         newton: Default::default(),
     };
     crate::render::write_wav(out, &rendered, false).map_err(|e| e.to_string())?;
-    Ok(format!(
-        "wrote {} ({notes} notes, {seconds:.1} s, from {})",
-        out.display(),
-        midi.display()
-    ))
+    Ok((seconds, peak))
 }
 
 #[cfg(test)]

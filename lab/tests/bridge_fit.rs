@@ -14,7 +14,13 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("bridge_fit");
+    scratch_in("bridge_fit", name)
+}
+
+/// A scratch path in a directory of its own (a test that checks for leftover temporary
+/// files must not see another test's write in progress).
+fn scratch_in(dir: &str, name: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(dir);
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join(name);
     let _ = std::fs::remove_file(&path);
@@ -270,9 +276,9 @@ fn no_leftovers(dir: &Path) {
 fn cli_fit_bridge_writes_a_loadable_passive_bridge_and_reports_errors() {
     for ports in [1, 2] {
         let (truth, data) = synthetic(30 + ports as u64, 5, ports);
-        let input = scratch(&format!("cli-{ports}.csv"));
+        let input = scratch_in("bridge_fit_cli", &format!("cli-{ports}.csv"));
         std::fs::write(&input, admittance_csv(&data)).unwrap();
-        let out = scratch(&format!("cli-{ports}.json"));
+        let out = scratch_in("bridge_fit_cli", &format!("cli-{ports}.json"));
         let run = colophony(&[
             "fit-bridge",
             input.to_str().unwrap(),
@@ -333,9 +339,9 @@ fn cli_fit_bridge_refuses_bad_input_and_writes_nothing() {
     cases.push(("too many modes".into(), admittance_csv(&few), "3"));
     cases.push(("zero modes".into(), admittance_csv(&data), "0"));
     for (i, (name, text, modes)) in cases.iter().enumerate() {
-        let input = scratch(&format!("bad-{i}.csv"));
+        let input = scratch_in("bridge_fit_refused", &format!("bad-{i}.csv"));
         std::fs::write(&input, text).unwrap();
-        let out = scratch(&format!("bad-{i}.json"));
+        let out = scratch_in("bridge_fit_refused", &format!("bad-{i}.json"));
         let run = colophony(&[
             "fit-bridge",
             input.to_str().unwrap(),
@@ -350,8 +356,8 @@ fn cli_fit_bridge_refuses_bad_input_and_writes_nothing() {
         assert_eq!(stderr.trim_end().lines().count(), 1, "{name}: `{stderr}`");
         assert!(!out.exists(), "{name}: wrote {}", out.display());
     }
-    let missing = scratch("missing.csv");
-    let out = scratch("missing.json");
+    let missing = scratch_in("bridge_fit_refused", "missing.csv");
+    let out = scratch_in("bridge_fit_refused", "missing.json");
     let run = colophony(&[
         "fit-bridge",
         missing.to_str().unwrap(),

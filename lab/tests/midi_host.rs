@@ -45,6 +45,7 @@ fn a_midi_file_rendered_offline_gives_the_plugins_bits() {
         gain: nice_plug::util::db_to_gain(params.gain.value()) as f64,
         sample_rate_hz: FS,
         block: BLOCK,
+        bridge: None,
     };
     let offline = perform(&events, &how, |_, _| {}).unwrap();
     let mut score = Score::new();

@@ -370,3 +370,139 @@ fn broken_or_missing_midi_files_fail_in_one_line_with_no_file() {
     assert!(String::from_utf8_lossy(&run.stderr).contains("track 0 has no notes"));
     assert!(!out.exists());
 }
+
+/// The samples of the renderer's 16-bit WAV, full scale 1.
+fn wav_samples(path: &std::path::Path) -> Vec<f32> {
+    let mut reader = hound::WavReader::open(path).unwrap();
+    reader
+        .samples::<i16>()
+        .map(|s| s.unwrap() as f32 / 32767.0)
+        .collect()
+}
+
+#[test]
+fn a_chosen_bridge_plays_through_the_plugins_thermal_instrument() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+    let bridge = |name: &str| root.join("assets/bridges").join(name);
+    let render = |file: &std::path::Path, out: &std::path::Path| {
+        colophony(&[
+            "render",
+            "--friction",
+            "thermal",
+            "--instrument",
+            "cello",
+            "--note",
+            "D3",
+            "--seconds",
+            "0.5",
+            "--bridge",
+            file.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ])
+    };
+    // The shipped cello bridge's own file gives the bits the plugin's performer gives on
+    // its shipped bridge (the same chain, the same data).
+    let shipped = scratch("bridge-shipped.wav");
+    let run = render(&bridge("cello-generic.json"), &shipped);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    use colophony_lab::midi_file::{perform, MidiEvent, Performance, Timed};
+    // The renderer's defaults (in f64: the plugin's parameters are f32).
+    let bow = colophony::dsp::instrument::BowControl {
+        velocity_m_per_s: 0.1,
+        force_n: 1.0,
+        position_beta: 0.1,
+    };
+    let mut setup = colophony::params::ColophonyParams::default().setup();
+    setup.point_law = None;
+    setup.bow_position_beta = bow.position_beta;
+    setup.bow_width_m = 0.01;
+    let how = Performance {
+        setup,
+        bow,
+        gain: 1.0,
+        sample_rate_hz: 48_000.0,
+        block: 512,
+        bridge: None,
+    };
+    let events = [
+        Timed {
+            sample: 0,
+            event: MidiEvent::NoteOn(50, 100),
+        },
+        Timed {
+            sample: 24_000,
+            event: MidiEvent::NoteOff(50),
+        },
+    ];
+    let mut direct = perform(&events, &how, |_, _| {}).unwrap();
+    direct.truncate(24_000);
+    let from_file = wav_samples(&shipped);
+    assert_eq!(from_file.len(), direct.len());
+    // The file is 16-bit: every sample within half a step of the performer's (rounding).
+    let step = 1.0 / 32767.0;
+    let worst = from_file
+        .iter()
+        .zip(&direct)
+        .fold(0.0f32, |m, (a, b)| m.max((a - b).abs()));
+    assert!(worst <= 0.5 * step + 1e-7, "{worst}");
+    assert!(from_file.iter().any(|x| x.abs() > 1e-3), "silent");
+    // Another bridge (the violin's, on the cello) changes the sound.
+    let other = scratch("bridge-violin.wav");
+    let run = render(&bridge("violin-generic.json"), &other);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let x = wav_samples(&other);
+    assert!(x.iter().all(|v| v.is_finite()) && x.iter().any(|v| v.abs() > 1e-3));
+    let differing = x
+        .iter()
+        .zip(&from_file)
+        .filter(|(a, b)| (*a - *b).abs() > step)
+        .count();
+    assert!(differing > 1000, "only {differing} samples differ");
+    // A broken bridge file, a missing one, or a bridge for a point law: one line, no file.
+    let broken = scratch("broken-bridge.json");
+    std::fs::write(
+        &broken,
+        r#"{"modes": [{"freq_hz": 100, "bandwidth_hz": -1, "gain": [[1]]}]}"#,
+    )
+    .unwrap();
+    for args in [
+        vec![
+            "--friction",
+            "thermal",
+            "--bridge",
+            broken.to_str().unwrap(),
+        ],
+        vec![
+            "--friction",
+            "thermal",
+            "--bridge",
+            "/nonexistent/bridge.json",
+        ],
+        vec![
+            "--bridge",
+            bridge("cello-generic.json")
+                .to_str()
+                .unwrap()
+                .to_owned()
+                .leak(),
+        ],
+    ] {
+        let out = scratch("bridge-error.wav");
+        let mut all = vec!["render", "--out", out.to_str().unwrap()];
+        all.extend(args.iter().copied());
+        let run = colophony(&all);
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert!(!run.status.success(), "{args:?} succeeded");
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert!(!out.exists(), "{args:?} left a file");
+    }
+}
