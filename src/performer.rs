@@ -41,6 +41,16 @@ use crate::quality::{self, Quality};
 use direct::DirectBow;
 use stroke::{Stroke, StrokeMode};
 
+/// `sample_rate_hz` if it is a usable rate (finite, positive), else 48 kHz: the gesture
+/// clocks never divide by a bad rate.
+fn usable_rate(sample_rate_hz: f64) -> f64 {
+    if sample_rate_hz.is_finite() && sample_rate_hz > 0.0 {
+        sample_rate_hz
+    } else {
+        48_000.0
+    }
+}
+
 /// The pitch-bend wheel's position, -1..=1, for a MIDI pitch-bend value `value` (0 =
 /// down, 0.5 = centre, 1 = up, as nice-plug delivers it); a NaN is the centre.
 pub fn wheel_position(value: f32) -> f64 {

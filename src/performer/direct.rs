@@ -73,11 +73,7 @@ pub struct DirectBow {
 
 impl DirectBow {
     pub fn new(sample_rate_hz: f64) -> Self {
-        let fs = if sample_rate_hz.is_finite() && sample_rate_hz > 0.0 {
-            sample_rate_hz
-        } else {
-            48_000.0
-        };
+        let fs = super::usable_rate(sample_rate_hz);
         Self {
             held: [None; 3],
             smoothing: 1.0 - (-1.0 / (DIRECT_SMOOTHING_S * fs)).exp(),

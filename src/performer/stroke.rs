@@ -86,11 +86,7 @@ pub struct Stroke {
 impl Stroke {
     /// At rest before any note: the bow moves as the parameters say (speed 1, down).
     pub fn new(sample_rate_hz: f64) -> Self {
-        let fs = if sample_rate_hz.is_finite() && sample_rate_hz > 0.0 {
-            sample_rate_hz
-        } else {
-            48_000.0
-        };
+        let fs = super::usable_rate(sample_rate_hz);
         Self {
             sample_rate_hz: fs,
             direction: 1.0,
