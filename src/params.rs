@@ -235,6 +235,8 @@ pub struct ColophonyParams {
     pub bow_strokes: EnumParam<StrokeChoice>,
     #[id = "bend_range"]
     pub bend_range: FloatParam,
+    #[id = "glide_time"]
+    pub glide_time_ms: FloatParam,
     /// The editor window's size, saved with the plugin state (not a parameter).
     #[persist = "editor-state"]
     pub editor_state: crate::editor::EditorState,
@@ -345,6 +347,18 @@ impl Default for ColophonyParams {
             .with_unit(" st")
             .with_step_size(0.01)
             .with_value_to_string(formatters::v2s_f32_rounded(2)),
+            // Read at each glide's start.
+            glide_time_ms: FloatParam::new(
+                "Glide Time",
+                (crate::performer::GLIDE_S_DEFAULT * 1e3) as f32,
+                FloatRange::Skewed {
+                    min: 10.0,
+                    max: 2000.0,
+                    factor: FloatRange::skew_factor(-1.5),
+                },
+            )
+            .with_unit(" ms")
+            .with_value_to_string(formatters::v2s_f32_rounded(0)),
             editor_state: Default::default(),
         }
     }
@@ -377,6 +391,7 @@ impl ColophonyParams {
             bow_position_beta: self.bow_position.value() as f64,
             bow_strokes: self.bow_strokes.value().mode(),
             bend_range_semitones: self.bend_range.value() as f64,
+            glide_s: self.glide_time_ms.value() as f64 * 1e-3,
         }
     }
 

@@ -77,6 +77,11 @@ pub const VIBRATO_FADE_S: f64 = 0.3;
 /// 1.3 ms at 48 kHz, steps of at most 1.4 cents at the widest vibrato.
 const VIBRATO_EVERY: u32 = 64;
 
+/// A legato note softer than this (MIDI 64) slides the finger (portamento).
+pub const PORTAMENTO_BELOW_VELOCITY: f64 = 64.0 / 127.0;
+/// Default finger glide time, s.
+pub const GLIDE_S_DEFAULT: f64 = 0.12;
+
 /// MIDI's null registered parameter number (CC101 and CC100 at 127).
 const RPN_NULL: u8 = 127;
 
@@ -114,6 +119,8 @@ pub struct Setup {
     pub bow_strokes: StrokeMode,
     /// Semitones the pitch-bend wheel bends at its ends (0..=12; MIDI RPN 0 overrides it).
     pub bend_range_semitones: f64,
+    /// How long a finger glide (portamento) takes, s.
+    pub glide_s: f64,
 }
 
 impl Default for Setup {
@@ -130,6 +137,7 @@ impl Default for Setup {
             bow_position_beta: 0.1,
             bow_strokes: StrokeMode::Alternate,
             bend_range_semitones: PITCH_BEND_SEMITONES,
+            glide_s: GLIDE_S_DEFAULT,
         }
     }
 }
@@ -224,6 +232,8 @@ struct Gesture {
     rpn_bend_range: Option<f64>,
     /// The registered parameter number CC101/CC100 selected ([`RPN_NULL`]: none).
     rpn: (u8, u8),
+    /// CC65 (portamento) down.
+    portamento_pedal: bool,
     /// The vibrato's present offset, semitones.
     vibrato_now: f64,
     phase: f64,
@@ -244,6 +254,7 @@ impl Gesture {
             wheel: 0.0,
             rpn_bend_range: None,
             rpn: (RPN_NULL, RPN_NULL),
+            portamento_pedal: false,
             vibrato_now: 0.0,
             phase: 0.0,
             phase_step: VIBRATO_RATE_HZ / sample_rate_hz,
@@ -387,9 +398,29 @@ impl Performer {
     /// A key goes down with `velocity` (0..=1). A note that lands while no key is held
     /// starts a new bow stroke ([`stroke`]: direction by the setup's stroke mode, attack
     /// by the velocity); one that lands while another is held is legato (the stroke goes
-    /// on; on the same string the finger moves and the bow stays on).
+    /// on; on the same string the finger moves and the bow stays on). A legato note below
+    /// [`PORTAMENTO_BELOW_VELOCITY`], or any with CC65 down, glides the finger over the
+    /// setup's glide time (the waveguide strings; the thermal model moves it at once).
     pub fn note_on(&mut self, note: u8, velocity: f32) {
         let separate = !self.held.iter().any(|&h| h);
+        // Portamento: a legato note played softly, or any legato note with CC65 down,
+        // slides the finger there on the waveguide strings.
+        let glide = !separate
+            && (self.gesture.portamento_pedal
+                || stroke::velocity_step(velocity) < PORTAMENTO_BELOW_VELOCITY);
+        if glide && self.source == Source::Strings {
+            self.tail = None;
+            self.gesture.since_note = 0;
+            if self
+                .instrument
+                .note_on_gliding(note, self.setup.glide_s)
+                .is_some()
+            {
+                self.held[note as usize & 127] = true;
+                self.last_note = Some(note);
+            }
+            return;
+        }
         self.land(note);
         // A note the source refused moves no bow.
         if separate && self.held[note as usize & 127] {
@@ -489,7 +520,7 @@ impl Performer {
     /// A MIDI controller at `value` (0..=1, as nice-plug delivers it): CC1 (mod wheel)
     /// sets the vibrato depth, CC11 (expression) and CC2 (breath) the dynamics; CC101 and
     /// CC100 select a registered parameter and CC6 / CC38 set it (RPN 0: the pitch-bend
-    /// range, semitones and cents); CC21, CC22 and CC23 the bow's speed, force and position
+    /// range, semitones and cents); CC65 turns portamento on (64 and up); CC21, CC22 and CC23 the bow's speed, force and position
     /// ([`direct`]); others are ignored.
     pub fn set_controller(&mut self, cc: u8, value: f32) {
         if !value.is_finite() {
@@ -504,6 +535,7 @@ impl Performer {
         match cc {
             1 => self.gesture.vibrato_cents = v * MAX_VIBRATO_CENTS,
             2 | 11 => self.gesture.set_expression(v),
+            65 => self.gesture.portamento_pedal = byte >= 64,
             101 => self.gesture.rpn.0 = byte,
             100 => self.gesture.rpn.1 = byte,
             6 | 38 if self.gesture.rpn == (0, 0) => {
@@ -1055,6 +1087,49 @@ mod tests {
             p.tick(bow);
         }
         assert_eq!(p.bow().velocity_m_per_s, -bow.velocity_m_per_s);
+    }
+
+    #[test]
+    fn a_soft_legato_note_glides_the_finger_and_a_firm_one_jumps() {
+        let string = InstrumentKind::Cello.string_for_note(50).unwrap();
+        // D3 bowed, then F3 legato on the same string at `velocity`; the string's pitch
+        // (cents above D3) every 64 samples for 0.3 s.
+        let slide = |velocity: f32| {
+            let mut p = cello();
+            let bow = BowControl::default();
+            p.note_on(50, 0.8);
+            for _ in 0..(0.3 * FS) as usize {
+                p.tick(bow);
+            }
+            let d3 = p.strings().string(string).fundamental_hz();
+            p.note_on(53, velocity);
+            p.note_off(50);
+            assert_eq!(InstrumentKind::Cello.string_for_note(53), Some(string));
+            let mut cents = Vec::new();
+            for i in 0..(0.3 * FS) as usize {
+                p.tick(bow);
+                if i % 64 == 0 {
+                    cents.push(1200.0 * (p.strings().string(string).fundamental_hz() / d3).log2());
+                }
+            }
+            cents
+        };
+        let firm = slide(0.8);
+        assert!(
+            (firm[0] - 300.0).abs() < 10.0,
+            "a firm legato jumps: {}",
+            firm[0]
+        );
+        let soft = slide(0.3);
+        // Rises monotonically from D3 to F3 over the glide time (0.12 s), then stays.
+        assert!(soft.windows(2).all(|w| w[1] >= w[0] - 1e-9));
+        let at = |t: f64| soft[(t * FS / 64.0) as usize];
+        assert!(at(0.0) < 20.0, "{}", at(0.0));
+        let half = at(0.5 * GLIDE_S_DEFAULT);
+        // Halfway in time, halfway in semitones (within 20 cents: the intonation table
+        // moves each place on the string by a few cents, and steps are 1.3 ms).
+        assert!((half - 150.0).abs() < 20.0, "{half}");
+        assert!((at(0.25) - firm[firm.len() - 1]).abs() < 0.01);
     }
 
     #[test]
