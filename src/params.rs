@@ -237,6 +237,8 @@ pub struct ColophonyParams {
     pub bend_range: FloatParam,
     #[id = "glide_time"]
     pub glide_time_ms: FloatParam,
+    #[id = "vibrato_rate"]
+    pub vibrato_rate: FloatParam,
     /// The editor window's size, saved with the plugin state (not a parameter).
     #[persist = "editor-state"]
     pub editor_state: crate::editor::EditorState,
@@ -359,6 +361,18 @@ impl Default for ColophonyParams {
             )
             .with_unit(" ms")
             .with_value_to_string(formatters::v2s_f32_rounded(0)),
+            // Read at each vibrato step; the mod wheel (CC1) sets the depth.
+            vibrato_rate: FloatParam::new(
+                "Vibrato Rate",
+                crate::performer::VIBRATO_RATE_HZ as f32,
+                FloatRange::Linear {
+                    min: crate::performer::VIBRATO_RATE_MIN_HZ as f32,
+                    max: crate::performer::VIBRATO_RATE_MAX_HZ as f32,
+                },
+            )
+            .with_unit(" Hz")
+            .with_step_size(0.01)
+            .with_value_to_string(formatters::v2s_f32_rounded(2)),
             editor_state: Default::default(),
         }
     }
@@ -392,6 +406,7 @@ impl ColophonyParams {
             bow_strokes: self.bow_strokes.value().mode(),
             bend_range_semitones: self.bend_range.value() as f64,
             glide_s: self.glide_time_ms.value() as f64 * 1e-3,
+            vibrato_rate_hz: self.vibrato_rate.value() as f64,
         }
     }
 

@@ -69,6 +69,16 @@ pub const DYNAMICS_SMOOTHING_S: f64 = 0.01;
 pub const MAX_VIBRATO_CENTS: f64 = 30.0;
 /// Vibrato rate, Hz (string players: 5-7 Hz).
 pub const VIBRATO_RATE_HZ: f64 = 5.5;
+/// The vibrato rate's range (the Vibrato Rate parameter, and CC19 across it), Hz.
+pub const VIBRATO_RATE_MIN_HZ: f64 = 3.0;
+pub const VIBRATO_RATE_MAX_HZ: f64 = 9.0;
+/// A player's vibrato is not a machine's: its rate and depth wander by up to this
+/// fraction either way, slowly ([`VIBRATO_DRIFT_S`]), from a fixed-seed random walk (the
+/// same input gives the same output).
+pub const VIBRATO_RATE_DRIFT: f64 = 0.03;
+pub const VIBRATO_DEPTH_DRIFT: f64 = 0.04;
+/// How often the drift picks a new direction, s (it glides there over the same time).
+pub const VIBRATO_DRIFT_S: f64 = 0.4;
 /// The vibrato starts this long after a note lands, s...
 pub const VIBRATO_DELAY_S: f64 = 0.15;
 /// ... and fades in over this long, s.
@@ -121,6 +131,8 @@ pub struct Setup {
     pub bend_range_semitones: f64,
     /// How long a finger glide (portamento) takes, s.
     pub glide_s: f64,
+    /// Vibrato rate, Hz ([`VIBRATO_RATE_MIN_HZ`]..=[`VIBRATO_RATE_MAX_HZ`]).
+    pub vibrato_rate_hz: f64,
 }
 
 impl Default for Setup {
@@ -138,6 +150,7 @@ impl Default for Setup {
             bow_strokes: StrokeMode::Alternate,
             bend_range_semitones: PITCH_BEND_SEMITONES,
             glide_s: GLIDE_S_DEFAULT,
+            vibrato_rate_hz: VIBRATO_RATE_HZ,
         }
     }
 }
@@ -238,6 +251,14 @@ struct Gesture {
     vibrato_now: f64,
     phase: f64,
     phase_step: f64,
+    /// The rate CC19 set, Hz (over the setup's until that changes).
+    cc_rate_hz: Option<f64>,
+    /// Drift of rate and depth: now, target (fractions), updates to the next target, and
+    /// the random state.
+    drift: [f64; 2],
+    drift_target: [f64; 2],
+    drift_countdown: u32,
+    seed: u64,
     /// Samples since the last note landed.
     since_note: u64,
     countdown: u32,
@@ -258,6 +279,11 @@ impl Gesture {
             vibrato_now: 0.0,
             phase: 0.0,
             phase_step: VIBRATO_RATE_HZ / sample_rate_hz,
+            cc_rate_hz: None,
+            drift: [0.0; 2],
+            drift_target: [0.0; 2],
+            drift_countdown: 0,
+            seed: 0x9e37_79b9_7f4a_7c15,
             since_note: 0,
             countdown: 0,
         }
@@ -354,6 +380,9 @@ impl Performer {
             return;
         }
         self.configured = true;
+        if setup.vibrato_rate_hz != self.setup.vibrato_rate_hz {
+            self.gesture.cc_rate_hz = None;
+        }
         let range_was = self.bend_range();
         self.setup = *setup;
         if self.bend_range() != range_was {
@@ -520,7 +549,8 @@ impl Performer {
     /// A MIDI controller at `value` (0..=1, as nice-plug delivers it): CC1 (mod wheel)
     /// sets the vibrato depth, CC11 (expression) and CC2 (breath) the dynamics; CC101 and
     /// CC100 select a registered parameter and CC6 / CC38 set it (RPN 0: the pitch-bend
-    /// range, semitones and cents); CC65 turns portamento on (64 and up); CC21, CC22 and CC23 the bow's speed, force and position
+    /// range, semitones and cents); CC65 turns portamento on (64 and up); CC19 sets the
+    /// vibrato rate (3..9 Hz, over the setup's until that changes); CC21, CC22 and CC23 the bow's speed, force and position
     /// ([`direct`]); others are ignored.
     pub fn set_controller(&mut self, cc: u8, value: f32) {
         if !value.is_finite() {
@@ -536,6 +566,10 @@ impl Performer {
             1 => self.gesture.vibrato_cents = v * MAX_VIBRATO_CENTS,
             2 | 11 => self.gesture.set_expression(v),
             65 => self.gesture.portamento_pedal = byte >= 64,
+            19 => {
+                self.gesture.cc_rate_hz =
+                    Some(VIBRATO_RATE_MIN_HZ + v * (VIBRATO_RATE_MAX_HZ - VIBRATO_RATE_MIN_HZ))
+            }
             101 => self.gesture.rpn.0 = byte,
             100 => self.gesture.rpn.1 = byte,
             6 | 38 if self.gesture.rpn == (0, 0) => {
@@ -565,8 +599,49 @@ impl Performer {
     fn vibrato_semitones(&self) -> f64 {
         let t = self.gesture.since_note as f64 / self.sample_rate_hz - VIBRATO_DELAY_S;
         let fade = (t / VIBRATO_FADE_S).clamp(0.0, 1.0);
-        fade * self.gesture.vibrato_cents / 100.0
-            * (2.0 * std::f64::consts::PI * self.gesture.phase).sin()
+        let depth = self.gesture.vibrato_cents * (1.0 + self.gesture.drift[1]);
+        fade * depth / 100.0 * (2.0 * std::f64::consts::PI * self.gesture.phase).sin()
+    }
+
+    /// The vibrato rate now, Hz: CC19's if it moved last, else the setup's.
+    pub fn vibrato_rate_hz(&self) -> f64 {
+        let rate = self
+            .gesture
+            .cc_rate_hz
+            .unwrap_or(self.setup.vibrato_rate_hz);
+        if rate.is_nan() {
+            return VIBRATO_RATE_HZ;
+        }
+        rate.clamp(VIBRATO_RATE_MIN_HZ, VIBRATO_RATE_MAX_HZ)
+    }
+
+    /// One vibrato update of the drift (every [`VIBRATO_EVERY`] samples): each wander glides
+    /// toward its target, and a new target is drawn every [`VIBRATO_DRIFT_S`].
+    fn advance_drift(&mut self) {
+        let fs = self.sample_rate_hz;
+        let g = &mut self.gesture;
+        let updates = (VIBRATO_DRIFT_S * fs / VIBRATO_EVERY as f64).max(1.0);
+        if g.drift_countdown == 0 {
+            g.drift_countdown = updates as u32;
+            for (k, limit) in [VIBRATO_RATE_DRIFT, VIBRATO_DEPTH_DRIFT]
+                .into_iter()
+                .enumerate()
+            {
+                // xorshift64*: a uniform draw in -1..1.
+                g.seed ^= g.seed >> 12;
+                g.seed ^= g.seed << 25;
+                g.seed ^= g.seed >> 27;
+                let r =
+                    (g.seed.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64;
+                g.drift_target[k] = limit * (2.0 * r - 1.0);
+            }
+        }
+        g.drift_countdown -= 1;
+        for k in 0..2 {
+            g.drift[k] += (g.drift_target[k] - g.drift[k]) / updates;
+        }
+        let rate = self.vibrato_rate_hz() * (1.0 + self.gesture.drift[0]);
+        self.gesture.phase_step = rate / fs;
     }
 
     /// Advances the gesture one sample and returns the bow it shapes: the direct bow
@@ -613,7 +688,8 @@ impl Performer {
         }
         if g.countdown == 0 {
             g.countdown = VIBRATO_EVERY;
-            let now = if g.vibrato_cents > 0.0 {
+            self.advance_drift();
+            let now = if self.gesture.vibrato_cents > 0.0 {
                 self.vibrato_semitones()
             } else {
                 0.0
@@ -879,23 +955,29 @@ mod tests {
         assert!((ratio_db + 15.0).abs() < 3.0, "{ratio_db:.1} dB");
     }
 
-    #[test]
-    fn the_mod_wheel_vibrato_moves_the_finger_at_its_rate_and_depth() {
+    /// Plays D3 for 3 s with the mod wheel up under `setup`, after `controllers`; returns
+    /// the finger's offset in cents every sample.
+    fn vibrato_cents(setup: &Setup, controllers: &[(u8, f32)]) -> Vec<f64> {
         let mut p = cello();
+        p.configure(setup);
         p.set_controller(1, 1.0);
+        for &(cc, v) in controllers {
+            p.set_controller(cc, v);
+        }
         let string = InstrumentKind::Cello.string_for_note(50).unwrap();
         p.note_on(50, 0.8);
         let bow = BowControl::default();
         let centre = p.strings().string(string).fundamental_hz();
-        let mut cents = Vec::new();
-        for _ in 0..(3.0 * FS) as usize {
-            p.tick(bow);
-            cents.push(1200.0 * (p.strings().string(string).fundamental_hz() / centre).log2());
-        }
-        // Silent through the onset delay.
-        let delay = (VIBRATO_DELAY_S * FS) as usize;
-        assert!(cents[..delay - 64].iter().all(|c| c.abs() < 1e-6));
-        // After the fade-in: depth and rate within 5 % of the setting.
+        (0..(3.0 * FS) as usize)
+            .map(|_| {
+                p.tick(bow);
+                1200.0 * (p.strings().string(string).fundamental_hz() / centre).log2()
+            })
+            .collect()
+    }
+
+    /// Depth (largest offset, cents) and rate (upward zero crossings, Hz) after the fade-in.
+    fn depth_and_rate(cents: &[f64]) -> (f64, f64) {
         let steady = &cents[((VIBRATO_DELAY_S + VIBRATO_FADE_S) * FS) as usize + 64..];
         let depth = steady.iter().fold(0.0f64, |m, c| m.max(c.abs()));
         let ups: Vec<usize> = steady
@@ -905,12 +987,60 @@ mod tests {
             .map(|(i, _)| i)
             .collect();
         let rate = (ups.len() - 1) as f64 * FS / (ups[ups.len() - 1] - ups[0]) as f64;
+        (depth, rate)
+    }
+
+    #[test]
+    fn the_mod_wheel_vibrato_moves_the_finger_at_its_rate_and_depth() {
+        let cents = vibrato_cents(&Setup::default(), &[]);
+        // Silent through the onset delay.
+        let delay = (VIBRATO_DELAY_S * FS) as usize;
+        assert!(cents[..delay - 64].iter().all(|c| c.abs() < 1e-6));
+        // After the fade-in: depth and rate within 5 % of the setting (the drift wanders
+        // by at most 4 % and 3 %).
+        let (depth, rate) = depth_and_rate(&cents);
         println!("vibrato depth {depth:.2} cents, rate {rate:.3} Hz");
         assert!(
             (depth / MAX_VIBRATO_CENTS - 1.0).abs() < 0.05,
             "depth {depth}"
         );
         assert!((rate / VIBRATO_RATE_HZ - 1.0).abs() < 0.05, "rate {rate}");
+    }
+
+    #[test]
+    fn the_vibrato_rate_follows_its_parameter_and_cc19_and_drifts_a_little() {
+        let setup = Setup {
+            vibrato_rate_hz: 7.0,
+            ..Setup::default()
+        };
+        let (_, rate) = depth_and_rate(&vibrato_cents(&setup, &[]));
+        assert!((rate / 7.0 - 1.0).abs() < 0.05, "parameter: {rate}");
+        // CC19 at 0: the slowest rate.
+        let (_, rate) = depth_and_rate(&vibrato_cents(&setup, &[(19, 0.0)]));
+        assert!(
+            (rate / VIBRATO_RATE_MIN_HZ - 1.0).abs() < 0.05,
+            "CC19: {rate}"
+        );
+        // The drift: successive cycles are not all the same length, and none strays
+        // further than the drift allows (3 %, plus 2 % for cycles counted to a sample
+        // and the finger's 64-sample steps).
+        let cents = vibrato_cents(&Setup::default(), &[]);
+        let steady = &cents[((VIBRATO_DELAY_S + VIBRATO_FADE_S) * FS) as usize + 64..];
+        let ups: Vec<usize> = steady
+            .windows(2)
+            .enumerate()
+            .filter(|(_, w)| w[0] < 0.0 && w[1] >= 0.0)
+            .map(|(i, _)| i)
+            .collect();
+        let periods: Vec<f64> = ups.windows(2).map(|w| (w[1] - w[0]) as f64 / FS).collect();
+        let nominal = 1.0 / VIBRATO_RATE_HZ;
+        assert!(
+            periods.iter().all(|t| (t / nominal - 1.0).abs() < 0.05),
+            "{periods:?}"
+        );
+        let spread = periods.iter().fold(0.0f64, |m, t| m.max(*t))
+            - periods.iter().fold(1.0f64, |m, t| m.min(*t));
+        assert!(spread > 64.0 / FS, "no drift: {periods:?}");
     }
 
     #[test]
