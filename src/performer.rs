@@ -51,6 +51,21 @@ fn usable_rate(sample_rate_hz: f64) -> f64 {
     }
 }
 
+/// A setting MIDI may hold over the setup's: `midi` if set, else `setup`, clamped to
+/// `range` (`default` for a NaN).
+fn midi_over_setup(
+    midi: Option<f64>,
+    setup: f64,
+    default: f64,
+    range: std::ops::RangeInclusive<f64>,
+) -> f64 {
+    let value = midi.unwrap_or(setup);
+    if value.is_nan() {
+        return default;
+    }
+    value.clamp(*range.start(), *range.end())
+}
+
 /// The pitch-bend wheel's position, -1..=1, for a MIDI pitch-bend value `value` (0 =
 /// down, 0.5 = centre, 1 = up, as nice-plug delivers it); a NaN is the centre.
 pub fn wheel_position(value: f32) -> f64 {
@@ -524,14 +539,12 @@ impl Performer {
     /// The pitch-bend range, semitones: MIDI RPN 0's if one came, else the setup's
     /// (clamped to 0..=[`MAX_BEND_RANGE_SEMITONES`]).
     pub fn bend_range(&self) -> f64 {
-        let range = self
-            .gesture
-            .rpn_bend_range
-            .unwrap_or(self.setup.bend_range_semitones);
-        if range.is_nan() {
-            return PITCH_BEND_SEMITONES;
-        }
-        range.clamp(0.0, MAX_BEND_RANGE_SEMITONES)
+        midi_over_setup(
+            self.gesture.rpn_bend_range,
+            self.setup.bend_range_semitones,
+            PITCH_BEND_SEMITONES,
+            0.0..=MAX_BEND_RANGE_SEMITONES,
+        )
     }
 
     /// Pitch bend in semitones, for every engine with pitch (the vibrato adds to it).
@@ -605,14 +618,12 @@ impl Performer {
 
     /// The vibrato rate now, Hz: CC19's if it moved last, else the setup's.
     pub fn vibrato_rate_hz(&self) -> f64 {
-        let rate = self
-            .gesture
-            .cc_rate_hz
-            .unwrap_or(self.setup.vibrato_rate_hz);
-        if rate.is_nan() {
-            return VIBRATO_RATE_HZ;
-        }
-        rate.clamp(VIBRATO_RATE_MIN_HZ, VIBRATO_RATE_MAX_HZ)
+        midi_over_setup(
+            self.gesture.cc_rate_hz,
+            self.setup.vibrato_rate_hz,
+            VIBRATO_RATE_HZ,
+            VIBRATO_RATE_MIN_HZ..=VIBRATO_RATE_MAX_HZ,
+        )
     }
 
     /// One vibrato update of the drift (every [`VIBRATO_EVERY`] samples): each wander glides
