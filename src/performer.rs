@@ -232,6 +232,13 @@ pub struct Performer {
     direct: DirectBow,
     /// Bridges the player chose for the thermal instrument of each kind.
     user_bridges: [Option<BridgeModes>; 3],
+    /// Whether any engine besides the waveguide strings sounds: they wake only at a note
+    /// the performer hands them and sleep only at a block's `update_sleep`, so this is
+    /// renewed there and the per-sample loop skips them with one test.
+    others_awake: bool,
+    /// While the gesture is steady (see [`Performer::shape`]): the factors on the bow's
+    /// velocity and force, applied without the gesture's per-sample checks.
+    steady: Option<(f64, f64)>,
     /// Whether [`Performer::configure`] has run since the engines were built.
     configured: bool,
     /// The bow of the last sample, as played (after the stroke and the dynamics).
@@ -331,6 +338,8 @@ impl Performer {
             stroke: Stroke::new(48_000.0),
             direct: DirectBow::new(48_000.0),
             user_bridges: [None, None, None],
+            others_awake: false,
+            steady: None,
             configured: false,
             bow_now: BowControl::default(),
         }
@@ -379,6 +388,7 @@ impl Performer {
         self.gesture = Gesture::new(fs);
         self.stroke = Stroke::new(fs);
         self.direct = DirectBow::new(fs);
+        self.steady = None;
         self.configured = false;
         Ok(())
     }
@@ -392,6 +402,7 @@ impl Performer {
             for engine in self.engines() {
                 engine.update_sleep();
             }
+            self.refresh_others();
             return;
         }
         self.configured = true;
@@ -430,6 +441,13 @@ impl Performer {
         for engine in self.engines() {
             engine.update_sleep();
         }
+        self.refresh_others();
+    }
+
+    /// Renews [`Performer::others_awake`].
+    fn refresh_others(&mut self) {
+        self.others_awake =
+            self.thermal.iter().any(|e| e.is_sounding()) || self.rubbed.is_sounding();
     }
 
     /// Every engine.
@@ -446,6 +464,7 @@ impl Performer {
     /// [`PORTAMENTO_BELOW_VELOCITY`], or any with CC65 down, glides the finger over the
     /// setup's glide time (the waveguide strings; the thermal model moves it at once).
     pub fn note_on(&mut self, note: u8, velocity: f32) {
+        self.steady = None;
         let separate = !self.held.iter().any(|&h| h);
         // Portamento: a legato note played softly, or any legato note with CC65 down,
         // slides the finger there on the waveguide strings.
@@ -506,6 +525,7 @@ impl Performer {
                 }
             }
         }
+        self.refresh_others();
     }
 
     pub fn note_off(&mut self, note: u8) {
@@ -569,6 +589,7 @@ impl Performer {
         if !value.is_finite() {
             return;
         }
+        self.steady = None;
         let v = (value as f64).clamp(0.0, 1.0);
         if self.direct.set_controller(cc, v) {
             return;
@@ -602,6 +623,7 @@ impl Performer {
 
     /// Channel pressure (aftertouch), 0..=1: the dynamics, as CC11.
     pub fn set_pressure(&mut self, value: f32) {
+        self.steady = None;
         if value.is_finite() {
             self.gesture.set_expression(value as f64);
         }
@@ -671,20 +693,31 @@ impl Performer {
             self.stroke.tick()
         };
         let g = &mut self.gesture;
-        if g.scale == 1.0 && g.target == 1.0 && speed == 1.0 && landing == 1.0 {
-            return bow;
-        }
         if g.scale != g.target {
             g.scale += g.smoothing * (g.target - g.scale);
             if (g.scale - g.target).abs() < 1e-9 {
                 g.scale = g.target;
             }
         }
-        BowControl {
-            velocity_m_per_s: bow.velocity_m_per_s * g.scale * speed,
-            force_n: bow.force_n * g.scale * landing,
-            ..bow
-        }
+        let out = if g.scale == 1.0 && speed == 1.0 && landing == 1.0 {
+            bow
+        } else {
+            BowControl {
+                velocity_m_per_s: bow.velocity_m_per_s * g.scale * speed,
+                force_n: bow.force_n * g.scale * landing,
+                ..bow
+            }
+        };
+        // Steady from here on until a controller, a pressure or a note: the next samples
+        // only multiply (the same bits: `speed` is +-1, so the order of the products does
+        // not round differently).
+        let steady = g.vibrato_cents == 0.0
+            && g.vibrato_now == 0.0
+            && g.scale == g.target
+            && self.direct.is_idle()
+            && self.stroke.is_settled();
+        self.steady = steady.then_some((g.scale * speed, g.scale));
+        out
     }
 
     /// One sample of the vibrato: its clock runs while the mod wheel is up (so the onset
@@ -750,15 +783,26 @@ impl Performer {
             engine.reset();
         }
         self.held = [false; 128];
+        self.refresh_others();
     }
 
     /// One sample. Every engine ticks while it sounds (the one just switched away from
     /// rings on); the contact probe is the source's.
     #[inline]
     pub fn tick(&mut self, bow: BowControl) -> Frame {
-        let bow = self.shape(bow);
+        let bow = match self.steady {
+            Some((v, f)) => BowControl {
+                velocity_m_per_s: bow.velocity_m_per_s * v,
+                force_n: bow.force_n * f,
+                ..bow
+            },
+            None => self.shape(bow),
+        };
         self.bow_now = bow;
         let mut frame = self.instrument.tick(bow);
+        if !self.others_awake {
+            return frame;
+        }
         for (k, engine) in self.thermal.iter_mut().enumerate() {
             if engine.is_sounding() {
                 let f = engine.tick(bow);
