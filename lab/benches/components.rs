@@ -1,8 +1,9 @@
 //! Criterion benches per component, for profiling (`cargo bench --bench components`;
 //! `-- --quick` for a fast pass): one friction solve per law on the cello D load line, one
 //! waveguide string sample, one thermal string sample at N_B 10 and 60, and one modal
-//! bridge junction solve (four strings, the shipped 14-mode cello bridge). Whole-model
-//! costs against precision are `colophony bench precision`.
+//! bridge junction solve (four strings, the shipped 14-mode cello bridge), and one sample
+//! of the cello bowing D3 bare and through the performer (the performance layer's cost is
+//! their difference). Whole-model costs against precision are `colophony bench precision`.
 
 use colophony::dsp::bridge::{solve_junction, ModalBridge};
 use colophony::dsp::friction::bristle::{BristleFriction, BristleLaw, BristleParams};
@@ -89,6 +90,35 @@ fn waveguide_tick(c: &mut Criterion) {
     });
 }
 
+fn performer_tick(c: &mut Criterion) {
+    use colophony::dsp::instrument::{BowControl, Instrument};
+    use colophony::performer::{Performer, Setup};
+    let bow = BowControl::default();
+    let mut group = c.benchmark_group("cello D3 bowed, one sample");
+    let mut bare = Instrument::new(InstrumentKind::Cello, FS);
+    bare.note_on(50);
+    for _ in 0..FS as usize / 2 {
+        bare.tick(bow);
+    }
+    group.bench_function("instrument", |b| {
+        b.iter(|| black_box(bare.tick(black_box(bow))))
+    });
+    let setup = Setup::default();
+    let mut performer = Performer::new(InstrumentKind::Cello);
+    performer
+        .activate(&setup, FS)
+        .expect("the default setup activates");
+    performer.configure(&setup);
+    performer.note_on(50, 0.8);
+    for _ in 0..FS as usize / 2 {
+        performer.tick(bow);
+    }
+    group.bench_function("through the performer", |b| {
+        b.iter(|| black_box(performer.tick(black_box(bow))))
+    });
+    group.finish();
+}
+
 fn thermal_tick(c: &mut Criterion) {
     let bow = ThermalBowControl {
         velocity_m_per_s: 0.15,
@@ -141,6 +171,7 @@ criterion_group!(
     components,
     friction_solve,
     waveguide_tick,
+    performer_tick,
     thermal_tick,
     bridge_junction
 );
