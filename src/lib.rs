@@ -93,10 +93,11 @@ impl Plugin for Colophony {
     /// nice-plug's VST3 wrapper turns every point of its 16 x 130 hidden MIDI-controller
     /// parameters (`MidiConfig::MidiCCs`: 128 CCs, channel pressure and pitch bend per
     /// channel) into a note event, and keeps the block's events in a buffer of this
-    /// capacity (its default 1024). A DAW that flushes its parameter state (Ardour does at
-    /// transport start and locate) sends all 2080 of them at once: with 1024 the wrapper
-    /// allocated on the audio thread ("Input note event buffer filled up!"). 8192 holds
-    /// such a flush three times over with our own parameters' automation and the notes.
+    /// capacity (its default 1024). A host that sends more than that in one block (a flush
+    /// of all 2080, say; in Ardour the wrapper logged "Input note event buffer filled up!"
+    /// four times in 6 s, what it sent there is not measured here) makes the wrapper
+    /// allocate on the audio thread. 8192 holds a full flush three times over with our own
+    /// parameters' automation and the notes.
     const INPUT_EVENT_CAPACITY: usize = 8192;
 
     type Editor = editor::ColophonyEditor;

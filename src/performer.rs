@@ -471,20 +471,7 @@ impl Performer {
         let glide = !separate
             && (self.gesture.portamento_pedal
                 || stroke::velocity_step(velocity) < PORTAMENTO_BELOW_VELOCITY);
-        if glide && self.source == Source::Strings {
-            self.tail = None;
-            self.gesture.since_note = 0;
-            if self
-                .instrument
-                .note_on_gliding(note, self.setup.glide_s)
-                .is_some()
-            {
-                self.held[note as usize & 127] = true;
-                self.last_note = Some(note);
-            }
-            return;
-        }
-        self.land(note);
+        self.land(note, glide.then_some(self.setup.glide_s));
         // A note the source refused moves no bow.
         if separate && self.held[note as usize & 127] {
             self.stroke
@@ -492,8 +479,9 @@ impl Performer {
         }
     }
 
-    /// The note reaches the source (no new stroke).
-    fn land(&mut self, note: u8) {
+    /// The note reaches the source (no new stroke); with `glide` (seconds), the waveguide
+    /// strings slide the finger there.
+    fn land(&mut self, note: u8, glide: Option<f64>) {
         // A bow lands: whatever tail was estimated no longer holds.
         self.tail = None;
         self.gesture.since_note = 0;
@@ -501,7 +489,11 @@ impl Performer {
         match self.source {
             // Notes the instrument cannot play are ignored.
             Source::Strings => {
-                if self.instrument.note_on(note).is_some() {
+                let landed = match glide {
+                    Some(seconds) => self.instrument.note_on_gliding(note, seconds),
+                    None => self.instrument.note_on(note),
+                };
+                if landed.is_some() {
                     self.held[key] = true;
                     self.last_note = Some(note);
                 }
@@ -877,7 +869,7 @@ impl Performer {
         }
         for (note, down) in held.iter().enumerate() {
             if *down {
-                self.land(note as u8);
+                self.land(note as u8, None);
             }
         }
     }

@@ -17,8 +17,7 @@ fn a_block_with_a_full_controller_flush_fits_the_reserved_event_buffer() {
     // Before the plugin's first load in this process (its logger reads it then).
     std::env::set_var("NICE_LOG", &log);
     const BLOCK: usize = 512;
-    let mut plugin = HostedPlugin::load_test_build();
-    plugin.activate(48_000.0, BLOCK);
+    let mut plugin = HostedPlugin::active_test_build(48_000.0, BLOCK);
     // A VST3 host that flushes nice-plug's 16 x 130 hidden MIDI-controller parameters
     // hands the plugin 2080 events in one block; CLAP delivers controllers as events
     // through the same capacity (`Plugin::INPUT_EVENT_CAPACITY`). Here 2080 controller

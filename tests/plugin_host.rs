@@ -15,9 +15,7 @@ const FS: f64 = 48_000.0;
 const BLOCK: usize = 512;
 
 fn active_plugin(sample_rate: f64, max_block: usize) -> HostedPlugin {
-    let mut plugin = HostedPlugin::load_test_build();
-    plugin.activate(sample_rate, max_block);
-    plugin
+    HostedPlugin::active_test_build(sample_rate, max_block)
 }
 
 /// The `instrument` parameter's display name for `kind` ("Violin", ...).

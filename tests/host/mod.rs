@@ -268,6 +268,14 @@ impl HostedPlugin {
         Self::load(test_plugin_path())
     }
 
+    /// [`HostedPlugin::load_test_build`], activated at `sample_rate` for blocks of up to
+    /// `max_block` frames.
+    pub fn active_test_build(sample_rate: f64, max_block: usize) -> Self {
+        let mut plugin = Self::load_test_build();
+        plugin.activate(sample_rate, max_block);
+        plugin
+    }
+
     pub fn params(&self) -> &[ParamDesc] {
         &self.params
     }
