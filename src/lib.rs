@@ -15,6 +15,7 @@ pub mod dsp;
 pub mod editor;
 pub mod params;
 pub mod performer;
+pub mod presets;
 pub mod quality;
 
 use dsp::instrument::{BowControl, InstrumentKind};
@@ -103,6 +104,10 @@ impl Plugin for Colophony {
     type Editor = editor::ColophonyEditor;
     type SysExMessage = ();
     type BackgroundTask = ();
+
+    fn filter_state(state: &mut PluginState) {
+        presets::migrate_state(state);
+    }
 
     fn params(&self) -> Arc<dyn Params> {
         self.params.clone()

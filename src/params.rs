@@ -242,6 +242,9 @@ pub struct ColophonyParams {
     /// The editor window's size, saved with the plugin state (not a parameter).
     #[persist = "editor-state"]
     pub editor_state: crate::editor::EditorState,
+    /// The state's version, for migrations ([`crate::presets::migrate_state`]).
+    #[persist = "state-version"]
+    pub state_version: crate::presets::StateVersion,
 }
 
 pub fn bow_velocity_range() -> FloatRange {
@@ -374,6 +377,7 @@ impl Default for ColophonyParams {
             .with_step_size(0.01)
             .with_value_to_string(formatters::v2s_f32_rounded(2)),
             editor_state: Default::default(),
+            state_version: crate::presets::StateVersion,
         }
     }
 }

@@ -9,7 +9,7 @@ mod host;
 
 use colophony::analysis::{cents, peak_frequency_hz, rms};
 use colophony::dsp::instrument::{midi_to_hz, InstrumentKind, BOW_RAMP_S};
-use host::{channel_f64, write_wav, Event, HostedPlugin, Score};
+use host::{channel_f64, workspace_root, write_wav, Event, HostedPlugin, Score};
 
 const FS: f64 = 48_000.0;
 const BLOCK: usize = 512;
@@ -868,4 +868,74 @@ fn assert_no_click_at(x: &[f64], switch_at: &[u64]) {
         // 1.5x: a step no larger than the waveform's own corners is not a click.
         assert!(at_switch <= 1.5 * before.max(1e-4), "click at sample {at}");
     }
+}
+
+/// The values `tests/fixtures/state/v1.state` was saved with (set by automation).
+fn fixture_values(plugin: &mut HostedPlugin) -> Score {
+    Score::new()
+        .at(0, plugin.text("Instrument", "Viola"))
+        .at(0, plugin.plain("Bow Force", 0.7))
+        .at(0, plugin.plain("Bow Velocity", -0.15))
+        .at(0, plugin.plain("Bow Position", 0.13))
+        .at(0, plugin.text("Friction Model", "LuGre"))
+        .at(0, plugin.plain("Glide Time", 300.0))
+        .at(0, plugin.plain("Reference Pitch", 442.0))
+}
+
+#[test]
+fn states_saved_by_every_version_load_with_their_values() {
+    let dir = workspace_root().join("tests/fixtures/state");
+    let v1 = dir.join("v1.state");
+    if std::env::var_os("COLOPHONY_RECORD_STATE").is_some() && !v1.exists() {
+        // Recorded once, by the build that introduced state version 1; never re-recorded.
+        let mut plugin = active_plugin(FS, BLOCK);
+        let score = fixture_values(&mut plugin);
+        plugin.render(BLOCK, BLOCK, &score);
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(&v1, plugin.save_state()).unwrap();
+    }
+    // The values as this build reads them: set by automation on a fresh instance.
+    let mut expected = active_plugin(FS, BLOCK);
+    let score = fixture_values(&mut expected);
+    expected.render(BLOCK, BLOCK, &score);
+    let names: Vec<String> = expected.params().iter().map(|p| p.name.clone()).collect();
+    // A saved state is nice-plug's JSON behind its length (u64, little-endian). v0.state:
+    // a state from before versions were recorded (v1.state without its `state-version`
+    // field, which is all that distinguished them).
+    for fixture in ["v0.state", "v1.state"] {
+        let bytes = std::fs::read(dir.join(fixture)).unwrap_or_else(|e| panic!("{fixture}: {e}"));
+        let mut plugin = HostedPlugin::load_test_build();
+        plugin
+            .load_state(&bytes)
+            .unwrap_or_else(|e| panic!("{fixture} refused: {e}"));
+        plugin.activate(FS, BLOCK);
+        for name in &names {
+            assert_eq!(
+                plugin.clap_value(name),
+                expected.clap_value(name),
+                "{fixture}: {name}"
+            );
+        }
+        let out = plugin.render(
+            secs(0.4, FS) as usize,
+            BLOCK,
+            &Score::new().at(0, Event::note_on(62)),
+        );
+        assert!(rms(&channel_f64(&out, 0)) > 1e-3, "{fixture}: silent");
+        // Saved again, it carries this build's version.
+        let resaved = String::from_utf8(plugin.save_state()).unwrap();
+        assert!(resaved.contains(r#""state-version":"1""#), "{resaved}");
+    }
+    // A damaged state (a value far outside its range): loads, clamped to the range's end.
+    let bytes = std::fs::read(&v1).unwrap();
+    let mut state: serde_json::Value = serde_json::from_slice(&bytes[8..]).unwrap();
+    state["params"]["bow_force"] = serde_json::json!({ "f32": 5000.0 });
+    let json = serde_json::to_vec(&state).unwrap();
+    let mut damaged = (json.len() as u64).to_le_bytes().to_vec();
+    damaged.extend_from_slice(&json);
+    let mut plugin = HostedPlugin::load_test_build();
+    plugin.load_state(&damaged).unwrap();
+    plugin.activate(FS, BLOCK);
+    let max = plugin.text_to_clap("Bow Force", "10");
+    assert_eq!(plugin.clap_value("Bow Force"), max);
 }

@@ -30,9 +30,9 @@ enum Command {
         /// violin, viola or cello.
         #[arg(long, default_value = "cello", value_parser = parse_instrument)]
         instrument: InstrumentKind,
-        /// MIDI number or note name (C4 = 60).
-        #[arg(long, default_value = "50", value_parser = parse_note)]
-        note: u8,
+        /// MIDI number or note name (C4 = 60); default D3 (50), or the preset's note.
+        #[arg(long, value_parser = parse_note)]
+        note: Option<u8>,
         #[arg(long, default_value_t = 3.0, allow_negative_numbers = true)]
         seconds: f64,
         /// m/s, signed (sign = bow direction).
@@ -71,10 +71,14 @@ enum Command {
         /// Thermal bow: width of the hair ribbon, m (the force is spread over it).
         #[arg(long, default_value_t = 0.01)]
         bow_width: f64,
-        /// Rub a modal object instead of bowing a string: paper-modal, door-hinge, chalk,
-        /// wine-glass or brake-squeal (the other bow settings are then the preset's).
-        #[arg(long, value_parser = parse_preset)]
-        preset: Option<RubbedPreset>,
+        /// Play a preset through the plugin's performer: a factory preset's id or name,
+        /// a user preset, or a preset .json file (`colophony presets` lists them). It sets
+        /// every parameter as the plugin would; --note (default: the preset's), --seconds,
+        /// --release, --midi, --track and --sample-rate still apply, the other bow and
+        /// model options are the preset's. The bare names paper-modal, door-hinge, chalk,
+        /// wine-glass and brake-squeal rub that object alone at its own bow.
+        #[arg(long)]
+        preset: Option<String>,
         /// Play a standard MIDI file (notes and pitch bend, with its tempo map) through the
         /// plugin's performer at the plugin's defaults and the bow given; --note,
         /// --seconds and --release are then unused.
@@ -128,6 +132,9 @@ enum Command {
         #[arg(long)]
         passes: Option<usize>,
     },
+    /// List the presets: the factory set and the user presets (in the folder the editor
+    /// saves to; COLOPHONY_PRESET_DIR overrides it).
+    Presets,
     /// Fit a passive modal bridge admittance to measured data (CSV in, JSON out).
     FitBridge {
         input: PathBuf,
@@ -137,13 +144,6 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
-}
-
-fn parse_preset(s: &str) -> Result<RubbedPreset, String> {
-    RubbedPreset::from_name(s).ok_or_else(|| {
-        let names: Vec<&str> = RubbedPreset::ALL.iter().map(|p| p.name()).collect();
-        format!("unknown preset '{s}': choose one of {}", names.join(", "))
-    })
 }
 
 fn report(result: Result<String, String>) -> ExitCode {
@@ -210,6 +210,15 @@ fn main() -> ExitCode {
             track,
             bridge,
         } => {
+            let rubbed = preset.as_deref().and_then(RubbedPreset::from_name);
+            if let (Some(name), None) = (&preset, rubbed) {
+                let score = match midi {
+                    Some(midi) => PresetScore::File(midi, track),
+                    None => PresetScore::Note(note, seconds, release),
+                };
+                return report(render_preset(name, score, &out, sample_rate));
+            }
+            let note = note.unwrap_or(DEFAULT_NOTE);
             let bridge = match bridge {
                 None => None,
                 Some(_) if friction != FrictionArg::Thermal => {
@@ -263,7 +272,7 @@ fn main() -> ExitCode {
                 FrictionArg::Point(model) => model,
                 FrictionArg::Thermal => FrictionModel::Hyperbolic,
             };
-            if let Some(preset) = preset {
+            if let Some(preset) = rubbed {
                 if thermal {
                     return report(Err(
                         "the thermal bow plays strings, not the rubbed presets".into()
@@ -374,6 +383,25 @@ fn main() -> ExitCode {
                 "unknown bench '{other}': choose friction, table1, scenes, precision, playing-space or intonation"
             )),
         }),
+        Command::Presets => {
+            println!("factory presets (colophony render --preset ID):");
+            for (id, p) in colophony::presets::factory() {
+                println!("  {id:<22} {}", p.name);
+            }
+            match colophony::presets::user_dir() {
+                None => println!("user presets: no folder (set COLOPHONY_PRESET_DIR)"),
+                Some(dir) => {
+                    println!("user presets in {}:", dir.display());
+                    for (stem, p) in colophony::presets::user_presets(&dir) {
+                        match p {
+                            Ok(p) => println!("  {stem:<22} {}", p.name),
+                            Err(e) => println!("  {stem:<22} (cannot be read: {e})"),
+                        }
+                    }
+                }
+            }
+            ExitCode::SUCCESS
+        }
         Command::FitBridge { input, modes, out } => {
             report(colophony_lab::admittance_fit::run_cli(&input, modes, &out))
         }
@@ -461,40 +489,107 @@ fn render_performed(
             note,
             seconds,
             release,
-        } => {
-            use colophony_lab::midi_file::{render_events, MidiEvent, Timed};
-            if !(seconds.is_finite() && seconds > 0.0 && seconds <= 3600.0) {
-                return Err(format!("--seconds must be within 0..=3600, got {seconds}"));
-            }
-            if instrument.string_for_note(note).is_none() {
-                let (lo, hi) = instrument.note_range();
-                return Err(format!(
-                    "the {} plays MIDI notes {lo}..={hi}; {note} is outside",
-                    instrument.name()
-                ));
-            }
-            let at = |t: f64| (t * sample_rate).round() as u64;
-            let lift = release.unwrap_or(seconds).clamp(0.0, seconds);
-            let events = [
-                Timed {
-                    sample: 0,
-                    event: MidiEvent::NoteOn(note, 100),
-                },
-                Timed {
-                    sample: at(lift),
-                    event: MidiEvent::NoteOff(note),
-                },
-            ];
-            let frames = at(seconds) as usize;
-            let (written, peak) = render_events(&events, &how, Some(frames), out)?;
-            Ok(format!(
+        } => play_note(&how, note, seconds, release, out).map(|(written, peak)| {
+            format!(
                 "wrote {} ({written:.1} s, peak {:.1} dBFS, the plugin's thermal {} on the given bridge)",
                 out.display(),
                 20.0 * (peak.max(1e-30) as f64).log10(),
                 instrument.name()
-            ))
+            )
+        }),
+    }
+}
+
+/// The note `colophony render` plays when none is given: D3, the cello's D string.
+const DEFAULT_NOTE: u8 = 50;
+
+/// What `render --preset` plays.
+enum PresetScore {
+    File(PathBuf, Option<usize>),
+    /// Note (default the preset's), seconds, release.
+    Note(Option<u8>, f64, Option<f64>),
+}
+
+/// `colophony render --preset`: every parameter from the preset, applied to the plugin's
+/// parameter set (so its ranges and defaults hold), played through the performer.
+fn render_preset(
+    name: &str,
+    score: PresetScore,
+    out: &std::path::Path,
+    sample_rate: f64,
+) -> Result<String, String> {
+    let preset = colophony::presets::find(name)?;
+    let params = colophony::params::ColophonyParams::default();
+    preset.apply_to(&params)?;
+    let setup = params.setup();
+    colophony_lab::render::check(&RenderSettings {
+        instrument: setup.instrument,
+        note: setup.instrument.note_range().0,
+        sample_rate_hz: sample_rate,
+        ..RenderSettings::default()
+    })
+    .map_err(|e| e.to_string())?;
+    let how = colophony_lab::midi_file::Performance {
+        setup,
+        bow: params.bow(),
+        gain: nice_plug::util::db_to_gain(params.gain.value()) as f64,
+        sample_rate_hz: sample_rate,
+        block: 512,
+        bridge: None,
+    };
+    match score {
+        PresetScore::File(midi, track) => {
+            colophony_lab::midi_file::render_file(&midi, track, &how, out)
+        }
+        PresetScore::Note(note, seconds, release) => {
+            let note = note.or(preset.note).unwrap_or(DEFAULT_NOTE);
+            play_note(&how, note, seconds, release, out).map(|(written, peak)| {
+                format!(
+                    "wrote {} ({written:.1} s, peak {:.1} dBFS, preset '{}')",
+                    out.display(),
+                    20.0 * (peak.max(1e-30) as f64).log10(),
+                    preset.name
+                )
+            })
         }
     }
+}
+
+/// One note held for `seconds` (lifted at `release`) through the performer; the seconds
+/// written and the peak.
+fn play_note(
+    how: &colophony_lab::midi_file::Performance,
+    note: u8,
+    seconds: f64,
+    release: Option<f64>,
+    out: &std::path::Path,
+) -> Result<(f64, f32), String> {
+    use colophony_lab::midi_file::{render_events, MidiEvent, Timed};
+    if !(seconds.is_finite() && seconds > 0.0 && seconds <= 3600.0) {
+        return Err(format!("--seconds must be within 0..=3600, got {seconds}"));
+    }
+    let instrument = how.setup.instrument;
+    if how.setup.rubbed.is_none() && instrument.string_for_note(note).is_none() {
+        let (lo, hi) = instrument.note_range();
+        return Err(format!(
+            "the {} plays MIDI notes {lo}..={hi}; {note} is outside",
+            instrument.name()
+        ));
+    }
+    let at = |t: f64| (t * how.sample_rate_hz).round() as u64;
+    let lift = release.unwrap_or(seconds).clamp(0.0, seconds);
+    let events = [
+        Timed {
+            sample: 0,
+            event: MidiEvent::NoteOn(note, 100),
+        },
+        Timed {
+            sample: at(lift),
+            event: MidiEvent::NoteOff(note),
+        },
+    ];
+    let frames = at(seconds) as usize;
+    render_events(&events, how, Some(frames), out)
 }
 
 /// `--friction` defaults to hyperbolic for strings; rubbed presets use elasto-plastic
