@@ -6,6 +6,7 @@ use colophony::editor::live::ContactSample;
 use colophony::editor::mapping::PadMapping;
 use colophony::editor::nodes::NodeRecord;
 use colophony::editor::pad::{pad_value_text, PAD_LABEL};
+use colophony::editor::presets::{PRESET_LABEL, SAVE_LABEL};
 use colophony::editor::view::THERMAL_LABEL;
 use colophony::editor::{EditorLink, EditorUi};
 use colophony::params::{
@@ -25,15 +26,37 @@ enum Call {
     End(String),
 }
 
-/// The host side of the `ParamSetter`: logs the calls and applies each value at once.
+/// The host side of the `ParamSetter`: logs the calls and applies each value at once;
+/// serves a saved state and keeps the states the editor hands back.
 #[derive(Default)]
 struct Recorder {
     calls: Mutex<Vec<Call>>,
+    states: Mutex<Vec<PluginState>>,
 }
 
 impl Recorder {
     fn calls(&self) -> Vec<Call> {
         self.calls.lock().unwrap().clone()
+    }
+}
+
+/// The state the recorder serves: the defaults, with the window size and version fields a
+/// real state carries.
+fn served_state() -> PluginState {
+    PluginState {
+        version: "0.1.0".into(),
+        params: colophony::presets::Preset::parse(r#"{"name": "defaults", "params": {}}"#)
+            .unwrap()
+            .state_params()
+            .unwrap(),
+        fields: [
+            (
+                "editor-state".to_owned(),
+                r#"{"width":900.0,"height":700.0}"#.to_owned(),
+            ),
+            ("state-version".to_owned(), "1".to_owned()),
+        ]
+        .into(),
     }
 }
 
@@ -65,10 +88,12 @@ impl GuiContextInner for Recorder {
     }
 
     fn get_state(&self) -> PluginState {
-        unimplemented!("the editor does not read the state")
+        served_state()
     }
 
-    fn set_state(&self, _state: PluginState) {}
+    fn set_state(&self, state: PluginState) {
+        self.states.lock().unwrap().push(state);
+    }
 
     fn request_restart(&self) {}
 }
@@ -460,4 +485,55 @@ fn the_thermal_bow_views_show_the_audio_threads_node_records_only_with_the_therm
         h.get_by_label(THERMAL_LABEL).value().as_deref(),
         Some("4 nodes, hottest 4.5 K above ambient, slipping 50 % of the time")
     );
+}
+
+#[test]
+fn choosing_a_preset_hands_the_host_one_whole_state_and_keeps_the_window() {
+    let mut f = fixture();
+    {
+        let mut h = harness(&mut f.editor);
+        let combo = h.get_by_role_and_label(egui::Role::ComboBox, PRESET_LABEL);
+        combo.click();
+        h.run();
+        h.get_by_label("Violin detache").click();
+        h.run();
+    }
+    let states = f.recorder.states.lock().unwrap().clone();
+    assert_eq!(states.len(), 1, "one state change");
+    let expected = colophony::presets::find("violin-detache")
+        .unwrap()
+        .state_params()
+        .unwrap();
+    assert_eq!(format!("{:?}", states[0].params), format!("{expected:?}"));
+    assert_eq!(
+        states[0].fields,
+        served_state().fields,
+        "window size and version kept"
+    );
+    // A preset is one state change, not a stream of parameter gestures.
+    assert!(f.recorder.calls().is_empty());
+}
+
+#[test]
+fn saving_a_preset_writes_the_current_values_to_the_user_folder() {
+    let dir = std::env::temp_dir().join(format!("colophony-editor-presets-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let mut f = fixture();
+    f.editor.presets_mut().set_user_dir(Some(dir.clone()));
+    {
+        let mut h = harness(&mut f.editor);
+        h.get_by_role(egui::Role::TextInput).click();
+        h.run();
+        h.get_by_role(egui::Role::TextInput).type_text("My bow");
+        h.run();
+        h.get_by_label(SAVE_LABEL).click();
+        h.run();
+    }
+    let saved = colophony::presets::Preset::load(&dir.join("my-bow.json")).unwrap();
+    assert_eq!(saved.name, "My bow");
+    assert_eq!(
+        format!("{:?}", saved.state_params().unwrap()),
+        format!("{:?}", served_state().params)
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -6,6 +6,7 @@
 //! * [`view`]: the editor's contents, drawn into any `egui::Ui` ([`EditorUi`]).
 //! * [`live`]: the live views and the wait-free ring that feeds them from the audio thread.
 //! * [`nodes`]: the thermal bow's temperature and slip views and their wait-free ring.
+//! * [`presets`]: the preset selector and "save as" ([`crate::presets`]).
 //! * [`regime`]: the regime the string is in, classified from the live samples (pure).
 //! * This file: the window glue. [`ColophonyEditor`] is the plugin's `Editor`;
 //!   [`EditorState`] is the window size saved with the plugin state
@@ -24,6 +25,7 @@ pub mod live;
 pub mod mapping;
 pub mod nodes;
 pub mod pad;
+pub mod presets;
 pub mod regime;
 pub mod view;
 

@@ -7,6 +7,7 @@ use super::live::{paint_friction_loop, paint_velocity_trace, ContactSample, SCOP
 use super::mapping::SchellengWindow;
 use super::nodes::{paint_slip_image, paint_temperature_profile, NodeRecord, RING_LEN};
 use super::pad::{format_force, format_velocity, XyPad, MAX_FORCE_COLOUR, MIN_FORCE_COLOUR};
+use super::presets::PresetBar;
 use super::regime::{classify_regime, Regime};
 use super::{EditorLink, EditorSize};
 use crate::dsp::instrument::{midi_to_hz, InstrumentKind};
@@ -53,6 +54,8 @@ pub struct EditorUi {
     detected: Option<Regime>,
     /// The thermal bow's node records copied out of the ring, reused every frame.
     records: Vec<NodeRecord>,
+    /// The preset selector and "save as".
+    presets: PresetBar,
 }
 
 impl EditorUi {
@@ -66,7 +69,13 @@ impl EditorUi {
             samples: Vec::with_capacity(SCOPE_LEN),
             detected: None,
             records: Vec::with_capacity(RING_LEN),
+            presets: PresetBar::default(),
         }
+    }
+
+    /// The preset selector and "save as" (to choose another user preset folder).
+    pub fn presets_mut(&mut self) -> &mut PresetBar {
+        &mut self.presets
     }
 
     pub fn pad(&self) -> &XyPad {
@@ -158,6 +167,7 @@ impl EditorUi {
             enum_selector(ui, "Resonator", &params.resonator, &setter);
             ui.checkbox(&mut self.live, "Live views");
         });
+        ui.horizontal_wrapped(|ui| self.presets.show(ui, &context));
         ui.separator();
 
         if self.live {
