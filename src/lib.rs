@@ -50,25 +50,47 @@ impl Default for Colophony {
 
 impl Colophony {
     fn handle_event(&mut self, event: NoteEvent<()>) {
+        let p = &mut self.performer;
         match event {
             NoteEvent::NoteOn {
                 key: Key::Number(note),
                 velocity,
+                channel,
                 ..
-            } => self.performer.note_on(note, velocity),
+            } => p.note_on_channel(channel.number().unwrap_or(0), note, velocity),
             NoteEvent::NoteOff {
                 key: Key::Number(note),
                 ..
-            } => self.performer.note_off(note),
+            } => p.note_off(note),
             NoteEvent::NoteOff {
                 key: Key::Wildcard, ..
             }
-            | NoteEvent::Choke { .. } => self.performer.all_notes_off(),
-            NoteEvent::MidiPitchBend { value, .. } => self.performer.set_pitch_wheel(value),
-            NoteEvent::MidiCC { cc, value, .. } => self.performer.set_controller(cc, value),
-            NoteEvent::MidiChannelPressure { pressure, .. } => {
-                self.performer.set_pressure(pressure)
+            | NoteEvent::Choke { .. } => p.all_notes_off(),
+            NoteEvent::MidiPitchBend { channel, value, .. } => {
+                p.set_pitch_wheel_channel(channel, value)
             }
+            NoteEvent::MidiCC {
+                channel, cc, value, ..
+            } => p.set_controller_channel(channel, cc, value),
+            NoteEvent::MidiChannelPressure {
+                channel, pressure, ..
+            } => p.set_pressure_channel(channel, pressure),
+            // CLAP note expressions and polyphonic aftertouch, per note.
+            NoteEvent::PolyTuning {
+                key: Key::Number(note),
+                tuning,
+                ..
+            } => p.set_note_tuning(note, tuning),
+            NoteEvent::PolyPressure {
+                key: Key::Number(note),
+                pressure,
+                ..
+            } => p.set_note_pressure(note, pressure),
+            NoteEvent::PolyBrightness {
+                key: Key::Number(note),
+                brightness,
+                ..
+            } => p.set_note_brightness(note, brightness),
             _ => {}
         }
     }

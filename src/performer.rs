@@ -25,6 +25,7 @@
 //! ```
 
 pub mod direct;
+pub mod mpe;
 pub mod stroke;
 
 use crate::dsp::bridge_data::{self, BridgeModes};
@@ -39,6 +40,7 @@ use crate::dsp::thermal::ThermalString;
 use crate::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
 use crate::quality::{self, Quality};
 use direct::DirectBow;
+use mpe::{Handled, Mpe, NoteState};
 use stroke::{Stroke, StrokeMode};
 
 /// `sample_rate_hz` if it is a usable rate (finite, positive), else 48 kHz: the gesture
@@ -243,6 +245,19 @@ pub struct Performer {
     configured: bool,
     /// The bow of the last sample, as played (after the stroke and the dynamics).
     bow_now: BowControl,
+    /// MPE zones and channel expression ([`mpe`]).
+    mpe: Mpe,
+    /// Per key: the channel it was played on, the string it went to, and its own note
+    /// expressions.
+    notes: [NoteSlot; 128],
+}
+
+/// What the performer remembers of a key's note for its per-note expression.
+#[derive(Debug, Clone, Copy, Default)]
+struct NoteSlot {
+    channel: u8,
+    string: Option<u8>,
+    state: NoteState,
 }
 
 /// What the player's controllers ask of the bow and the finger (the performance layer):
@@ -342,6 +357,8 @@ impl Performer {
             steady: None,
             configured: false,
             bow_now: BowControl::default(),
+            mpe: Mpe::default(),
+            notes: [NoteSlot::default(); 128],
         }
     }
 
@@ -464,6 +481,17 @@ impl Performer {
     /// [`PORTAMENTO_BELOW_VELOCITY`], or any with CC65 down, glides the finger over the
     /// setup's glide time (the waveguide strings; the thermal model moves it at once).
     pub fn note_on(&mut self, note: u8, velocity: f32) {
+        self.note_on_channel(0, note, velocity);
+    }
+
+    /// A note on MIDI channel `channel` (0..=15): on an MPE member channel it takes that
+    /// channel's bend, pressure and timbre as its own ([`mpe`]).
+    pub fn note_on_channel(&mut self, channel: u8, note: u8, velocity: f32) {
+        self.notes[note as usize & 127] = NoteSlot {
+            channel: channel & 15,
+            string: None,
+            state: NoteState::default(),
+        };
         self.steady = None;
         let separate = !self.held.iter().any(|&h| h);
         // Portamento: a legato note played softly, or any legato note with CC65 down,
@@ -493,9 +521,10 @@ impl Performer {
                     Some(seconds) => self.instrument.note_on_gliding(note, seconds),
                     None => self.instrument.note_on(note),
                 };
-                if landed.is_some() {
+                if let Some(string) = landed {
                     self.held[key] = true;
                     self.last_note = Some(note);
+                    self.notes[key].string = Some(string as u8);
                 }
             }
             Source::Thermal(k) => {
@@ -504,9 +533,10 @@ impl Performer {
                 if let Some(engine) = self.thermal.get_mut(k) {
                     // A new node count fades the instrument out and lands the note after.
                     engine.set_settings(settings);
-                    if engine.note_on(note).is_some() {
+                    if let Some(string) = engine.note_on(note) {
                         self.held[key] = true;
                         self.last_note = Some(note);
+                        self.notes[key].string = Some(string as u8);
                     }
                 }
             }
@@ -517,7 +547,104 @@ impl Performer {
                 }
             }
         }
+        self.express(note);
         self.refresh_others();
+    }
+
+    /// Gives `note`'s string the note's expression: its MPE channel's, with its own note
+    /// expressions over it. Nothing for a note not held or on no string.
+    fn express(&mut self, note: u8) {
+        let key = note as usize & 127;
+        let slot = self.notes[key];
+        let (true, Some(string)) = (self.held[key], slot.string) else {
+            return;
+        };
+        let expression = slot.state.over(self.mpe.expression(slot.channel));
+        match self.source {
+            Source::Strings => self
+                .instrument
+                .set_note_expression(string as usize, expression),
+            Source::Thermal(k) => {
+                if let Some(engine) = self.thermal.get_mut(k) {
+                    engine.set_note_expression(string as usize, expression);
+                }
+            }
+            Source::Rubbed(_) => {}
+        }
+    }
+
+    /// Re-applies the expression of every held note on `channel` (`None`: every held
+    /// note).
+    fn express_channel(&mut self, channel: Option<u8>) {
+        for note in 0..128u8 {
+            let slot = &self.notes[note as usize];
+            if self.held[note as usize] && channel.is_none_or(|c| c == slot.channel) {
+                self.express(note);
+            }
+        }
+    }
+
+    /// The pitch-bend wheel (0..=1) on `channel`: an MPE member channel's bends its own
+    /// notes, any other channel's every note ([`Performer::set_pitch_wheel`]).
+    pub fn set_pitch_wheel_channel(&mut self, channel: u8, value: f32) {
+        if self.mpe.pitch_bend(channel, wheel_position(value)) {
+            self.express_channel(Some(channel));
+        } else {
+            self.set_pitch_wheel(value);
+        }
+    }
+
+    /// Channel pressure (0..=1) on `channel`: an MPE member channel's presses its own
+    /// notes' strings, any other's is the dynamics ([`Performer::set_pressure`]).
+    pub fn set_pressure_channel(&mut self, channel: u8, value: f32) {
+        if !value.is_finite() {
+            return;
+        }
+        if self.mpe.pressure(channel, value as f64) {
+            self.express_channel(Some(channel));
+        } else {
+            self.set_pressure(value);
+        }
+    }
+
+    /// A controller (0..=1) on `channel`: the MPE Configuration Message, and CC74 or
+    /// RPN 0 on a member channel, are MPE's ([`mpe`]); everything else is
+    /// [`Performer::set_controller`]'s.
+    pub fn set_controller_channel(&mut self, channel: u8, cc: u8, value: f32) {
+        if !value.is_finite() {
+            return;
+        }
+        match self.mpe.controller(channel, cc, value as f64) {
+            Handled::Shared => self.set_controller(cc, value),
+            Handled::Configured => self.express_channel(None),
+            Handled::Expression => self.express_channel(None),
+        }
+    }
+
+    /// A CLAP note expression: `note`'s tuning, semitones (its finger).
+    pub fn set_note_tuning(&mut self, note: u8, semitones: f32) {
+        if semitones.is_finite() {
+            self.notes[note as usize & 127].state.tuning_semitones = semitones as f64;
+            self.express(note);
+        }
+    }
+
+    /// A CLAP note expression (or polyphonic aftertouch): `note`'s pressure, 0..=1 (its
+    /// string's bow force, [`mpe::pressure_to_force_scale`]).
+    pub fn set_note_pressure(&mut self, note: u8, pressure: f32) {
+        if pressure.is_finite() {
+            self.notes[note as usize & 127].state.pressure = Some(pressure as f64);
+            self.express(note);
+        }
+    }
+
+    /// A CLAP note expression: `note`'s brightness, 0..=1 (its string's bow position,
+    /// [`mpe::timbre_to_position_scale`]).
+    pub fn set_note_brightness(&mut self, note: u8, brightness: f32) {
+        if brightness.is_finite() {
+            self.notes[note as usize & 127].state.brightness = Some(brightness as f64);
+            self.express(note);
+        }
     }
 
     pub fn note_off(&mut self, note: u8) {

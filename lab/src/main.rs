@@ -581,10 +581,12 @@ fn play_note(
     let events = [
         Timed {
             sample: 0,
+            channel: 0,
             event: MidiEvent::NoteOn(note, 100),
         },
         Timed {
             sample: at(lift),
+            channel: 0,
             event: MidiEvent::NoteOff(note),
         },
     ];

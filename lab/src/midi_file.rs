@@ -31,6 +31,8 @@ pub enum MidiEvent {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Timed {
     pub sample: u64,
+    /// MIDI channel, 0..=15 (MPE: a note's member channel carries its own expression).
+    pub channel: u8,
     pub event: MidiEvent,
 }
 
@@ -65,7 +67,7 @@ pub fn read_events(
     // chosen ones.
     enum Item {
         Tempo(u32),
-        Event(MidiEvent),
+        Event(u8, MidiEvent),
     }
     let mut items: Vec<(u64, usize, usize, Item)> = Vec::new();
     for (t, events) in smf.tracks.iter().enumerate() {
@@ -75,22 +77,26 @@ pub fn read_events(
             tick += e.delta.as_int() as u64;
             let item = match e.kind {
                 TrackEventKind::Meta(MetaMessage::Tempo(us)) => Some(Item::Tempo(us.as_int())),
-                TrackEventKind::Midi { message, .. } if wanted => match message {
-                    MidiMessage::NoteOn { key, vel } if vel.as_int() > 0 => {
-                        Some(Item::Event(MidiEvent::NoteOn(key.as_int(), vel.as_int())))
-                    }
-                    MidiMessage::NoteOn { key, .. } | MidiMessage::NoteOff { key, .. } => {
-                        Some(Item::Event(MidiEvent::NoteOff(key.as_int())))
-                    }
-                    MidiMessage::PitchBend { bend } => {
-                        Some(Item::Event(MidiEvent::PitchBend(bend.0.as_int())))
-                    }
+                TrackEventKind::Midi { channel, message } if wanted => match message {
+                    MidiMessage::NoteOn { key, vel } if vel.as_int() > 0 => Some(Item::Event(
+                        channel.as_int(),
+                        MidiEvent::NoteOn(key.as_int(), vel.as_int()),
+                    )),
+                    MidiMessage::NoteOn { key, .. } | MidiMessage::NoteOff { key, .. } => Some(
+                        Item::Event(channel.as_int(), MidiEvent::NoteOff(key.as_int())),
+                    ),
+                    MidiMessage::PitchBend { bend } => Some(Item::Event(
+                        channel.as_int(),
+                        MidiEvent::PitchBend(bend.0.as_int()),
+                    )),
                     MidiMessage::Controller { controller, value } => Some(Item::Event(
+                        channel.as_int(),
                         MidiEvent::Controller(controller.as_int(), value.as_int()),
                     )),
-                    MidiMessage::ChannelAftertouch { vel } => {
-                        Some(Item::Event(MidiEvent::Pressure(vel.as_int())))
-                    }
+                    MidiMessage::ChannelAftertouch { vel } => Some(Item::Event(
+                        channel.as_int(),
+                        MidiEvent::Pressure(vel.as_int()),
+                    )),
                     _ => None,
                 },
                 _ => None,
@@ -118,8 +124,9 @@ pub fn read_events(
                 tick_s = us.max(1) as f64 * 1e-6 / ticks_per_beat;
             }
             Item::Tempo(_) => {}
-            Item::Event(event) => out.push(Timed {
+            Item::Event(channel, event) => out.push(Timed {
                 sample: (seconds * sample_rate_hz).round() as u64,
+                channel,
                 event,
             }),
         }
@@ -180,17 +187,22 @@ pub fn perform(
             for i in 0..block as u64 {
                 let now = done + i;
                 while next < events.len() && events[next].sample <= now {
+                    let c = events[next].channel;
                     match events[next].event {
-                        MidiEvent::NoteOn(n, v) => performer.note_on(n, v as f32 / 127.0),
+                        MidiEvent::NoteOn(n, v) => {
+                            performer.note_on_channel(c, n, v as f32 / 127.0)
+                        }
                         MidiEvent::NoteOff(n) => performer.note_off(n),
                         MidiEvent::PitchBend(raw) => {
                             // As nice-plug hands it to the plugin: 0..1 in f32.
-                            performer.set_pitch_wheel(raw as f32 / 16383.0);
+                            performer.set_pitch_wheel_channel(c, raw as f32 / 16383.0);
                         }
                         MidiEvent::Controller(cc, v) => {
-                            performer.set_controller(cc, v as f32 / 127.0)
+                            performer.set_controller_channel(c, cc, v as f32 / 127.0)
                         }
-                        MidiEvent::Pressure(v) => performer.set_pressure(v as f32 / 127.0),
+                        MidiEvent::Pressure(v) => {
+                            performer.set_pressure_channel(c, v as f32 / 127.0)
+                        }
                     }
                     next += 1;
                 }

@@ -22,7 +22,11 @@ fn a_midi_file_rendered_offline_gives_the_plugins_bits() {
     // The same notes, bends and controllers, at the same samples and block size, through
     // the CLAP build in the host and through `colophony render --midi`'s performer.
     let bend = |amount: f64| (8192.0 + amount * 8192.0).round().clamp(0.0, 16383.0) as u16;
-    let at = |sample: u64, event: MidiEvent| Timed { sample, event };
+    let at = |sample: u64, event: MidiEvent| Timed {
+        sample,
+        channel: 0,
+        event,
+    };
     let events = [
         at(0, MidiEvent::NoteOn(50, 100)),
         at(24_000, MidiEvent::PitchBend(bend(0.5))),

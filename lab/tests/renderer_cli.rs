@@ -432,10 +432,12 @@ fn a_chosen_bridge_plays_through_the_plugins_thermal_instrument() {
     let events = [
         Timed {
             sample: 0,
+            channel: 0,
             event: MidiEvent::NoteOn(50, 100),
         },
         Timed {
             sample: 24_000,
+            channel: 0,
             event: MidiEvent::NoteOff(50),
         },
     ];

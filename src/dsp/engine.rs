@@ -13,7 +13,7 @@
 //! assert!(sound > 0.0);
 //! ```
 
-use super::instrument::{BowControl, Frame, Instrument};
+use super::instrument::{BowControl, Frame, Instrument, NoteExpression};
 use super::rubbed::RubbedInstrument;
 use super::thermal_instrument::ThermalInstrument;
 
@@ -26,6 +26,8 @@ pub trait Engine {
     fn all_notes_off(&mut self);
     /// Pitch bend, semitones (engines without pitch ignore it).
     fn set_pitch_bend(&mut self, _semitones: f64) {}
+    /// String `string`'s note's own expression (engines without strings ignore it).
+    fn set_note_expression(&mut self, _string: usize, _expression: NoteExpression) {}
     /// The string later notes go to (0 = lowest), `None` for the usual choice.
     fn set_preferred_string(&mut self, _string: Option<usize>) {}
     /// Reference pitch A4, Hz.
@@ -62,6 +64,9 @@ macro_rules! string_engine {
             }
             fn set_pitch_bend(&mut self, semitones: f64) {
                 <$t>::set_pitch_bend(self, semitones)
+            }
+            fn set_note_expression(&mut self, string: usize, expression: NoteExpression) {
+                <$t>::set_note_expression(self, string, expression)
             }
             fn set_preferred_string(&mut self, string: Option<usize>) {
                 <$t>::set_preferred_string(self, string)

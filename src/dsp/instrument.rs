@@ -241,6 +241,57 @@ pub struct Frame {
     pub friction_force_n: f64,
 }
 
+/// One note's own expression on top of the shared controls (MPE's per-channel bend,
+/// pressure and timbre; CLAP's note expressions): its finger's bend, how hard the bow
+/// presses on its string, and where on its string the bow plays.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NoteExpression {
+    /// Added to the shared pitch bend, semitones (the string's reach still limits it).
+    pub bend_semitones: f64,
+    /// Multiplies the bow force on this string (0..=[`MAX_NOTE_FORCE_SCALE`]).
+    pub force_scale: f64,
+    /// Multiplies the bow position beta on this string (the result within
+    /// [`MIN_NOTE_BETA`]..=[`MAX_NOTE_BETA`]).
+    pub position_scale: f64,
+}
+
+impl NoteExpression {
+    /// No expression of its own: the shared bow and bend.
+    pub const NEUTRAL: Self = Self {
+        bend_semitones: 0.0,
+        force_scale: 1.0,
+        position_scale: 1.0,
+    };
+
+    /// Takes `new` (sanitized) in place of this one; whether the bend changed (the
+    /// string must be retuned).
+    pub fn replace(&mut self, new: NoteExpression) -> bool {
+        let new = new.sanitized();
+        let bent = new.bend_semitones != self.bend_semitones;
+        *self = new;
+        bent
+    }
+
+    /// Finite and within the ranges above (a non-finite part stays neutral).
+    pub fn sanitized(self) -> Self {
+        let or = |x: f64, neutral: f64| if x.is_finite() { x } else { neutral };
+        Self {
+            bend_semitones: or(self.bend_semitones, 0.0)
+                .clamp(-MAX_NOTE_BEND_SEMITONES, MAX_NOTE_BEND_SEMITONES),
+            force_scale: or(self.force_scale, 1.0).clamp(0.0, MAX_NOTE_FORCE_SCALE),
+            position_scale: or(self.position_scale, 1.0).clamp(0.0, MAX_NOTE_BETA / MIN_NOTE_BETA),
+        }
+    }
+}
+
+/// The widest per-note bend, semitones: MPE's default member-channel range.
+pub const MAX_NOTE_BEND_SEMITONES: f64 = 48.0;
+/// The most a note's pressure may multiply its string's bow force.
+pub const MAX_NOTE_FORCE_SCALE: f64 = 4.0;
+/// A note's own bow position stays within the Bow Position parameter's range.
+pub const MIN_NOTE_BETA: f64 = 0.02;
+pub const MAX_NOTE_BETA: f64 = 0.5;
+
 #[derive(Debug, Clone)]
 struct StringVoice {
     string: WaveguideString,
@@ -254,6 +305,8 @@ struct StringVoice {
     /// and the change per retune.
     glide: f64,
     glide_step: f64,
+    /// The note's own expression ([`NoteExpression::NEUTRAL`] until one arrives).
+    expression: NoteExpression,
 }
 
 /// Samples between two retunes of a gliding finger (1.3 ms at 48 kHz).
@@ -309,6 +362,7 @@ impl Instrument {
             awake: false,
             glide: 0.0,
             glide_step: 0.0,
+            expression: NoteExpression::NEUTRAL,
         });
         Self {
             kind,
@@ -375,9 +429,10 @@ impl Instrument {
     /// `None` if the instrument cannot play the note (it is then ignored).
     pub fn note_on(&mut self, note: u8) -> Option<usize> {
         let index = self.kind.string_for_note_on(note, self.preferred_string)?;
+        self.voices[index].expression = NoteExpression::NEUTRAL;
+        self.voices[index].glide = 0.0;
         let hz = self.tuned_hz(index, note);
         let voice = &mut self.voices[index];
-        voice.glide = 0.0;
         voice.string.stop_at(hz);
         voice.note = Some(note);
         voice.bowed = true;
@@ -472,6 +527,26 @@ impl Instrument {
         self.retune();
     }
 
+    /// Gives string `index` its note's own expression (sanitized; see
+    /// [`NoteExpression`]); a changed bend retunes it at once. A new note on the string
+    /// starts neutral again.
+    pub fn set_note_expression(&mut self, index: usize, expression: NoteExpression) {
+        let Some(voice) = self.voices.get_mut(index) else {
+            return;
+        };
+        if let (true, Some(note)) = (voice.expression.replace(expression), voice.note) {
+            let hz = self.tuned_hz(index, note);
+            self.voices[index].string.bend_to(hz);
+        }
+    }
+
+    /// String `index`'s note expression.
+    pub fn note_expression(&self, index: usize) -> NoteExpression {
+        self.voices
+            .get(index)
+            .map_or(NoteExpression::NEUTRAL, |v| v.expression)
+    }
+
     /// Tunes every note from the reference pitch `a4_hz` (415..466 Hz; see
     /// [`reference_semitones`]); sounding notes follow at once.
     pub fn set_reference_pitch(&mut self, a4_hz: f64) {
@@ -502,7 +577,9 @@ impl Instrument {
             self.kind,
             string,
             note,
-            self.bend_semitones + self.voices[string].glide,
+            self.bend_semitones
+                + self.voices[string].glide
+                + self.voices[string].expression.bend_semitones,
             self.reference_semitones,
         )
     }
@@ -621,10 +698,19 @@ impl Instrument {
                     (voice.bow_gain - self.ramp_step).max(0.0)
                 };
             }
-            voice.string.set_bow_position(bow.position_beta);
+            let e = &voice.expression;
+            let (force, beta) = if *e == NoteExpression::NEUTRAL {
+                (bow.force_n, bow.position_beta)
+            } else {
+                (
+                    bow.force_n * e.force_scale,
+                    (bow.position_beta * e.position_scale).clamp(MIN_NOTE_BETA, MAX_NOTE_BETA),
+                )
+            };
+            voice.string.set_bow_position(beta);
             let input = BowInput {
                 velocity_m_per_s: bow.velocity_m_per_s,
-                normal_force_n: bow.force_n * voice.bow_gain,
+                normal_force_n: force * voice.bow_gain,
             };
             let out = voice.string.tick(&mut voice.contact, input);
             bridge += out.bridge_force_n;

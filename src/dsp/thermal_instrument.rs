@@ -47,9 +47,9 @@
 use super::bridge::{solve_junction, BridgeMode, ModalBridge};
 use super::filters::flush_tiny;
 use super::instrument::{
-    midi_to_hz, reference_semitones, BowControl, Frame, InstrumentKind, BOW_RAMP_S,
-    HIGHEST_TUNING_SEMITONES, LOWEST_TUNING_SEMITONES, MAX_BEND_RANGE_SEMITONES, SLEEP_ENERGY_J,
-    STRINGS,
+    midi_to_hz, reference_semitones, BowControl, Frame, InstrumentKind, NoteExpression, BOW_RAMP_S,
+    HIGHEST_TUNING_SEMITONES, LOWEST_TUNING_SEMITONES, MAX_BEND_RANGE_SEMITONES, MAX_NOTE_BETA,
+    MIN_NOTE_BETA, SLEEP_ENERGY_J, STRINGS,
 };
 use super::intonation::{self, IntonationTable};
 use super::resample::Resampler;
@@ -108,12 +108,25 @@ impl ThermalSettings {
     }
 }
 
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy)]
 struct Voice {
     note: Option<u8>,
     bowed: bool,
     /// Bow envelope, 0 (lifted) to 1 (full force).
     bow_gain: f64,
+    /// The note's own expression (neutral until one arrives).
+    expression: NoteExpression,
+}
+
+impl Default for Voice {
+    fn default() -> Self {
+        Self {
+            note: None,
+            bowed: false,
+            bow_gain: 0.0,
+            expression: NoteExpression::NEUTRAL,
+        }
+    }
 }
 
 /// The strings and bridge at the internal rate.
@@ -429,8 +442,10 @@ impl ThermalInstrument {
     /// play it with this bow.
     pub fn note_on(&mut self, note: u8) -> Option<usize> {
         let index = self.kind.string_for_note_on(note, self.preferred_string)?;
+        let before = std::mem::replace(&mut self.voices[index].expression, NoteExpression::NEUTRAL);
         let f0 = self.tuned_hz(index, note);
         if !self.tune(index, f0) {
+            self.voices[index].expression = before;
             return None;
         }
         let voice = &mut self.voices[index];
@@ -476,6 +491,21 @@ impl ThermalInstrument {
         self.retune();
     }
 
+    /// Gives string `index` its note's own expression (sanitized; see [`NoteExpression`]):
+    /// a changed bend retunes it (a bend the bow cannot follow lifts it, as the shared
+    /// bend does). A new note on the string starts neutral again.
+    pub fn set_note_expression(&mut self, index: usize, expression: NoteExpression) {
+        let Some(voice) = self.voices.get_mut(index) else {
+            return;
+        };
+        if let (true, Some(note)) = (voice.expression.replace(expression), voice.note) {
+            let f0 = self.tuned_hz(index, note);
+            if !self.tune(index, f0) {
+                self.voices[index].bowed = false;
+            }
+        }
+    }
+
     /// Tunes every note from the reference pitch `a4_hz` (415..466 Hz; see
     /// [`reference_semitones`]); sounding notes follow at once.
     pub fn set_reference_pitch(&mut self, a4_hz: f64) {
@@ -496,7 +526,7 @@ impl ThermalInstrument {
             self.kind,
             string,
             note,
-            self.bend_semitones,
+            self.bend_semitones + self.voices[string].expression.bend_semitones,
             self.reference_semitones,
         )
     }
@@ -634,10 +664,20 @@ impl ThermalInstrument {
                     (voice.bow_gain - self.ramp_step).max(0.0)
                 };
             }
-            *control = ThermalBowControl {
-                velocity_m_per_s: bow.velocity_m_per_s,
-                force_per_m: force_per_m * voice.bow_gain,
-                position_beta: bow.position_beta,
+            let e = &voice.expression;
+            *control = if *e == NoteExpression::NEUTRAL {
+                ThermalBowControl {
+                    velocity_m_per_s: bow.velocity_m_per_s,
+                    force_per_m: force_per_m * voice.bow_gain,
+                    position_beta: bow.position_beta,
+                }
+            } else {
+                ThermalBowControl {
+                    velocity_m_per_s: bow.velocity_m_per_s,
+                    force_per_m: force_per_m * e.force_scale * voice.bow_gain,
+                    position_beta: (bow.position_beta * e.position_scale)
+                        .clamp(MIN_NOTE_BETA, MAX_NOTE_BETA),
+                }
             };
         }
         let mut out = [0.0];

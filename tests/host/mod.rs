@@ -23,7 +23,9 @@ use clack_extensions::note_ports::{NoteDialects, NotePortInfoBuffer, PluginNoteP
 use clack_extensions::params::{ParamInfoBuffer, PluginParams};
 use clack_extensions::state::PluginState;
 use clack_extensions::tail::{PluginTail, TailLength};
-use clack_host::events::event_types::{MidiEvent, NoteOffEvent, NoteOnEvent, ParamValueEvent};
+use clack_host::events::event_types::{
+    MidiEvent, NoteExpressionEvent, NoteExpressionType, NoteOffEvent, NoteOnEvent, ParamValueEvent,
+};
 use clack_host::events::Match;
 use clack_host::prelude::*;
 use std::ffi::CString;
@@ -84,6 +86,13 @@ pub enum Event {
     /// Pitch-bend wheel position, -1 (down) ..= 1 (up), sent as a 14-bit MIDI pitch bend.
     PitchBend {
         amount: f64,
+    },
+    /// Any three-byte MIDI message (status with its channel, two data bytes).
+    Midi([u8; 3]),
+    /// A CLAP note expression: the tuning of `key`'s note, semitones.
+    Tuning {
+        key: u8,
+        semitones: f64,
     },
     /// A parameter change in CLAP units (see [`HostedPlugin::plain`]).
     Param {
@@ -543,6 +552,13 @@ fn push_event(buffer: &mut EventBuffer, t: u32, event: Event, port: u16, clap_no
         Event::Param { id, value } => {
             buffer.push(&ParamValueEvent::new(t, id, Pckn::match_all(), value))
         }
+        Event::Midi(bytes) => buffer.push(&MidiEvent::new(t, port, bytes)),
+        Event::Tuning { key, semitones } => buffer.push(&NoteExpressionEvent::new(
+            t,
+            Pckn::new(port, 0u16, key as u16, Match::All),
+            NoteExpressionType::Tuning,
+            semitones,
+        )),
     }
 }
 
