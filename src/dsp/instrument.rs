@@ -307,6 +307,8 @@ struct StringVoice {
     glide_step: f64,
     /// The note's own expression ([`NoteExpression::NEUTRAL`] until one arrives).
     expression: NoteExpression,
+    /// Whether it is not neutral (one test per sample instead of three).
+    expressive: bool,
 }
 
 /// Samples between two retunes of a gliding finger (1.3 ms at 48 kHz).
@@ -363,6 +365,7 @@ impl Instrument {
             glide: 0.0,
             glide_step: 0.0,
             expression: NoteExpression::NEUTRAL,
+            expressive: false,
         });
         Self {
             kind,
@@ -430,6 +433,7 @@ impl Instrument {
     pub fn note_on(&mut self, note: u8) -> Option<usize> {
         let index = self.kind.string_for_note_on(note, self.preferred_string)?;
         self.voices[index].expression = NoteExpression::NEUTRAL;
+        self.voices[index].expressive = false;
         self.voices[index].glide = 0.0;
         let hz = self.tuned_hz(index, note);
         let voice = &mut self.voices[index];
@@ -534,7 +538,9 @@ impl Instrument {
         let Some(voice) = self.voices.get_mut(index) else {
             return;
         };
-        if let (true, Some(note)) = (voice.expression.replace(expression), voice.note) {
+        let bent = voice.expression.replace(expression);
+        voice.expressive = voice.expression != NoteExpression::NEUTRAL;
+        if let (true, Some(note)) = (bent, voice.note) {
             let hz = self.tuned_hz(index, note);
             self.voices[index].string.bend_to(hz);
         }
@@ -699,7 +705,7 @@ impl Instrument {
                 };
             }
             let e = &voice.expression;
-            let (force, beta) = if *e == NoteExpression::NEUTRAL {
+            let (force, beta) = if !voice.expressive {
                 (bow.force_n, bow.position_beta)
             } else {
                 (
