@@ -387,8 +387,11 @@ impl Performer {
                     shipped = bridge_data::shipped_cello_bridge();
                     &shipped
                 }
-                // The viola borrows the violin's generic bridge (no viola data shipped).
-                (None, InstrumentKind::Violin | InstrumentKind::Viola) => {
+                (None, InstrumentKind::Viola) => {
+                    shipped = bridge_data::shipped_viola_bridge();
+                    &shipped
+                }
+                (None, InstrumentKind::Violin) => {
                     shipped = bridge_data::shipped_violin_bridge();
                     &shipped
                 }

@@ -312,10 +312,8 @@ pub fn render_cell(cell: &Cell) -> Result<(Vec<f64>, Vec<ContactSample>), String
 fn thermal_bridge(kind: InstrumentKind) -> crate::admittance_fit::BridgeModes {
     match kind {
         InstrumentKind::Cello => crate::admittance_fit::shipped_cello_bridge(),
-        // The viola borrows the violin's generic bridge, as in the plugin.
-        InstrumentKind::Violin | InstrumentKind::Viola => {
-            crate::admittance_fit::shipped_violin_bridge()
-        }
+        InstrumentKind::Viola => colophony::dsp::bridge_data::shipped_viola_bridge(),
+        InstrumentKind::Violin => crate::admittance_fit::shipped_violin_bridge(),
     }
 }
 

@@ -421,13 +421,17 @@ fn cli_figure_bridge_fit_draws_data_against_model() {
 }
 
 /// The shipped generic bridges: `COLOPHONY_BLESS_BRIDGES=1 cargo test --test bridge_fit
-/// shipped` regenerates `assets/bridges/{cello,violin}-synthetic.csv`, the fitted
-/// `{cello,violin}-generic.json` and `docs/bridge-fit-cello.png`; without it, the test
+/// shipped` regenerates `assets/bridges/{cello,violin,viola}-synthetic.csv`, the fitted
+/// `{cello,violin,viola}-generic.json` and `docs/bridge-fit-cello.png`; without it, the test
 /// checks that the shipped files are what that would produce.
 #[test]
 fn shipped_generic_bridges_are_passive_fits_of_their_synthetic_source() {
     let bless = std::env::var_os("COLOPHONY_BLESS_BRIDGES").is_some();
-    for inst in [GenericInstrument::Cello, GenericInstrument::Violin] {
+    for inst in [
+        GenericInstrument::Cello,
+        GenericInstrument::Violin,
+        GenericInstrument::Viola,
+    ] {
         let name = inst.name();
         let csv = repo(&format!("assets/bridges/{name}-synthetic.csv"));
         let json = repo(&format!("assets/bridges/{name}-generic.json"));

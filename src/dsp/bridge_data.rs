@@ -202,6 +202,18 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), String> {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn the_viola_has_a_bridge_of_its_own_below_the_violins() {
+        // A larger body: its air mode (the lowest) below the violin's, above the cello's.
+        let lowest = |b: BridgeModes| b.modes.iter().map(|m| m.freq_hz).fold(f64::MAX, f64::min);
+        let (violin, viola, cello) = (
+            lowest(shipped_violin_bridge()),
+            lowest(shipped_viola_bridge()),
+            lowest(shipped_cello_bridge()),
+        );
+        assert!(cello < viola && viola < violin, "{cello} {viola} {violin}");
+    }
+
     use super::*;
 
     #[test]
@@ -261,6 +273,13 @@ mod tests {
 pub fn shipped_cello_bridge() -> BridgeModes {
     parse_bridge(include_str!("../../assets/bridges/cello-generic.json"))
         .expect("the shipped cello bridge is valid")
+        .0
+}
+
+/// The shipped generic viola bridge, `assets/bridges/viola-generic.json`.
+pub fn shipped_viola_bridge() -> BridgeModes {
+    parse_bridge(include_str!("../../assets/bridges/viola-generic.json"))
+        .expect("the shipped viola bridge is valid")
         .0
 }
 

@@ -180,6 +180,24 @@ pub const VIOLIN_GENERIC: [GenericMode; 14] = [
     row(4500.0, 8.0, 0.2, -40.0),
 ];
 
+/// Generic viola: the violin's table with every frequency times 0.84 and every peak
+/// admittance times 0.7 (a body about 15 % longer and heavier: A0 ~ 230 Hz, B1- ~ 395 Hz,
+/// B1+ ~ 455 Hz, the bridge hill near 2 kHz); chosen, not measured, like the others.
+pub const VIOLA_GENERIC: [GenericMode; 14] = {
+    let mut table = VIOLIN_GENERIC;
+    let mut i = 0;
+    while i < table.len() {
+        table[i].freq_hz *= VIOLA_FREQUENCY_SCALE;
+        table[i].peak_s_per_kg *= VIOLA_ADMITTANCE_SCALE;
+        i += 1;
+    }
+    table
+};
+/// The viola's frequencies over the violin's.
+pub const VIOLA_FREQUENCY_SCALE: f64 = 0.84;
+/// The viola's peak admittances over the violin's.
+pub const VIOLA_ADMITTANCE_SCALE: f64 = 0.7;
+
 /// A table as modes: gain `g (0.9 u u^T + 0.1 I)` with `u` the unit direction, so every
 /// gain is PSD with a 10 % isotropic part, and `g = peak 2 pi b`, so that the admittance
 /// along `u` (`u^T G u / (2 pi b)` at resonance) peaks at `peak_s_per_kg`.
@@ -210,14 +228,16 @@ pub fn generic_modes(table: &[GenericMode]) -> BridgeModes {
 pub enum GenericInstrument {
     Cello,
     Violin,
+    Viola,
 }
 
 impl GenericInstrument {
-    /// The file stem under `assets/bridges/`: `cello` or `violin`.
+    /// The file stem under `assets/bridges/`: `cello`, `violin` or `viola`.
     pub fn name(self) -> &'static str {
         match self {
             GenericInstrument::Cello => "cello",
             GenericInstrument::Violin => "violin",
+            GenericInstrument::Viola => "viola",
         }
     }
 
@@ -226,15 +246,18 @@ impl GenericInstrument {
         match self {
             GenericInstrument::Cello => generic_modes(&CELLO_GENERIC),
             GenericInstrument::Violin => generic_modes(&VIOLIN_GENERIC),
+            GenericInstrument::Viola => generic_modes(&VIOLA_GENERIC),
         }
     }
 
     /// The synthetic 2x2 measurement: 800 log-spaced points (cello 50-5000 Hz, violin
-    /// 150-8000 Hz) with 1 % complex noise (seed 1 for the cello, 2 for the violin).
+    /// 150-8000 Hz, viola 120-7000 Hz) with 1 % complex noise (seed 1 for the cello, 2 for
+    /// the violin, 3 for the viola).
     pub fn synthetic_data(self) -> AdmittanceData {
         let (lo, hi, seed) = match self {
             GenericInstrument::Cello => (50.0, 5000.0, 1),
             GenericInstrument::Violin => (150.0, 8000.0, 2),
+            GenericInstrument::Viola => (120.0, 7000.0, 3),
         };
         let mut data = sample(&self.modes(), 2, &log_grid_hz(lo, hi, 800));
         add_relative_noise(&mut data, 0.01, seed);
