@@ -17,6 +17,7 @@ pub mod params;
 pub mod performer;
 pub mod presets;
 pub mod quality;
+pub mod user_bridges;
 
 use dsp::instrument::{BowControl, InstrumentKind};
 use nice_plug::midi::Key;
@@ -150,9 +151,25 @@ impl Plugin for Colophony {
     ) -> bool {
         // Every buffer is sized here, never in `process`.
         let fs = buffer_config.sample_rate as f64;
+        // The bridges saved with the project (a damaged one plays the shipped bridge).
+        let (bridges, problems) = user_bridges::saved_modes(&self.params.user_bridges);
+        for problem in problems {
+            nice_log!("{problem}");
+        }
+        for (kind, bridge) in InstrumentKind::ALL.into_iter().zip(bridges) {
+            self.performer.set_user_bridge(kind, bridge);
+        }
         if let Err(e) = self.performer.activate(&self.params.setup(), fs) {
-            nice_log!("{e}");
-            return false;
+            // A chosen bridge the thermal model cannot run at this rate: never refuse the
+            // host for it, play the shipped bridges instead.
+            nice_log!("{e}; playing the shipped bridges");
+            for kind in InstrumentKind::ALL {
+                self.performer.set_user_bridge(kind, None);
+            }
+            if let Err(e) = self.performer.activate(&self.params.setup(), fs) {
+                nice_log!("{e}");
+                return false;
+            }
         }
         self.editor_link.scope.set_sample_rate(fs as f32);
         true

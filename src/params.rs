@@ -242,6 +242,10 @@ pub struct ColophonyParams {
     /// The editor window's size, saved with the plugin state (not a parameter).
     #[persist = "editor-state"]
     pub editor_state: crate::editor::EditorState,
+    /// The bridges chosen for the thermal instruments, saved with the project
+    /// ([`crate::user_bridges`]; not a parameter).
+    #[persist = "user-bridges"]
+    pub user_bridges: crate::user_bridges::UserBridges,
     /// The state's version, for migrations ([`crate::presets::migrate_state`]).
     #[persist = "state-version"]
     pub state_version: crate::presets::StateVersion,
@@ -377,6 +381,7 @@ impl Default for ColophonyParams {
             .with_step_size(0.01)
             .with_value_to_string(formatters::v2s_f32_rounded(2)),
             editor_state: Default::default(),
+            user_bridges: Default::default(),
             state_version: crate::presets::StateVersion,
         }
     }

@@ -2,11 +2,12 @@
 //! nice-plug `ParamSetter`, whose host side (`GuiContextInner`) is a recorder that logs every
 //! begin/set/end call and applies the values to the parameters as a host would.
 
+use colophony::editor::bridge::{BRIDGE_FILE_LABEL, LOAD_BRIDGE_LABEL, SHIPPED_BRIDGE_LABEL};
 use colophony::editor::live::ContactSample;
 use colophony::editor::mapping::PadMapping;
 use colophony::editor::nodes::NodeRecord;
 use colophony::editor::pad::{pad_value_text, PAD_LABEL};
-use colophony::editor::presets::{PRESET_LABEL, SAVE_LABEL};
+use colophony::editor::presets::{PRESET_LABEL, PRESET_NAME_LABEL, SAVE_LABEL};
 use colophony::editor::view::THERMAL_LABEL;
 use colophony::editor::{EditorLink, EditorUi};
 use colophony::params::{
@@ -32,6 +33,7 @@ enum Call {
 struct Recorder {
     calls: Mutex<Vec<Call>>,
     states: Mutex<Vec<PluginState>>,
+    restarts: Mutex<usize>,
 }
 
 impl Recorder {
@@ -95,7 +97,9 @@ impl GuiContextInner for Recorder {
         self.states.lock().unwrap().push(state);
     }
 
-    fn request_restart(&self) {}
+    fn request_restart(&self) {
+        *self.restarts.lock().unwrap() += 1;
+    }
 }
 
 struct Fixture {
@@ -522,9 +526,11 @@ fn saving_a_preset_writes_the_current_values_to_the_user_folder() {
     f.editor.presets_mut().set_user_dir(Some(dir.clone()));
     {
         let mut h = harness(&mut f.editor);
-        h.get_by_role(egui::Role::TextInput).click();
+        h.get_by_role_and_label(egui::Role::TextInput, PRESET_NAME_LABEL)
+            .click();
         h.run();
-        h.get_by_role(egui::Role::TextInput).type_text("My bow");
+        h.get_by_role_and_label(egui::Role::TextInput, PRESET_NAME_LABEL)
+            .type_text("My bow");
         h.run();
         h.get_by_label(SAVE_LABEL).click();
         h.run();
@@ -536,4 +542,72 @@ fn saving_a_preset_writes_the_current_values_to_the_user_folder() {
         format!("{:?}", served_state().params)
     );
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn loading_a_bridge_keeps_it_in_the_project_and_restarts_and_a_bad_file_changes_nothing() {
+    let cello = colophony::dsp::instrument::InstrumentKind::Cello;
+    let fitted = workspace_file("assets/bridges/violin-generic.json");
+    let broken = std::env::temp_dir().join(format!(
+        "colophony-broken-bridge-{}.json",
+        std::process::id()
+    ));
+    std::fs::write(&broken, "{").unwrap();
+    let broken = broken.to_string_lossy().into_owned();
+    for (path, loads, error) in [
+        ("/no/such/bridge.json", false, "cannot read"),
+        (broken.as_str(), false, "not a bridge JSON file"),
+        (fitted.as_str(), true, ""),
+    ] {
+        let mut f = fixture();
+        unsafe {
+            f.params
+                .friction_model
+                .as_ptr()
+                ._internal_set_normalized_value(
+                    f.params
+                        .friction_model
+                        .preview_normalized(FrictionChoice::Thermal),
+                );
+        }
+        {
+            let mut h = harness(&mut f.editor);
+            h.get_by_role_and_label(egui::Role::TextInput, BRIDGE_FILE_LABEL)
+                .click();
+            h.run();
+            h.get_by_role_and_label(egui::Role::TextInput, BRIDGE_FILE_LABEL)
+                .type_text(path);
+            h.run();
+            h.get_by_label(LOAD_BRIDGE_LABEL).click();
+            h.run();
+        }
+        let chosen = colophony::user_bridges::chosen_name(&f.params.user_bridges, cello);
+        let restarts = *f.recorder.restarts.lock().unwrap();
+        let status = f.editor.bridge_status().unwrap_or_default().to_owned();
+        if loads {
+            assert_eq!(chosen.as_deref(), Some("violin-generic.json"), "{status}");
+            assert_eq!(restarts, 1);
+            // And back to the shipped bridge: one more restart.
+            let mut h = harness(&mut f.editor);
+            h.get_by_label(SHIPPED_BRIDGE_LABEL).click();
+            h.run();
+            drop(h);
+            assert_eq!(
+                colophony::user_bridges::chosen_name(&f.params.user_bridges, cello),
+                None
+            );
+            assert_eq!(*f.recorder.restarts.lock().unwrap(), 2);
+        } else {
+            assert_eq!(chosen, None, "{path}: the shipped bridge stays");
+            assert_eq!(restarts, 0);
+            assert!(status.contains(error), "{path}: {status}");
+        }
+    }
+}
+
+fn workspace_file(path: &str) -> String {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join(path)
+        .to_string_lossy()
+        .into_owned()
 }

@@ -1013,3 +1013,58 @@ fn a_clap_tuning_expression_bends_its_note_only() {
         );
     }
 }
+
+/// A saved state of the thermal cello with `bridges` (the `user-bridges` field's value)
+/// loaded into a fresh instance, which then bows D3 for 0.3 s.
+fn thermal_cello_with_saved_bridges(bridges: &serde_json::Value) -> Vec<f32> {
+    let mut first = active_plugin(FS, BLOCK);
+    let setup = Score::new().at(0, first.text("Friction Model", "Thermal (paper B)"));
+    first.render(BLOCK, BLOCK, &setup);
+    let bytes = first.save_state();
+    let mut state: serde_json::Value = serde_json::from_slice(&bytes[8..]).unwrap();
+    state["fields"]["user-bridges"] = serde_json::Value::String(bridges.to_string());
+    let json = serde_json::to_vec(&state).unwrap();
+    let mut saved = (json.len() as u64).to_le_bytes().to_vec();
+    saved.extend_from_slice(&json);
+    let mut plugin = HostedPlugin::load_test_build();
+    plugin.load_state(&saved).expect("state refused");
+    plugin.activate(FS, BLOCK);
+    let out = plugin.render(
+        secs(0.3, FS) as usize,
+        BLOCK,
+        &Score::new().at(0, Event::note_on(50)),
+    );
+    out[0].clone()
+}
+
+#[test]
+fn a_bridge_saved_with_the_project_plays_and_a_damaged_one_plays_the_shipped_bridge() {
+    let violin =
+        std::fs::read_to_string(workspace_root().join("assets/bridges/violin-generic.json"))
+            .unwrap();
+    let shipped = thermal_cello_with_saved_bridges(&serde_json::json!({}));
+    let chosen = thermal_cello_with_saved_bridges(&serde_json::json!({
+        "cello": { "name": "violin-generic.json", "json": violin }
+    }));
+    let damaged = thermal_cello_with_saved_bridges(&serde_json::json!({
+        "cello": { "name": "gone.json", "json": "{ not a bridge" }
+    }));
+    for out in [&shipped, &chosen, &damaged] {
+        assert!(out.iter().all(|x| x.is_finite()));
+        assert!(
+            rms(&out.iter().map(|&x| x as f64).collect::<Vec<_>>()) > 1e-3,
+            "silent"
+        );
+    }
+    // The violin's bridge under the cello's strings sounds different from the cello's own.
+    let diff: Vec<f64> = shipped
+        .iter()
+        .zip(&chosen)
+        .map(|(a, b)| (a - b) as f64)
+        .collect();
+    assert!(rms(&diff) > 1e-3, "the saved bridge did not play");
+    assert_eq!(
+        damaged, shipped,
+        "a damaged saved bridge plays the shipped one"
+    );
+}

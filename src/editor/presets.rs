@@ -14,6 +14,8 @@ use std::path::PathBuf;
 
 /// The selector's accessible label.
 pub const PRESET_LABEL: &str = "Preset";
+/// The name field's label.
+pub const PRESET_NAME_LABEL: &str = "Save as";
 /// The save button's label.
 pub const SAVE_LABEL: &str = "Save preset";
 
@@ -115,11 +117,13 @@ impl PresetBar {
                 Err(e) => self.status = Some(format!("{}: {e}", preset.name)),
             }
         }
+        let label = ui.label(PRESET_NAME_LABEL).id;
         ui.add(
             egui::TextEdit::singleline(&mut self.save_name)
                 .hint_text("name")
                 .desired_width(110.0),
-        );
+        )
+        .labelled_by(label);
         let can_save = !self.save_name.trim().is_empty() && self.user_dir.is_some();
         if ui
             .add_enabled(can_save, egui::Button::new(SAVE_LABEL))

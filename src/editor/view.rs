@@ -3,6 +3,7 @@
 //! numbers. [`EditorUi::ui`] draws one frame into any `egui::Ui`, which is how the editor
 //! tests drive it without a window.
 
+use super::bridge::BridgeBar;
 use super::live::{paint_friction_loop, paint_velocity_trace, ContactSample, SCOPE_LEN};
 use super::mapping::SchellengWindow;
 use super::nodes::{paint_slip_image, paint_temperature_profile, NodeRecord, RING_LEN};
@@ -56,6 +57,8 @@ pub struct EditorUi {
     records: Vec<NodeRecord>,
     /// The preset selector and "save as".
     presets: PresetBar,
+    /// The thermal model's bridge.
+    bridge: BridgeBar,
 }
 
 impl EditorUi {
@@ -70,7 +73,13 @@ impl EditorUi {
             detected: None,
             records: Vec::with_capacity(RING_LEN),
             presets: PresetBar::default(),
+            bridge: BridgeBar::default(),
         }
+    }
+
+    /// The bridge row's last message (an error, or what was loaded).
+    pub fn bridge_status(&self) -> Option<&str> {
+        self.bridge.status()
     }
 
     /// The preset selector and "save as" (to choose another user preset folder).
@@ -168,6 +177,11 @@ impl EditorUi {
             ui.checkbox(&mut self.live, "Live views");
         });
         ui.horizontal_wrapped(|ui| self.presets.show(ui, &context));
+        if params.friction_model.value() == FrictionChoice::Thermal
+            && params.resonator.value() == ResonatorChoice::Strings
+        {
+            ui.horizontal_wrapped(|ui| self.bridge.show(ui, &params, &context));
+        }
         ui.separator();
 
         if self.live {
