@@ -207,6 +207,7 @@ impl Plugin for Colophony {
             }
             self.performer.skip(buffer.samples(), p.bow());
             self.editor_link.set_note(self.performer.last_note());
+            self.editor_link.set_played_bow(None);
             return host_status(self.performer.status(buffer.samples()));
         }
         for (sample, mut channels) in buffer.iter_samples().enumerate() {
@@ -241,6 +242,7 @@ impl Plugin for Colophony {
             next_event = context.next_event();
         }
         self.editor_link.set_note(self.performer.last_note());
+        self.editor_link.set_played_bow(self.performer.bowed_bow());
         host_status(self.performer.status(buffer.samples()))
     }
 }

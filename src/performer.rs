@@ -967,6 +967,15 @@ impl Performer {
         self.bow_now
     }
 
+    /// The bow as played (velocity m/s, force N, as [`Performer::bow`]) while a key is
+    /// held, `None` otherwise: what the editor marks on its pad.
+    pub fn bowed_bow(&self) -> Option<(f32, f32)> {
+        self.held.iter().any(|&h| h).then_some((
+            self.bow_now.velocity_m_per_s as f32,
+            self.bow_now.force_n as f32,
+        ))
+    }
+
     /// What the notes play now.
     pub fn source(&self) -> Source {
         self.source
@@ -1085,6 +1094,26 @@ mod tests {
         p.activate(&setup, FS).unwrap();
         p.configure(&setup);
         p
+    }
+
+    #[test]
+    fn the_bow_as_played_follows_the_dynamics_and_is_none_when_lifted() {
+        let mut p = cello();
+        assert_eq!(p.bowed_bow(), None);
+        p.set_controller(11, 0.5);
+        p.note_on(50, 0.8);
+        let bow = BowControl::default();
+        for _ in 0..(0.5 * FS) as usize {
+            p.tick(bow);
+        }
+        let (v, f) = p.bowed_bow().unwrap();
+        // Half expression is half the range down, on both (smoothing and the attack have
+        // settled after 0.5 s; 1e-6 is f32 rounding).
+        let scale = 10f64.powf(-DYNAMICS_RANGE_DB * 0.5 / 20.0);
+        assert!(((v as f64).abs() / 0.1 - scale).abs() < 1e-6, "{v}");
+        assert!((f as f64 / 1.0 - scale).abs() < 1e-6, "{f}");
+        p.note_off(50);
+        assert_eq!(p.bowed_bow(), None);
     }
 
     /// Bows cello D3 at the defaults with the expression at `e` from the start; returns

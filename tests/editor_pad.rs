@@ -611,3 +611,30 @@ fn workspace_file(path: &str) -> String {
         .to_string_lossy()
         .into_owned()
 }
+
+#[test]
+fn the_pad_marks_the_bow_as_played_where_it_leaves_the_parameters() {
+    let mut f = fixture();
+    // The performer plays the default bow scaled by the dynamics (CC11 at half): slower
+    // and lighter than the parameters say.
+    f.link.set_played_bow(Some((0.03, 0.3)));
+    {
+        let _h = harness(&mut f.editor);
+    }
+    assert_eq!(f.editor.pad().played_marker(), Some((0.03, 0.3)));
+    // On the handle, or with no bow on a string: no marker.
+    f.link.set_played_bow(Some((0.1, 1.0)));
+    {
+        let _h = harness(&mut f.editor);
+    }
+    assert_eq!(f.editor.pad().played_marker(), None);
+    f.link.set_played_bow(None);
+    {
+        let _h = harness(&mut f.editor);
+    }
+    assert_eq!(f.editor.pad().played_marker(), None);
+    assert!(
+        f.recorder.calls().is_empty(),
+        "marking sends nothing to the host"
+    );
+}

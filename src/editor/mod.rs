@@ -135,6 +135,9 @@ impl<'a> PersistentField<'a, EditorSize> for EditorState {
 pub struct EditorLink {
     note: AtomicU8,
     listening: AtomicBool,
+    /// The bow as played (after the strokes, the dynamics and the controllers): velocity
+    /// and force as f32 bits in one word, [`Self::NO_BOW`] while nothing is bowed.
+    played: AtomicU64,
     /// The probed string's contact, one sample per audio sample while listening.
     pub scope: live::Scope,
     /// The thermal bow's nodes on the probed string, one record every few ms while
@@ -144,6 +147,27 @@ pub struct EditorLink {
 
 impl EditorLink {
     const NO_NOTE: u8 = u8::MAX;
+    const NO_BOW: u64 = u64::MAX;
+
+    /// Audio thread, once per block: the bow as the performer plays it (velocity m/s,
+    /// force N), or `None` while no bow is on a string.
+    pub fn set_played_bow(&self, bow: Option<(f32, f32)>) {
+        let bits = bow.map_or(Self::NO_BOW, |(v, f)| {
+            (v.to_bits() as u64) << 32 | f.to_bits() as u64
+        });
+        self.played.store(bits, Ordering::Relaxed);
+    }
+
+    /// The bow as played, for the pad's marker.
+    pub fn played_bow(&self) -> Option<(f32, f32)> {
+        match self.played.load(Ordering::Relaxed) {
+            Self::NO_BOW => None,
+            bits => Some((
+                f32::from_bits((bits >> 32) as u32),
+                f32::from_bits(bits as u32),
+            )),
+        }
+    }
 
     /// Audio thread: the last note the strings took (`None` before any).
     pub fn set_note(&self, note: Option<u8>) {
@@ -174,6 +198,7 @@ impl Default for EditorLink {
         Self {
             note: AtomicU8::new(Self::NO_NOTE),
             listening: AtomicBool::new(false),
+            played: AtomicU64::new(Self::NO_BOW),
             scope: live::Scope::default(),
             nodes: nodes::NodeRing::default(),
         }

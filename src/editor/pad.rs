@@ -30,6 +30,8 @@ pub const MAX_FORCE_COLOUR: Color32 = Color32::from_rgb(235, 140, 60);
 pub const MIN_FORCE_COLOUR: Color32 = Color32::from_rgb(90, 170, 235);
 const WINDOW_FILL: Color32 = Color32::from_rgba_premultiplied(40, 90, 45, 90);
 const HANDLE_COLOUR: Color32 = Color32::from_rgb(250, 225, 90);
+/// The ring marking the bow as played.
+const PLAYED_COLOUR: Color32 = Color32::from_rgb(120, 200, 255);
 
 /// State of one pad across frames.
 #[derive(Debug, Clone, Default)]
@@ -38,9 +40,17 @@ pub struct XyPad {
     dragging: bool,
     /// The values last sent while dragging (velocity m/s, force N).
     sent: Option<(f32, f32)>,
+    /// The played bow the last frame marked (velocity m/s, force N), if any.
+    played: Option<(f32, f32)>,
 }
 
 impl XyPad {
+    /// The bow as played that the last frame marked on the pad (velocity m/s, force N):
+    /// `None` while no bow is on a string or while it sits on the handle.
+    pub fn played_marker(&self) -> Option<(f32, f32)> {
+        self.played
+    }
+
     /// Whether a gesture is open (begin sent, end not yet).
     pub fn is_dragging(&self) -> bool {
         self.dragging
@@ -56,6 +66,7 @@ impl XyPad {
         velocity: &FloatParam,
         force: &FloatParam,
         window: Option<&SchellengWindow>,
+        played: Option<(f32, f32)>,
     ) -> Response {
         let rect = Rect::from_min_max(
             pos2(outer.left() + LEFT_MARGIN, outer.top()),
@@ -81,6 +92,21 @@ impl XyPad {
             info
         });
         self.paint(ui, rect, window, v, f);
+        // The bow as the performer plays it (the strokes, the dynamics and the MIDI
+        // controllers move it away from the parameters): a ring where it differs from the
+        // handle by more than a couple of pixels.
+        self.played = played.filter(|&(pv, pf)| {
+            let (a, b) = (
+                self.mapping.values_to_pos(rect, pv, pf),
+                self.mapping.values_to_pos(rect, v, f),
+            );
+            a.distance(b) > 2.0 && pv.is_finite() && pf.is_finite()
+        });
+        if let Some((pv, pf)) = self.played {
+            let p = self.mapping.values_to_pos(rect, pv, pf.max(0.0));
+            ui.painter()
+                .circle_stroke(p, 7.0, Stroke::new(2.0, PLAYED_COLOUR));
+        }
         if let Some(hover) = response.hover_pos() {
             let (hv, hf) = self.mapping.pos_to_values(rect, hover);
             response

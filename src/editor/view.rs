@@ -211,6 +211,7 @@ impl EditorUi {
                 &params.bow_velocity,
                 &params.bow_force,
                 window.as_ref(),
+                self.link.played_bow(),
             );
             ui.add_space(8.0);
             ui.allocate_ui_with_layout(
