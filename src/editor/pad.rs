@@ -42,9 +42,17 @@ pub struct XyPad {
     sent: Option<(f32, f32)>,
     /// The played bow the last frame marked (velocity m/s, force N), if any.
     played: Option<(f32, f32)>,
+    /// The played bow to mark at the next [`XyPad::show`].
+    played_in: Option<(f32, f32)>,
 }
 
 impl XyPad {
+    /// The bow as played (velocity m/s, force N; `None`: no bow on a string) for the next
+    /// [`XyPad::show`] to mark.
+    pub fn mark_played(&mut self, bow: Option<(f32, f32)>) {
+        self.played_in = bow;
+    }
+
     /// The bow as played that the last frame marked on the pad (velocity m/s, force N):
     /// `None` while no bow is on a string or while it sits on the handle.
     pub fn played_marker(&self) -> Option<(f32, f32)> {
@@ -66,7 +74,6 @@ impl XyPad {
         velocity: &FloatParam,
         force: &FloatParam,
         window: Option<&SchellengWindow>,
-        played: Option<(f32, f32)>,
     ) -> Response {
         let rect = Rect::from_min_max(
             pos2(outer.left() + LEFT_MARGIN, outer.top()),
@@ -95,7 +102,7 @@ impl XyPad {
         // The bow as the performer plays it (the strokes, the dynamics and the MIDI
         // controllers move it away from the parameters): a ring where it differs from the
         // handle by more than a couple of pixels.
-        self.played = played.filter(|&(pv, pf)| {
+        self.played = self.played_in.filter(|&(pv, pf)| {
             let (a, b) = (
                 self.mapping.values_to_pos(rect, pv, pf),
                 self.mapping.values_to_pos(rect, v, f),

@@ -204,6 +204,7 @@ impl EditorUi {
             );
             let (outer, _) = ui.allocate_exact_size(pad_size, egui::Sense::hover());
             let mut pad_ui = ui.new_child(egui::UiBuilder::new().max_rect(outer));
+            self.pad.mark_played(self.link.played_bow());
             self.pad.show(
                 &mut pad_ui,
                 outer,
@@ -211,7 +212,6 @@ impl EditorUi {
                 &params.bow_velocity,
                 &params.bow_force,
                 window.as_ref(),
-                self.link.played_bow(),
             );
             ui.add_space(8.0);
             ui.allocate_ui_with_layout(
