@@ -1,7 +1,8 @@
-// Renders STK's stk::Bowed for `colophony bench precision` (the bench compiles it with
-// g++ -O2 against libstk-dev). Usage: stk_bowed SECONDS RATE_HZ FREQ_HZ OUT.f32
-// Renders three times from a fresh instrument, prints the fastest render time in seconds
-// (the sample loop only) and writes the last render as raw native-endian f32.
+// Renders STK's stk::Bowed for `colophony bench precision` and `colophony bench peers`
+// (the benches compile it with g++ -O2 against libstk-dev).
+// Usage: stk_bowed SECONDS RATE_HZ FREQ_HZ OUT.f32 [RUNS]
+// Renders RUNS times (default 3) from a fresh instrument, prints the fastest render time in
+// seconds (the sample loop only) and writes the last render as raw native-endian f32.
 #include <stk/Bowed.h>
 
 #include <algorithm>
@@ -11,17 +12,18 @@
 #include <vector>
 
 int main(int argc, char** argv) {
-    if (argc != 5) {
-        std::fprintf(stderr, "usage: %s SECONDS RATE_HZ FREQ_HZ OUT.f32\n", argv[0]);
+    if (argc != 5 && argc != 6) {
+        std::fprintf(stderr, "usage: %s SECONDS RATE_HZ FREQ_HZ OUT.f32 [RUNS]\n", argv[0]);
         return 2;
     }
+    const int runs = argc == 6 ? std::max(1, std::atoi(argv[5])) : 3;
     const double seconds = std::atof(argv[1]);
     const double rate = std::atof(argv[2]);
     const double freq = std::atof(argv[3]);
     stk::Stk::setSampleRate(rate);
     std::vector<float> out(static_cast<size_t>(seconds * rate));
     double best = 1e300;
-    for (int run = 0; run < 3; ++run) {
+    for (int run = 0; run < runs; ++run) {
         stk::Bowed bowed(50.0);
         bowed.setVibrato(0.0);
         const auto start = std::chrono::steady_clock::now();

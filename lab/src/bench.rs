@@ -417,3 +417,103 @@ scene_instrument!(
         i.asleep_polarisations() as f64 / (2 * colophony::dsp::instrument::STRINGS) as f64
     }
 );
+
+/// CPU time (user + system, seconds) of the children this process has waited for.
+#[cfg(unix)]
+fn children_cpu_s() -> f64 {
+    // SAFETY: getrusage only writes the struct it is given.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    unsafe { libc::getrusage(libc::RUSAGE_CHILDREN, &mut usage) };
+    let t = |tv: libc::timeval| tv.tv_sec as f64 + tv.tv_usec as f64 * 1e-6;
+    t(usage.ru_utime) + t(usage.ru_stime)
+}
+
+#[cfg(not(unix))]
+fn children_cpu_s() -> f64 {
+    0.0
+}
+
+/// Runs `cmd` to completion; its CPU time (user + system, s).
+fn child_cpu_s(cmd: &mut std::process::Command, what: &str) -> Result<f64, String> {
+    let before = children_cpu_s();
+    let out = cmd
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .output()
+        .map_err(|e| format!("cannot run {what}: {e}"))?;
+    if !out.status.success() {
+        let err = String::from_utf8_lossy(&out.stderr);
+        return Err(format!(
+            "{what} failed: {}",
+            err.lines().next().unwrap_or("")
+        ));
+    }
+    Ok(children_cpu_s() - before)
+}
+
+/// `colophony bench peers`: issue 20's comparison. Whole processes each render `seconds`
+/// of cello D3 at 48 kHz to a file: this binary's `render` with the hyperbolic (default)
+/// and the elasto-plastic string (paper A), and STK's `stk::Bowed` at 146.8 Hz
+/// (`assets/peers/stk_bowed.cpp`, one render per process, raw f32 out, built with g++ -O2
+/// against libstk-dev: `scripts/install-peers.sh` installs it). User + system CPU of each
+/// process, best of three, the three interleaved in each round so load on a shared machine
+/// hits them alike. Prints each one's CPU seconds and its ratio to STK's. Unix only (the
+/// children's CPU time comes from getrusage).
+pub fn peers(seconds: f64, dir: &std::path::Path) -> Result<String, String> {
+    if !(seconds.is_finite() && seconds > 0.0 && seconds <= 3600.0) {
+        return Err(format!("--seconds must be within 0..=3600, got {seconds}"));
+    }
+    if !cfg!(unix) {
+        return Err("bench peers measures child CPU time with getrusage: Unix only".into());
+    }
+    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    let stk = crate::precision::peers::build_stk(dir).map_err(|e| {
+        format!("{e} (STK is needed: scripts/install-peers.sh, or apt-get install libstk-dev g++)")
+    })?;
+    let me = std::env::current_exe().map_err(|e| e.to_string())?;
+    let secs = format!("{seconds}");
+    let d3_hz = format!("{}", colophony::dsp::instrument::midi_to_hz(50.0));
+    let ours = |friction: &str| {
+        let mut c = std::process::Command::new(&me);
+        c.args([
+            "render",
+            "--note",
+            "D3",
+            "--seconds",
+            &secs,
+            "--friction",
+            friction,
+        ])
+        .arg("--out")
+        .arg(dir.join(format!("{friction}.wav")));
+        c
+    };
+    let mut rows: Vec<(&str, std::process::Command)> = vec![
+        ("STK Bowed", {
+            let mut c = std::process::Command::new(&stk);
+            c.args([secs.as_str(), "48000", d3_hz.as_str()])
+                .arg(dir.join("stk.f32"))
+                .arg("1");
+            c
+        }),
+        ("hyperbolic string (default)", ours("hyperbolic")),
+        ("elasto-plastic string (paper A)", ours("elasto-plastic")),
+    ];
+    let mut best = vec![f64::INFINITY; rows.len()];
+    for _round in 0..3 {
+        for (i, (name, cmd)) in rows.iter_mut().enumerate() {
+            best[i] = best[i].min(child_cpu_s(cmd, name)?);
+        }
+    }
+    let mut lines = vec![format!(
+        "{seconds} s of cello D3 at 48 kHz to a file, whole process, user + system CPU, best of 3 (interleaved)"
+    )];
+    for ((name, _), cpu) in rows.iter().zip(&best) {
+        lines.push(format!(
+            "{name:<32} {cpu:8.3} s  {:6.1}x real time  {:5.2}x STK",
+            seconds / cpu,
+            cpu / best[0]
+        ));
+    }
+    Ok(lines.join("\n"))
+}

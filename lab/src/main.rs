@@ -108,7 +108,9 @@ enum Command {
     /// Print real-time ratios (run a release build): `friction` times 10 s of cello D at
     /// 48 kHz with each friction law; `table1` times paper B's thermal bow per node count;
     /// `precision --out DIR [--quick]` writes the work-precision benchmark (errors against
-    /// refined references beside the cost, and the STK and Faust peers) to DIR.
+    /// refined references beside the cost, and the STK and Faust peers) to DIR; `peers
+    /// [--seconds S] [--out DIR]` times whole processes rendering cello D3 against STK's
+    /// Bowed (needs libstk-dev and g++).
     Bench {
         what: String,
         /// Output directory (precision).
@@ -131,6 +133,9 @@ enum Command {
         /// intonation: measuring passes (default 2).
         #[arg(long)]
         passes: Option<usize>,
+        /// peers: seconds each process renders (default 300).
+        #[arg(long)]
+        seconds: Option<f64>,
     },
     /// List the presets: the factory set and the user presets (in the folder the editor
     /// saves to; COLOPHONY_PRESET_DIR overrides it).
@@ -358,10 +363,15 @@ fn main() -> ExitCode {
             step,
             models,
             passes,
+            seconds,
         } => report(match what.as_str() {
             "friction" => colophony_lab::bench::friction_table(),
             "table1" => colophony_lab::bench::table1(),
             "scenes" => colophony_lab::bench::scenes(),
+            "peers" => colophony_lab::bench::peers(
+                seconds.unwrap_or(300.0),
+                &out.unwrap_or_else(|| std::env::temp_dir().join("colophony-peers")),
+            ),
             "precision" => match out {
                 Some(dir) => colophony_lab::precision::run(&dir, quick),
                 None => Err("bench precision needs --out DIR".into()),

@@ -508,3 +508,29 @@ fn a_chosen_bridge_plays_through_the_plugins_thermal_instrument() {
         assert!(!out.exists(), "{args:?} left a file");
     }
 }
+
+#[test]
+fn bench_peers_compares_with_stk_or_says_how_to_install_it() {
+    let dir = scratch("peers-dir");
+    let run = colophony(&[
+        "bench",
+        "peers",
+        "--seconds",
+        "0.2",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    if run.status.success() {
+        // Three rows, each with its ratio to STK (STK's own is 1).
+        for row in ["STK Bowed", "hyperbolic string", "elasto-plastic string"] {
+            assert!(stdout.contains(row), "{stdout}");
+        }
+        assert!(stdout.contains("1.00x STK"), "{stdout}");
+    } else {
+        // No STK or g++ on this machine: one line that says how to get them.
+        assert!(stderr.contains("install-peers.sh"), "{stderr}");
+        assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
+    }
+}

@@ -105,7 +105,8 @@ fn run_driver(program: &Path, args: &[&str], raw: &Path) -> Result<(f64, Vec<f64
     Ok((took, audio))
 }
 
-fn build_stk(dir: &Path) -> Result<PathBuf, String> {
+/// Writes the STK driver into `dir` and builds it with `g++ -O2 ... -lstk`.
+pub fn build_stk(dir: &Path) -> Result<PathBuf, String> {
     let source = dir.join("stk_bowed.cpp");
     std::fs::write(&source, STK_SOURCE).map_err(|e| e.to_string())?;
     let exe = dir.join("stk_bowed");
