@@ -13,10 +13,12 @@
 pub mod analysis;
 pub mod dsp;
 pub mod editor;
+pub mod editor_state;
 pub mod params;
 pub mod performer;
 pub mod presets;
 pub mod quality;
+pub mod telemetry;
 pub mod user_bridges;
 
 use dsp::instrument::{BowControl, InstrumentKind};
@@ -228,7 +230,11 @@ impl Plugin for Colophony {
                 let sample = editor::live::ContactSample::new(&frame, &played);
                 self.editor_link.scope.push(sample);
                 if let Some(string) = self.performer.probed_thermal_string() {
-                    self.node_probe.add_string(string, &self.editor_link);
+                    self.node_probe.add_from(
+                        string.node_temperatures(),
+                        string.slipping(),
+                        &self.editor_link,
+                    );
                 }
             }
             let out = dsp::filters::safety_limit(dsp::filters::flush_tiny(frame.audio * gain));

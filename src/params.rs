@@ -241,7 +241,7 @@ pub struct ColophonyParams {
     pub vibrato_rate: FloatParam,
     /// The editor window's size, saved with the plugin state (not a parameter).
     #[persist = "editor-state"]
-    pub editor_state: crate::editor::EditorState,
+    pub editor_state: crate::editor_state::EditorState,
     /// The bridges chosen for the thermal instruments, saved with the project
     /// ([`crate::user_bridges`]; not a parameter).
     #[persist = "user-bridges"]

@@ -72,7 +72,11 @@ fn feeding_the_live_and_thermal_views_does_not_allocate() {
             }
             let frame = cello.tick(bow);
             link.scope.push(ContactSample::new(&frame, &bow));
-            probe.add_string(cello.probed_string(), &link);
+            probe.add_from(
+                cello.probed_string().node_temperatures(),
+                cello.probed_string().slipping(),
+                &link,
+            );
         }
     });
     assert_eq!(count, 0);

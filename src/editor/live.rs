@@ -1,23 +1,21 @@
 //! Live views of the simulation, fed from the audio thread without locks or allocation.
 //!
-//! [`Scope`] is a single-writer ring of the probed string's contact signals, one entry per
-//! sample: the string velocity at the bow, the relative (string minus bow) velocity and
-//! the friction coefficient `F / F_N` (friction force over bow force). The audio thread
-//! writes with four atomic stores per sample (plain moves on x86), and only while
+//! [`Scope`] is a [`crate::telemetry::Ring`] of the probed string's contact signals, one
+//! entry per sample: the string velocity at the bow, the relative (string minus bow)
+//! velocity and the friction coefficient `F / F_N` (friction force over bow force). The
+//! audio thread writes with six atomic stores per sample (plain moves on x86), and only while
 //! an editor that shows the live views is open ([`super::EditorLink::is_listening`], read
 //! once per block); otherwise nothing is computed or written for them. The editor copies
 //! the newest samples out and drops any the writer overwrote during the copy, so both sides
 //! are wait-free.
 
 use crate::dsp::instrument::{BowControl, Frame};
+use crate::telemetry::{Record, Ring};
 use egui::{pos2, vec2, Align2, Color32, FontId, Rect, Shape, Stroke, Ui};
-use std::sync::atomic::{fence, AtomicU32, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU32, Ordering};
 
 /// Ring length, samples (a power of two): three periods of cello C at 96 kHz fit.
 pub const SCOPE_LEN: usize = 1 << 13;
-const MASK: u64 = SCOPE_LEN as u64 - 1;
-/// Values per sample in the ring.
-const CHANNELS: usize = 3;
 
 /// One sample of the probed string's contact.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -47,29 +45,37 @@ impl ContactSample {
     }
 }
 
-/// Wait-free single-producer ring of [`ContactSample`]s.
-pub struct Scope {
-    data: Box<[AtomicU32]>,
-    /// Samples written since creation (the next one goes to `written & MASK`).
-    written: AtomicU64,
-    sample_rate_bits: AtomicU32,
+impl Record for ContactSample {
+    const WORDS: usize = 3;
+
+    #[inline]
+    fn store(&self, words: &[AtomicU32]) {
+        words[0].store(self.string_velocity.to_bits(), Ordering::Relaxed);
+        words[1].store(self.relative_velocity.to_bits(), Ordering::Relaxed);
+        words[2].store(self.mu.to_bits(), Ordering::Relaxed);
+    }
+
+    fn load(words: &[AtomicU32]) -> Self {
+        let f = |i: usize| f32::from_bits(words[i].load(Ordering::Relaxed));
+        Self {
+            string_velocity: f(0),
+            relative_velocity: f(1),
+            mu: f(2),
+        }
+    }
 }
 
-impl std::fmt::Debug for Scope {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Scope")
-            .field("written", &self.written())
-            .finish_non_exhaustive()
-    }
+/// The contact samples ([`crate::telemetry::Ring`]) and the rate they are written at.
+#[derive(Debug)]
+pub struct Scope {
+    ring: Ring<ContactSample>,
+    sample_rate_bits: AtomicU32,
 }
 
 impl Default for Scope {
     fn default() -> Self {
         Self {
-            data: (0..SCOPE_LEN * CHANNELS)
-                .map(|_| AtomicU32::new(0))
-                .collect(),
-            written: AtomicU64::new(0),
+            ring: Ring::new(SCOPE_LEN),
             sample_rate_bits: AtomicU32::new(48_000f32.to_bits()),
         }
     }
@@ -79,19 +85,12 @@ impl Scope {
     /// Audio thread (one writer only): appends one sample.
     #[inline]
     pub fn push(&self, sample: ContactSample) {
-        let n = self.written.load(Ordering::Relaxed);
-        let base = (n & MASK) as usize * CHANNELS;
-        // Release on the data too: a reader that sees any of these values (and then fences)
-        // also sees `written` at least `n`, so it knows this slot was being rewritten.
-        self.data[base].store(sample.string_velocity.to_bits(), Ordering::Release);
-        self.data[base + 1].store(sample.relative_velocity.to_bits(), Ordering::Release);
-        self.data[base + 2].store(sample.mu.to_bits(), Ordering::Release);
-        self.written.store(n + 1, Ordering::Release);
+        self.ring.push(&sample);
     }
 
     /// Samples written so far.
     pub fn written(&self) -> u64 {
-        self.written.load(Ordering::Acquire)
+        self.ring.written()
     }
 
     /// Main thread: the rate the samples are written at (set on activation).
@@ -103,28 +102,10 @@ impl Scope {
         f32::from_bits(self.sample_rate_bits.load(Ordering::Relaxed))
     }
 
-    /// Editor: replaces `out` with up to the `max` newest samples, oldest first. Samples the
-    /// writer overwrote while they were copied are dropped from the front.
+    /// Editor: replaces `out` with up to the `max` newest samples, oldest first; samples
+    /// the writer overwrote while they were copied are left out.
     pub fn copy_latest(&self, max: usize, out: &mut Vec<ContactSample>) {
-        out.clear();
-        let end = self.written.load(Ordering::Acquire);
-        let count = (max.min(SCOPE_LEN) as u64).min(end);
-        let start = end - count;
-        for k in start..end {
-            let base = (k & MASK) as usize * CHANNELS;
-            out.push(ContactSample {
-                string_velocity: f32::from_bits(self.data[base].load(Ordering::Relaxed)),
-                relative_velocity: f32::from_bits(self.data[base + 1].load(Ordering::Relaxed)),
-                mu: f32::from_bits(self.data[base + 2].load(Ordering::Relaxed)),
-            });
-        }
-        fence(Ordering::Acquire);
-        let end_after = self.written.load(Ordering::Relaxed);
-        // Sample k's slot is rewritten by sample k + SCOPE_LEN (possibly in progress at
-        // `end_after`): keep only k > end_after - SCOPE_LEN.
-        let first_valid = (end_after + 1).saturating_sub(SCOPE_LEN as u64);
-        let stale = first_valid.saturating_sub(start).min(count) as usize;
-        out.drain(..stale);
+        self.ring.copy_latest(max, out);
     }
 }
 
@@ -325,8 +306,9 @@ mod tests {
         }
         let mut out = Vec::new();
         scope.copy_latest(usize::MAX, &mut out);
-        // The slot the next write would reuse counts as stale, so one fewer than the ring.
-        assert_eq!(out.len(), SCOPE_LEN - 1);
+        // Every slot holds a whole sample (a slot turns stale only while the writer marks
+        // it), so the whole ring comes back, and no more.
+        assert_eq!(out.len(), SCOPE_LEN);
         assert_eq!(out.last().unwrap().string_velocity, (total - 1) as f32);
         for pair in out.windows(2) {
             assert_eq!(pair[1].string_velocity - pair[0].string_velocity, 1.0);

@@ -31,103 +31,22 @@ pub mod presets;
 pub mod regime;
 pub mod view;
 
+pub use crate::editor_state::{EditorSize, EditorState};
 pub use view::EditorUi;
 
 use crate::params::ColophonyParams;
 use nice_plug::context::gui::GuiContext;
 use nice_plug::editor::dpi::{LogicalSize, NativeSize, Size};
 use nice_plug::editor::{Editor, HostMethods, ParentWindowHandle, ResizeHint, SpawnedEditor};
-use nice_plug::params::persist::PersistentField;
 use nice_plug::plugin::TrackInfo;
 use nice_plug_egui::baseview::{HandlerError, WindowSize};
 use nice_plug_egui::{
     create_egui_editor, EguiEditor, EguiEditorHandle, EguiEditorState, EguiNiceSettings, Frame,
     NiceEguiApp, RepaintNotifier,
 };
-use serde::{Deserialize, Serialize};
 use std::error::Error;
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicU8, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
-
-/// The editor window's size in logical points.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct EditorSize {
-    pub width: f32,
-    pub height: f32,
-}
-
-impl EditorSize {
-    pub const DEFAULT: Self = Self {
-        width: 880.0,
-        height: 760.0,
-    };
-    pub const MIN: Self = Self {
-        width: 640.0,
-        height: 430.0,
-    };
-    pub const MAX: Self = Self {
-        width: 4096.0,
-        height: 4096.0,
-    };
-
-    /// Clamped to [`Self::MIN`] .. [`Self::MAX`]; the default if not finite (a damaged state).
-    pub fn sanitized(self) -> Self {
-        if !(self.width.is_finite() && self.height.is_finite()) {
-            return Self::DEFAULT;
-        }
-        Self {
-            width: self.width.clamp(Self::MIN.width, Self::MAX.width),
-            height: self.height.clamp(Self::MIN.height, Self::MAX.height),
-        }
-    }
-}
-
-/// The persisted editor state: the window size, both halves in one atomic so a save never
-/// sees half a resize.
-#[derive(Debug)]
-pub struct EditorState {
-    bits: AtomicU64,
-}
-
-impl EditorState {
-    fn pack(size: EditorSize) -> u64 {
-        (size.width.to_bits() as u64) << 32 | size.height.to_bits() as u64
-    }
-
-    pub fn size(&self) -> EditorSize {
-        let bits = self.bits.load(Ordering::Acquire);
-        EditorSize {
-            width: f32::from_bits((bits >> 32) as u32),
-            height: f32::from_bits(bits as u32),
-        }
-    }
-
-    pub fn set_size(&self, size: EditorSize) {
-        self.bits
-            .store(Self::pack(size.sanitized()), Ordering::Release);
-    }
-}
-
-impl Default for EditorState {
-    fn default() -> Self {
-        Self {
-            bits: AtomicU64::new(Self::pack(EditorSize::DEFAULT)),
-        }
-    }
-}
-
-impl<'a> PersistentField<'a, EditorSize> for EditorState {
-    fn set(&self, new_value: EditorSize) {
-        self.set_size(new_value);
-    }
-
-    fn map<F, R>(&self, f: F) -> R
-    where
-        F: Fn(&EditorSize) -> R,
-    {
-        f(&self.size())
-    }
-}
 
 /// What the audio thread tells the editor, lock-free: the note once per block, and the
 /// live samples and the thermal bow's nodes only while an editor showing them is open.
@@ -200,7 +119,7 @@ impl Default for EditorLink {
             listening: AtomicBool::new(false),
             played: AtomicU64::new(Self::NO_BOW),
             scope: live::Scope::default(),
-            nodes: nodes::NodeRing::default(),
+            nodes: nodes::node_ring(),
         }
     }
 }

@@ -4,26 +4,24 @@
 //! **Transport.** While an open editor listens and the thermal instrument plays, the audio
 //! thread adds the probed string's node temperatures and slip states to a [`NodeProbe`]
 //! (its own plain arrays, about a hundred additions a sample) and every
-//! [`RECORD_INTERVAL_S`] publishes their means as one [`NodeRecord`] into the [`NodeRing`]:
-//! a ring of seqlocked slots of atomics. The writer marks a slot odd (being written),
-//! stores the values, then marks it with the record's even sequence number; a reader keeps a
-//! record only if the slot held that record's number before and after it copied it, so it
-//! never sees a torn record, and neither side waits.
+//! [`RECORD_INTERVAL_S`] publishes their means as one [`NodeRecord`] into the [`NodeRing`],
+//! the telemetry ring every live view uses ([`crate::telemetry::Ring`]: seqlocked slots of
+//! atomics, so a reader never sees a torn record and neither side waits). The probe takes
+//! plain slices: the editor knows nothing of the thermal string.
 //!
 //! **Views.** [`paint_temperature_profile`] draws the newest record's temperatures across
 //! the bow (K above ambient, the model's unit) over the band they spanned in the records
 //! shown; [`paint_slip_image`] draws the slip fraction of every node over the last records,
 //! a node x time image (bright: slipping all the record, dark: sticking).
 
-use crate::dsp::thermal::ThermalString;
+use crate::telemetry::{Record, Ring};
 use egui::{pos2, vec2, Align2, Color32, FontId, Mesh, Rect, Shape, Stroke, Ui};
-use std::sync::atomic::{fence, AtomicU32, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU32, Ordering};
 
 /// Most nodes a record holds: the most the thermal bow has on any string.
 pub const MAX_NODES: usize = crate::dsp::thermal_instrument::MAX_NODES;
 /// Records in the ring (a power of two): 1.28 s at one record every 5 ms.
 pub const RING_LEN: usize = 256;
-const MASK: u64 = RING_LEN as u64 - 1;
 /// Time over which one record averages, s: short enough to follow a bow stroke, long
 /// enough that a record spans a period of the open strings down to 200 Hz.
 pub const RECORD_INTERVAL_S: f32 = 0.005;
@@ -49,105 +47,39 @@ impl Default for NodeRecord {
     }
 }
 
-struct Slot {
-    /// `2 n + 1` while record `n` is written into the slot, `2 n + 2` once it is whole.
-    seq: AtomicU64,
-    count: AtomicU32,
-    temperature: [AtomicU32; MAX_NODES],
-    slip: [AtomicU32; MAX_NODES],
-}
+impl Record for NodeRecord {
+    /// The node count, then every node's temperature and slip fraction.
+    const WORDS: usize = 1 + 2 * MAX_NODES;
 
-impl Default for Slot {
-    fn default() -> Self {
-        Self {
-            seq: AtomicU64::new(0),
-            count: AtomicU32::new(0),
-            temperature: std::array::from_fn(|_| AtomicU32::new(0)),
-            slip: std::array::from_fn(|_| AtomicU32::new(0)),
-        }
-    }
-}
-
-/// Wait-free single-producer ring of [`NodeRecord`]s.
-pub struct NodeRing {
-    slots: Box<[Slot]>,
-    /// Records published since creation.
-    written: AtomicU64,
-}
-
-impl std::fmt::Debug for NodeRing {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("NodeRing")
-            .field("written", &self.written())
-            .finish_non_exhaustive()
-    }
-}
-
-impl Default for NodeRing {
-    fn default() -> Self {
-        Self {
-            slots: (0..RING_LEN).map(|_| Slot::default()).collect(),
-            written: AtomicU64::new(0),
-        }
-    }
-}
-
-impl NodeRing {
-    /// Audio thread (one writer only): publishes one record.
-    pub fn push(&self, record: &NodeRecord) {
-        let n = self.written.load(Ordering::Relaxed);
-        let slot = &self.slots[(n & MASK) as usize];
-        slot.seq.store(2 * n + 1, Ordering::Relaxed);
-        // Orders the odd mark before the values: a reader that sees any new value sees it.
-        fence(Ordering::Release);
-        let count = record.count.min(MAX_NODES);
-        slot.count.store(count as u32, Ordering::Relaxed);
+    fn store(&self, words: &[AtomicU32]) {
+        let count = self.count.min(MAX_NODES);
+        words[0].store(count as u32, Ordering::Relaxed);
         for i in 0..count {
-            slot.temperature[i].store(record.temperature_kelvin[i].to_bits(), Ordering::Relaxed);
-            slot.slip[i].store(record.slip_fraction[i].to_bits(), Ordering::Relaxed);
-        }
-        slot.seq.store(2 * n + 2, Ordering::Release);
-        self.written.store(n + 1, Ordering::Release);
-    }
-
-    /// Records published so far.
-    pub fn written(&self) -> u64 {
-        self.written.load(Ordering::Acquire)
-    }
-
-    /// Editor: replaces `out` with up to the `max` newest whole records, oldest first;
-    /// records overwritten or being written while copied are left out.
-    pub fn copy_latest(&self, max: usize, out: &mut Vec<NodeRecord>) {
-        out.clear();
-        let end = self.written();
-        let start = end - (max.min(RING_LEN) as u64).min(end);
-        for n in start..end {
-            if let Some(record) = self.read(n) {
-                out.push(record);
-            }
+            words[1 + i].store(self.temperature_kelvin[i].to_bits(), Ordering::Relaxed);
+            words[1 + MAX_NODES + i].store(self.slip_fraction[i].to_bits(), Ordering::Relaxed);
         }
     }
 
-    /// Record `n`, if its slot holds it whole.
-    fn read(&self, n: u64) -> Option<NodeRecord> {
-        let slot = &self.slots[(n & MASK) as usize];
-        let seq = slot.seq.load(Ordering::Acquire);
-        if seq != 2 * n + 2 {
-            return None;
-        }
+    fn load(words: &[AtomicU32]) -> Self {
         let mut record = NodeRecord {
-            count: (slot.count.load(Ordering::Relaxed) as usize).min(MAX_NODES),
+            count: (words[0].load(Ordering::Relaxed) as usize).min(MAX_NODES),
             ..NodeRecord::default()
         };
         for i in 0..record.count {
-            record.temperature_kelvin[i] =
-                f32::from_bits(slot.temperature[i].load(Ordering::Relaxed));
-            record.slip_fraction[i] = f32::from_bits(slot.slip[i].load(Ordering::Relaxed));
+            record.temperature_kelvin[i] = f32::from_bits(words[1 + i].load(Ordering::Relaxed));
+            record.slip_fraction[i] =
+                f32::from_bits(words[1 + MAX_NODES + i].load(Ordering::Relaxed));
         }
-        // Orders the loads before the second look at the mark.
-        fence(Ordering::Acquire);
-        (slot.seq.load(Ordering::Relaxed) == seq).then_some(record)
+        record
     }
+}
+
+/// The node records' ring ([`crate::telemetry::Ring`]), [`RING_LEN`] long.
+pub type NodeRing = Ring<NodeRecord>;
+
+/// A node ring of [`RING_LEN`] records.
+pub fn node_ring() -> NodeRing {
+    Ring::new(RING_LEN)
 }
 
 /// The audio thread's running sums for the next record (plain arrays, no allocation).
@@ -172,16 +104,17 @@ impl Default for NodeProbe {
 
 impl NodeProbe {
     /// Audio thread, once per sample while listening to the thermal instrument: adds the
-    /// probed string's nodes and publishes a record into `link.nodes` when one is due.
+    /// probed string's node temperatures (K) and slip states, and publishes a record into
+    /// `link.nodes` when one is due.
     #[inline]
-    pub fn add_string(&mut self, string: &ThermalString, link: &super::EditorLink) {
+    pub fn add_from<T: Copy + Into<f64>>(
+        &mut self,
+        temperatures: &[T],
+        slipping: &[bool],
+        link: &super::EditorLink,
+    ) {
         let interval = (link.scope.sample_rate() * RECORD_INTERVAL_S).max(1.0) as u32;
-        self.add(
-            string.node_temperatures(),
-            string.slipping(),
-            interval,
-            &link.nodes,
-        );
+        self.add(temperatures, slipping, interval, &link.nodes);
     }
 
     /// Adds one sample of node temperatures (K) and slip states; after `interval` samples
@@ -399,7 +332,7 @@ mod tests {
 
     #[test]
     fn node_ring_returns_the_newest_records_in_order() {
-        let ring = NodeRing::default();
+        let ring = node_ring();
         let mut out = Vec::new();
         ring.copy_latest(100, &mut out);
         assert!(out.is_empty());
@@ -414,7 +347,7 @@ mod tests {
 
     #[test]
     fn node_ring_wraps_and_keeps_the_last_ring_length() {
-        let ring = NodeRing::default();
+        let ring = node_ring();
         let total = 3 * RING_LEN as u64 + 17;
         for n in 0..total {
             ring.push(&record(n));
@@ -432,7 +365,7 @@ mod tests {
 
     #[test]
     fn node_ring_reader_sees_only_whole_records_in_order_while_written() {
-        let ring = std::sync::Arc::new(NodeRing::default());
+        let ring = std::sync::Arc::new(node_ring());
         let writer = {
             let ring = ring.clone();
             std::thread::spawn(move || {
@@ -462,7 +395,7 @@ mod tests {
 
     #[test]
     fn node_probe_publishes_means_every_interval() {
-        let ring = NodeRing::default();
+        let ring = node_ring();
         let mut probe = NodeProbe::default();
         // Node 0 slips on every other sample, node 1 never; temperatures 1, 2, 3, 4 K.
         for k in 0..4 {
@@ -503,7 +436,11 @@ mod tests {
                 cello.update_sleep();
             }
             cello.tick(bow);
-            probe.add_string(cello.probed_string(), &link);
+            probe.add_from(
+                cello.probed_string().node_temperatures(),
+                cello.probed_string().slipping(),
+                &link,
+            );
         }
         // One record per 5 ms: 200 in a second.
         assert_eq!(link.nodes.written(), 200);
@@ -535,7 +472,7 @@ mod tests {
 
     #[test]
     fn node_probe_starts_again_when_the_node_count_changes() {
-        let ring = NodeRing::default();
+        let ring = node_ring();
         let mut probe = NodeProbe::default();
         probe.add(&[100.0; 3], &[true; 3], 2, &ring);
         probe.add(&[1.0; 5], &[false; 5], 2, &ring);
