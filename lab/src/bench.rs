@@ -436,18 +436,7 @@ fn children_cpu_s() -> f64 {
 /// Runs `cmd` to completion; its CPU time (user + system, s).
 fn child_cpu_s(cmd: &mut std::process::Command, what: &str) -> Result<f64, String> {
     let before = children_cpu_s();
-    let out = cmd
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::piped())
-        .output()
-        .map_err(|e| format!("cannot run {what}: {e}"))?;
-    if !out.status.success() {
-        let err = String::from_utf8_lossy(&out.stderr);
-        return Err(format!(
-            "{what} failed: {}",
-            err.lines().next().unwrap_or("")
-        ));
-    }
+    crate::precision::peers::run_checked(cmd, what)?;
     Ok(children_cpu_s() - before)
 }
 

@@ -73,7 +73,8 @@ pub fn ensure_installed() -> Result<(), String> {
     run(&install)
 }
 
-fn run_checked(cmd: &mut Command, what: &str) -> Result<String, String> {
+/// Runs `cmd` to completion: its standard output, or the first line of its error.
+pub(crate) fn run_checked(cmd: &mut Command, what: &str) -> Result<String, String> {
     let out = cmd
         .output()
         .map_err(|e| format!("cannot run {what}: {e}"))?;
