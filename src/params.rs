@@ -14,6 +14,7 @@
 //! | `string` | String | - | auto, I (highest) .. IV (lowest) | auto |
 //! | `quality` | Quality | - | draft, good, reference, auto, custom | good |
 //! | `reference_pitch` | Reference Pitch | Hz (A4) | 415 .. 466 | 440 |
+//! | `dynamics_guard` | Dynamics Guard | - | off, on (the dynamics keep the bow in Schelleng's window) | on |
 
 use crate::dsp::friction::FrictionModel;
 use crate::dsp::instrument::InstrumentKind;
@@ -239,6 +240,8 @@ pub struct ColophonyParams {
     pub glide_time_ms: FloatParam,
     #[id = "vibrato_rate"]
     pub vibrato_rate: FloatParam,
+    #[id = "dynamics_guard"]
+    pub dynamics_guard: BoolParam,
     /// The editor window's size, saved with the plugin state (not a parameter).
     #[persist = "editor-state"]
     pub editor_state: crate::editor_state::EditorState,
@@ -380,6 +383,8 @@ impl Default for ColophonyParams {
             .with_unit(" Hz")
             .with_step_size(0.01)
             .with_value_to_string(formatters::v2s_f32_rounded(2)),
+            // Read once per block.
+            dynamics_guard: BoolParam::new("Dynamics Guard", true),
             editor_state: Default::default(),
             user_bridges: Default::default(),
             state_version: crate::presets::StateVersion,
@@ -416,6 +421,7 @@ impl ColophonyParams {
             bend_range_semitones: self.bend_range.value() as f64,
             glide_s: self.glide_time_ms.value() as f64 * 1e-3,
             vibrato_rate_hz: self.vibrato_rate.value() as f64,
+            dynamics_guard: self.dynamics_guard.value(),
         }
     }
 

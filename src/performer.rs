@@ -33,7 +33,7 @@ use crate::dsp::engine::Engine;
 use crate::dsp::friction::FrictionModel;
 use crate::dsp::instrument::{
     midi_to_hz, BowControl, Frame, Instrument, InstrumentKind, MAX_BEND_RANGE_SEMITONES,
-    PITCH_BEND_SEMITONES,
+    MAX_NOTE_BETA, MIN_NOTE_BETA, PITCH_BEND_SEMITONES,
 };
 use crate::dsp::rubbed::{RubbedInstrument, RubbedPreset};
 use crate::dsp::thermal::ThermalString;
@@ -80,6 +80,12 @@ pub fn wheel_position(value: f32) -> f64 {
 /// The dynamics' range: expression 0 (CC11, CC2 or channel pressure at 0) plays the bow
 /// this many dB below expression 1 (the default, and the parameters' own bow).
 pub const DYNAMICS_RANGE_DB: f64 = 30.0;
+/// With the window guard the bow position is the parameter's times `scale^-x` (the
+/// dynamics' bow scale): the bow sits at the parameter's place at full expression and
+/// drifts away from the bridge as the dynamics fall, 2^(1/2) = 1.41 times farther at the
+/// softest (-30 dB: `x = log10(2) / 3`), as players bow nearer the fingerboard for
+/// piano and nearer the bridge for forte.
+pub const DYNAMICS_DRIFT_EXPONENT: f64 = std::f64::consts::LOG10_2 / 3.0;
 /// Time constant of the dynamics' smoothing, s (no zipper noise from 7-bit steps).
 pub const DYNAMICS_SMOOTHING_S: f64 = 0.01;
 /// Vibrato depth at the mod wheel's top, cents (peak, either side: players' wide vibrato).
@@ -150,6 +156,11 @@ pub struct Setup {
     pub glide_s: f64,
     /// Vibrato rate, Hz ([`VIBRATO_RATE_MIN_HZ`]..=[`VIBRATO_RATE_MAX_HZ`]).
     pub vibrato_rate_hz: f64,
+    /// The window guard (on by default): the dynamics scale the bow's velocity and force
+    /// together and move it from the bridge as they fall, so the bow keeps its place in
+    /// Schelleng's window. Off, they scale the velocity alone: a soft dynamic under the
+    /// parameters' force presses a slow bow too hard (raucous).
+    pub dynamics_guard: bool,
 }
 
 impl Default for Setup {
@@ -168,6 +179,7 @@ impl Default for Setup {
             bend_range_semitones: PITCH_BEND_SEMITONES,
             glide_s: GLIDE_S_DEFAULT,
             vibrato_rate_hz: VIBRATO_RATE_HZ,
+            dynamics_guard: true,
         }
     }
 }
@@ -239,8 +251,8 @@ pub struct Performer {
     /// renewed there and the per-sample loop skips them with one test.
     others_awake: bool,
     /// While the gesture is steady (see [`Performer::shape`]): the factors on the bow's
-    /// velocity and force, applied without the gesture's per-sample checks.
-    steady: Option<(f64, f64)>,
+    /// velocity, force and position, applied without the gesture's per-sample checks.
+    steady: Option<(f64, f64, f64)>,
     /// Whether [`Performer::configure`] has run since the engines were built.
     configured: bool,
     /// The bow of the last sample, as played (after the stroke and the dynamics).
@@ -821,13 +833,22 @@ impl Performer {
                 g.scale = g.target;
             }
         }
-        let out = if g.scale == 1.0 && speed == 1.0 && landing == 1.0 {
+        // With the guard the force follows the velocity and the bow drifts from the
+        // bridge as the dynamics fall; without it only the velocity follows.
+        let (force_scale, away) = if !self.setup.dynamics_guard {
+            (1.0, 1.0)
+        } else if g.scale == 1.0 {
+            (1.0, 1.0)
+        } else {
+            (g.scale, g.scale.powf(-DYNAMICS_DRIFT_EXPONENT))
+        };
+        let out = if g.scale == 1.0 && speed == 1.0 && landing == 1.0 && away == 1.0 {
             bow
         } else {
             BowControl {
                 velocity_m_per_s: bow.velocity_m_per_s * g.scale * speed,
-                force_n: bow.force_n * g.scale * landing,
-                ..bow
+                force_n: bow.force_n * force_scale * landing,
+                position_beta: (bow.position_beta * away).clamp(MIN_NOTE_BETA, MAX_NOTE_BETA),
             }
         };
         // Steady from here on until a controller, a pressure or a note: the next samples
@@ -838,7 +859,7 @@ impl Performer {
             && g.scale == g.target
             && self.direct.is_idle()
             && self.stroke.is_settled();
-        self.steady = steady.then_some((g.scale * speed, g.scale));
+        self.steady = steady.then_some((g.scale * speed, force_scale, away));
         out
     }
 
@@ -913,10 +934,15 @@ impl Performer {
     #[inline]
     pub fn tick(&mut self, bow: BowControl) -> Frame {
         let bow = match self.steady {
-            Some((v, f)) => BowControl {
+            Some((v, f, 1.0)) => BowControl {
                 velocity_m_per_s: bow.velocity_m_per_s * v,
                 force_n: bow.force_n * f,
                 ..bow
+            },
+            Some((v, f, away)) => BowControl {
+                velocity_m_per_s: bow.velocity_m_per_s * v,
+                force_n: bow.force_n * f,
+                position_beta: (bow.position_beta * away).clamp(MIN_NOTE_BETA, MAX_NOTE_BETA),
             },
             None => self.shape(bow),
         };
@@ -1142,6 +1168,67 @@ mod tests {
             rms,
             classify_regime(&probe[n - window..], FS as f32, f0 as f32),
         )
+    }
+
+    #[test]
+    fn without_the_window_guard_a_soft_dynamic_under_a_heavy_bow_turns_raucous() {
+        // Expression 0.25 is 22.5 dB down: with the guard the force follows the velocity
+        // (Helmholtz, the test below); without it a bow 13x slower under the full 1 N
+        // presses about three times Schelleng's F_max for cello D3 and loses the single
+        // slip per period.
+        let setup = Setup {
+            dynamics_guard: false,
+            ..Setup::default()
+        };
+        let mut p = Performer::new(InstrumentKind::Cello);
+        p.activate(&setup, FS).unwrap();
+        p.configure(&setup);
+        p.set_controller(11, 0.25);
+        p.note_on(50, 0.8);
+        let bow = BowControl::default();
+        let n = (2.0 * FS) as usize;
+        let mut probe = Vec::with_capacity(n);
+        for i in 0..n {
+            if i % 256 == 0 {
+                p.configure(&setup);
+            }
+            let frame = p.tick(bow);
+            probe.push(ContactSample::new(&frame, &p.bow()));
+        }
+        let played = p.bow();
+        assert_eq!(played.force_n, 1.0, "the force is the parameter's");
+        assert_eq!(played.position_beta, 0.1, "no drift without the guard");
+        let f0 = midi_to_hz(50.0);
+        let window = 8 * (FS / f0) as usize;
+        let regime = classify_regime(&probe[n - window..], FS as f32, f0 as f32);
+        assert_ne!(regime, Some(Regime::Helmholtz));
+    }
+
+    #[test]
+    fn with_the_window_guard_soft_dynamics_move_the_bow_from_the_bridge() {
+        let mut p = cello();
+        p.set_controller(11, 0.0);
+        p.note_on(50, 0.8);
+        let bow = BowControl::default();
+        for _ in 0..(0.5 * FS) as usize {
+            p.tick(bow);
+        }
+        // -30 dB: the bow 2^(1/2) times farther from the bridge (1e-6: the smoothing's
+        // last step and rounding).
+        assert!(
+            (p.bow().position_beta / 0.1 - 2f64.sqrt()).abs() < 1e-6,
+            "{:?}",
+            p.bow()
+        );
+        p.set_controller(11, 1.0);
+        for _ in 0..(0.5 * FS) as usize {
+            p.tick(bow);
+        }
+        assert_eq!(
+            p.bow().position_beta,
+            0.1,
+            "full expression: the parameter's place"
+        );
     }
 
     #[test]
