@@ -835,9 +835,7 @@ impl Performer {
         }
         // With the guard the force follows the velocity and the bow drifts from the
         // bridge as the dynamics fall; without it only the velocity follows.
-        let (force_scale, away) = if !self.setup.dynamics_guard {
-            (1.0, 1.0)
-        } else if g.scale == 1.0 {
+        let (force_scale, away) = if !self.setup.dynamics_guard || g.scale == 1.0 {
             (1.0, 1.0)
         } else {
             (g.scale, g.scale.powf(-DYNAMICS_DRIFT_EXPONENT))

@@ -5,7 +5,8 @@
 //! a sample rate (8 k to 384 k), a sequence of block sizes (1 to 8192, primes and powers of
 //! two over-weighted), and a script of timed actions: bow velocity (0 and +-max over-weighted),
 //! trains of bow reversals every few ms, bow force (0 and max), bow position (both ends),
-//! notes in and out of every range, note storms (up to 32 notes a few samples apart),
+//! notes in and out of every range, note storms (up to 32 notes a few samples apart), raw
+//! channel messages on all 16 channels, MPE zones and CLAP tuning expressions,
 //! friction-law, instrument, resonator and thermal-bow switches during notes, pitch bend,
 //! output gain, and bow lifts of 60-400 ms with nothing else happening.
 //!
@@ -215,6 +216,11 @@ fn action() -> impl Strategy<Value = Action> {
         1 => op(thermal_bow().prop_map(Op::ThermalBow).boxed()),
         2 => op(prop_oneof![Just(-2.0), Just(2.0), -2.0..=2.0f64].prop_map(Op::Bend).boxed()),
         1 => op(prop_oneof![Just(12.0), -40.0..=12.0f64].prop_map(Op::GainDb).boxed()),
+        3 => op((0u8..16, prop::sample::select(vec![0x80u8, 0x90, 0xb0, 0xd0, 0xe0]), any::<u8>(), any::<u8>())
+            .prop_map(|(channel, kind, a, b)| Op::Midi([kind | channel, a & 127, b & 127])).boxed()),
+        1 => op((0u8..=15).prop_map(Op::MpeZone).boxed()),
+        1 => op((any::<u8>(), prop_oneof![Just(-128.0), Just(128.0), -60.0..=60.0f64])
+            .prop_map(|(n, st)| Op::Tuning(n & 127, st)).boxed()),
         2 => (60.0..400.0f64).prop_map(|ms| Action::Lift { ms }),
     ]
 }
@@ -265,6 +271,13 @@ enum Op {
     /// Semitones, -2..2.
     Bend(f64),
     GainDb(f64),
+    /// A raw channel message: note on/off, controller, pitch bend or channel pressure on
+    /// any of the 16 channels (MPE member channels once a zone exists).
+    Midi([u8; 3]),
+    /// The MPE Configuration Message for the lower zone with this many member channels.
+    MpeZone(u8),
+    /// A CLAP tuning expression on a key, semitones.
+    Tuning(u8, f64),
 }
 
 impl Op {
@@ -442,6 +455,28 @@ impl Rig {
                 self.setup.bow_width_m = s.width_m;
             }
             (Engine::Rubbed(..), Op::Resonator(Some(p))) => self.setup.rubbed = Some(p),
+            (_, Op::Midi([status, a, b])) => {
+                let (channel, value) = (status & 15, b as f32 / 127.0);
+                let p = &mut self.performer;
+                match status & 0xf0 {
+                    0x90 if b > 0 => p.note_on_channel(channel, a, value),
+                    0x80 | 0x90 => p.note_off(a),
+                    0xb0 => p.set_controller_channel(channel, a, value),
+                    0xd0 => p.set_pressure_channel(channel, a as f32 / 127.0),
+                    // As nice-plug hands a 14-bit bend over: 0..1.
+                    _ => p.set_pitch_wheel_channel(
+                        channel,
+                        ((b as u16) << 7 | a as u16) as f32 / 16383.0,
+                    ),
+                }
+            }
+            (_, Op::MpeZone(members)) => {
+                for (cc, value) in [(101u8, 0u8), (100, 6), (6, members)] {
+                    self.performer
+                        .set_controller_channel(0, cc, value as f32 / 127.0);
+                }
+            }
+            (_, Op::Tuning(n, semitones)) => self.performer.set_note_tuning(n, semitones as f32),
             _ => {}
         }
         if self.setup != before {
@@ -967,6 +1002,13 @@ fn render_plugin(case: &PluginCase) -> Result<Vec<f32>, String> {
             }
             Op::Bend(b) => push(Event::pitch_bend(b / 2.0)),
             Op::GainDb(g) => push(plugin.plain("Output Gain", g)),
+            Op::Midi(bytes) => push(Event::Midi(bytes)),
+            Op::MpeZone(members) => {
+                for (cc, value) in [(101u8, 0u8), (100, 6), (6, members)] {
+                    events.push((t, Event::Midi([0xb0, cc, value])));
+                }
+            }
+            Op::Tuning(key, semitones) => push(Event::Tuning { key, semitones }),
         }
     }
     let mut left = Vec::with_capacity(frames);
