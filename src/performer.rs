@@ -562,8 +562,35 @@ impl Performer {
                 }
             }
         }
+        if let Some(string) = self.notes[key].string.filter(|_| self.held[key]) {
+            self.share_the_bow(note, string);
+        }
         self.express(note);
         self.refresh_others();
+    }
+
+    /// One bow touches at most two adjacent strings: a note landing on `string` lifts the
+    /// bow from every other string more than one away (its note rings on, its key still
+    /// down), as a chord played with one bow is rolled and its first notes left ringing.
+    /// A double stop on neighbouring strings keeps both bowed.
+    fn share_the_bow(&mut self, note: u8, string: u8) {
+        for other in 0..128u8 {
+            let slot = &mut self.notes[other as usize];
+            let far = slot.string.is_some_and(|s| s.abs_diff(string) > 1);
+            if other == note || !self.held[other as usize] || !far {
+                continue;
+            }
+            slot.string = None;
+            match self.source {
+                Source::Strings => self.instrument.note_off(other),
+                Source::Thermal(k) => {
+                    if let Some(engine) = self.thermal.get_mut(k) {
+                        engine.note_off(other);
+                    }
+                }
+                Source::Rubbed(_) => {}
+            }
+        }
     }
 
     /// Gives `note`'s string the note's expression: its MPE channel's, with its own note
@@ -1118,6 +1145,44 @@ mod tests {
         p.activate(&setup, FS).unwrap();
         p.configure(&setup);
         p
+    }
+
+    #[test]
+    fn one_bow_plays_two_adjacent_strings_and_leaves_the_others_ringing() {
+        let bow = BowControl::default();
+        let settle = |p: &mut Performer| {
+            for _ in 0..(0.1 * FS) as usize {
+                p.tick(bow);
+            }
+        };
+        let bowed = |p: &Performer| -> Vec<usize> {
+            (0..4).filter(|&i| p.strings().bow_gain(i) > 0.0).collect()
+        };
+        // A double stop on the D and A strings (2, 3): both bowed.
+        let mut p = cello();
+        p.note_on(50, 0.8);
+        p.note_on(57, 0.8);
+        settle(&mut p);
+        assert_eq!(bowed(&p), [2, 3]);
+        // C and A strings (0, 3) cannot share a bow: the later one takes it, and the C
+        // string, bowed for 0.1 s first, rings on.
+        let mut p = cello();
+        p.note_on(36, 0.8);
+        settle(&mut p);
+        p.note_on(57, 0.8);
+        settle(&mut p);
+        assert_eq!(bowed(&p), [3]);
+        assert!(
+            p.strings().string(0).energy_j() > 0.0,
+            "the C string rings on"
+        );
+        // A four-note chord, low to high: the bow ends on the top two strings.
+        let mut p = cello();
+        for note in [36, 43, 50, 57] {
+            p.note_on(note, 0.8);
+        }
+        settle(&mut p);
+        assert_eq!(bowed(&p), [2, 3]);
     }
 
     #[test]
