@@ -283,6 +283,9 @@ struct Gesture {
     target: f64,
     /// The bow's present scale (smoothed toward `target`).
     scale: f64,
+    /// The window guard's drift of the bow position at this scale:
+    /// `scale^-`[`DYNAMICS_DRIFT_EXPONENT`] (1 at full scale).
+    away: f64,
     smoothing: f64,
     /// Vibrato depth, cents.
     vibrato_cents: f64,
@@ -318,6 +321,7 @@ impl Gesture {
         Self {
             target: 1.0,
             scale: 1.0,
+            away: 1.0,
             smoothing: 1.0 - (-1.0 / (DYNAMICS_SMOOTHING_S * sample_rate_hz)).exp(),
             vibrato_cents: 0.0,
             bend: 0.0,
@@ -859,13 +863,20 @@ impl Performer {
             if (g.scale - g.target).abs() < 1e-9 {
                 g.scale = g.target;
             }
+            // The guard's drift follows the scale: one power per change of the scale,
+            // none per sample while it rests (a vibrato ticks this path every sample).
+            g.away = if g.scale == 1.0 {
+                1.0
+            } else {
+                g.scale.powf(-DYNAMICS_DRIFT_EXPONENT)
+            };
         }
         // With the guard the force follows the velocity and the bow drifts from the
         // bridge as the dynamics fall; without it only the velocity follows.
-        let (force_scale, away) = if !self.setup.dynamics_guard || g.scale == 1.0 {
-            (1.0, 1.0)
+        let (force_scale, away) = if self.setup.dynamics_guard {
+            (g.scale, g.away)
         } else {
-            (g.scale, g.scale.powf(-DYNAMICS_DRIFT_EXPONENT))
+            (1.0, 1.0)
         };
         let out = if g.scale == 1.0 && speed == 1.0 && landing == 1.0 && away == 1.0 {
             bow
