@@ -3,6 +3,7 @@
 //! bowed strings at the note's pitch); the renderer's `--preset` plays a named preset and
 //! a broken or unknown one fails in one line with no file.
 
+use colophony::analysis::{cents, rms};
 use colophony::dsp::instrument::midi_to_hz;
 use colophony::params::ColophonyParams;
 use colophony::performer::Performer;
@@ -33,10 +34,10 @@ fn every_factory_preset_sounds_on_its_note() {
         // 0.2 s (paper A's modal object, as the renderer's own rub of it) and a squeal
         // that builds up over a second (the brake). -60 dBFS: far below any of them, far
         // above a note that does not speak.
-        let rms = (out.iter().map(|x| x * x).sum::<f64>() / out.len() as f64).sqrt();
+        let rms = rms(&out);
         assert!(rms > 1e-3, "{id}: rms {rms:.2e}");
         if setup.rubbed.is_none() {
-            let tail_rms = (tail.iter().map(|x| x * x).sum::<f64>() / tail.len() as f64).sqrt();
+            let tail_rms = rms(tail);
             assert!(
                 tail_rms > 1e-3,
                 "{id}: the bowed note dies ({tail_rms:.2e} after 0.75 s)"
@@ -45,7 +46,7 @@ fn every_factory_preset_sounds_on_its_note() {
             // intonation is the playing-space issue's; this checks the preset plays the
             // note, not an octave or a fifth off).
             let hz = autocorrelation_pitch_hz(tail, FS, midi_to_hz(note as f64));
-            let cents = 1200.0 * (hz / midi_to_hz(note as f64)).log2();
+            let cents = cents(hz, midi_to_hz(note as f64));
             assert!(
                 cents.abs() < 50.0,
                 "{id}: {hz:.1} Hz, {cents:+.0} cents from note {note}"
