@@ -34,8 +34,8 @@ fn every_factory_preset_sounds_on_its_note() {
         // 0.2 s (paper A's modal object, as the renderer's own rub of it) and a squeal
         // that builds up over a second (the brake). -60 dBFS: far below any of them, far
         // above a note that does not speak.
-        let rms = rms(&out);
-        assert!(rms > 1e-3, "{id}: rms {rms:.2e}");
+        let level = rms(&out);
+        assert!(level > 1e-3, "{id}: rms {level:.2e}");
         if setup.rubbed.is_none() {
             let tail_rms = rms(tail);
             assert!(
@@ -46,10 +46,10 @@ fn every_factory_preset_sounds_on_its_note() {
             // intonation is the playing-space issue's; this checks the preset plays the
             // note, not an octave or a fifth off).
             let hz = autocorrelation_pitch_hz(tail, FS, midi_to_hz(note as f64));
-            let cents = cents(hz, midi_to_hz(note as f64));
+            let off = cents(hz, midi_to_hz(note as f64));
             assert!(
-                cents.abs() < 50.0,
-                "{id}: {hz:.1} Hz, {cents:+.0} cents from note {note}"
+                off.abs() < 50.0,
+                "{id}: {hz:.1} Hz, {off:+.0} cents from note {note}"
             );
         }
     }
