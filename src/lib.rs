@@ -149,7 +149,7 @@ impl Plugin for Colophony {
         &mut self,
         _audio_io_layout: &AudioIOLayout,
         buffer_config: &BufferConfig,
-        _context: &mut impl ActivateContext<Self>,
+        context: &mut impl ActivateContext<Self>,
     ) -> bool {
         // Every buffer is sized here, never in `process`.
         let fs = buffer_config.sample_rate as f64;
@@ -174,6 +174,11 @@ impl Plugin for Colophony {
             }
         }
         self.editor_link.scope.set_sample_rate(fs as f32);
+        // The playing source's resampler delay (0.2 ms or less). Reported here only: a
+        // report from `process` makes the wrapper wake the host's main thread from the
+        // audio thread, and a CLAP host may only take a new latency while deactivated; a
+        // source switched while playing keeps the reported value until the next activation.
+        context.set_latency_samples(self.performer.latency_samples());
         true
     }
 

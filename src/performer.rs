@@ -1043,6 +1043,17 @@ impl Performer {
         self.source
     }
 
+    /// How late the current source's output is behind its model, whole host samples (its
+    /// resampler's delay, rounded): what the plugin reports to the host as latency.
+    pub fn latency_samples(&self) -> u32 {
+        let samples = match self.source {
+            Source::Strings => self.instrument.latency_samples(),
+            Source::Thermal(k) => self.thermal.get(k).map_or(0.0, |e| e.latency_samples()),
+            Source::Rubbed(_) => 0.0,
+        };
+        samples.round().clamp(0.0, 1e6) as u32
+    }
+
     /// The last note the strings took (the editor draws its Schelleng window).
     pub fn last_note(&self) -> Option<u8> {
         self.last_note

@@ -26,6 +26,22 @@ fn best_of_runs(runs: usize, mut run: impl FnMut()) -> f64 {
         .fold(f64::MAX, f64::min)
 }
 
+/// Paper A's cello D scene (v_b 0.1 m/s, F_N 1.1 N, beta 0.1), `SECONDS` at `fs`.
+fn paper_a_cello_d(fs: f64) -> RenderSettings {
+    RenderSettings {
+        instrument: InstrumentKind::Cello,
+        note: 50,
+        seconds: SECONDS,
+        bow: BowControl {
+            velocity_m_per_s: 0.1,
+            force_n: 1.1,
+            position_beta: 0.1,
+        },
+        sample_rate_hz: fs,
+        ..RenderSettings::default()
+    }
+}
+
 /// A markdown table: each friction law on paper A's cello D scenario (v_b 0.1 m/s,
 /// F_N 1.1 N, beta 0.1) and on the wine-glass preset, 10 s at 48 kHz: real-time ratio and
 /// cost relative to the static curve.
@@ -39,17 +55,8 @@ pub fn friction_table() -> Result<String, String> {
     let mut rows = Vec::new();
     for model in FrictionModel::ALL {
         let settings = RenderSettings {
-            instrument: InstrumentKind::Cello,
-            note: 50,
-            seconds: SECONDS,
-            bow: BowControl {
-                velocity_m_per_s: 0.1,
-                force_n: 1.1,
-                position_beta: 0.1,
-            },
-            sample_rate_hz: FS,
             friction: model,
-            ..RenderSettings::default()
+            ..paper_a_cello_d(FS)
         };
         let mut failure = None;
         let string_s = best_of_three(|| {
@@ -82,7 +89,44 @@ pub fn friction_table() -> Result<String, String> {
             glass_s / static_row.2
         ));
     }
+    lines.push(String::new());
+    lines.extend(host_rate_rows()?);
     Ok(lines.join("\n"))
+}
+
+/// The default string (hyperbolic cello D, as above) at other host rates: the plugin's
+/// strings at their internal 48 kHz resampled to the host rate, against the same strings
+/// run at the host rate itself ([`RenderSettings::native_rate`]); x real time.
+fn host_rate_rows() -> Result<Vec<String>, String> {
+    let mut lines = vec![
+        "| host rate (kHz) | plugin (48 kHz inside, resampled): x real time | strings at the host rate: x real time |".into(),
+        "|---|---|---|".into(),
+    ];
+    for fs in [44_100.0, 48_000.0, 96_000.0, 192_000.0] {
+        let settings = |native_rate| RenderSettings {
+            native_rate,
+            ..paper_a_cello_d(fs)
+        };
+        let mut failure = None;
+        let mut time = |native| {
+            best_of_three(|| {
+                if let Err(e) = render(&settings(native)) {
+                    failure = Some(e.to_string());
+                }
+            })
+        };
+        let (plugin_s, native_s) = (time(false), time(true));
+        if let Some(e) = failure {
+            return Err(e);
+        }
+        lines.push(format!(
+            "| {:.1} | {:.0} | {:.0} |",
+            fs / 1000.0,
+            SECONDS / plugin_s,
+            SECONDS / native_s
+        ));
+    }
+    Ok(lines)
 }
 
 /// Paper B's Table 1 on this machine: real-time cost (% of one core) of the whole cello

@@ -277,6 +277,8 @@ fn string_group(
         |fs: f64, tolerance_m_per_s: Option<f64>, dispersion_stages: Option<usize>| Model::String {
             settings: RenderSettings {
                 sample_rate_hz: fs,
+                // The discretisation itself, not the plugin's fixed internal rate.
+                native_rate: true,
                 ..settings
             },
             tolerance_m_per_s,

@@ -37,6 +37,10 @@ pub struct RenderSettings {
     /// Whether notes are tuned by the bowed sound (the plugin's tuning,
     /// [`colophony::dsp::intonation`]); off, by the free decay (paper A's string).
     pub intonation: bool,
+    /// Whether the strings run at `sample_rate_hz` itself ([`Instrument::native`]: paper
+    /// A's discretisation, for the convergence studies) instead of the plugin's internal
+    /// rate resampled to it ([`Instrument::new`]).
+    pub native_rate: bool,
 }
 
 impl Default for RenderSettings {
@@ -53,6 +57,7 @@ impl Default for RenderSettings {
             reference_hz: colophony::dsp::instrument::REFERENCE_HZ_DEFAULT,
             torsion: true,
             intonation: true,
+            native_rate: false,
         }
     }
 }
@@ -186,7 +191,11 @@ pub fn render_with(
     let fs = settings.sample_rate_hz;
     let frames = (settings.seconds * fs).round() as usize;
     let release = settings.release_s.map(|s| (s * fs).round() as usize);
-    let mut instrument = Instrument::new(settings.instrument, fs);
+    let mut instrument = if settings.native_rate {
+        Instrument::native(settings.instrument, fs)
+    } else {
+        Instrument::new(settings.instrument, fs)
+    };
     instrument
         .set_bristle_params(settings.bristle)
         .map_err(RenderError::BadSetting)?;

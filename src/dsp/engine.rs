@@ -45,6 +45,10 @@ pub trait Engine {
     fn ring_out_s(&self) -> Option<f64>;
     /// One sample.
     fn tick(&mut self, bow: BowControl) -> Frame;
+    /// How late the output is behind the model, host samples (a resampler's delay).
+    fn latency_samples(&self) -> f64 {
+        0.0
+    }
     /// Silence and forget every note.
     fn reset(&mut self);
 }
@@ -88,6 +92,9 @@ macro_rules! string_engine {
             }
             fn tick(&mut self, bow: BowControl) -> Frame {
                 <$t>::tick(self, bow)
+            }
+            fn latency_samples(&self) -> f64 {
+                <$t>::latency_samples(self)
             }
             fn reset(&mut self) {
                 <$t>::reset(self)

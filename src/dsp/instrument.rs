@@ -25,7 +25,17 @@ use super::body::{BodyMode, BodyModes};
 use super::friction::bristle::{BristleParams, SolverStats};
 use super::friction::{AnyFriction, BowInput, FrictionContact, FrictionModel};
 use super::intonation::{self, IntonationTable, MAX_CORRECTION_CENTS};
+use super::resample::Resampler;
 use super::waveguide::{StringSpec, WaveguideString};
+
+/// The rate the point-bow strings and their body run at, whatever the host's: the output
+/// is resampled to the host rate ([`Resampler`]). The bowed string's regime (Helmholtz
+/// motion or a double slip: both are stable over much of the window, and which one an
+/// attack falls into changes with any detail of the discretisation) and its pitch then do
+/// not depend on the project's rate, and the intonation table, measured at this rate,
+/// holds at every rate. 48 kHz: the commonest host rate (no resampling there), and twice
+/// the hearing range. Measured in docs/precision.md (issue 16, item 3).
+pub const INTERNAL_RATE_HZ: f64 = 48_000.0;
 
 pub const STRINGS: usize = 4;
 /// Highest note above the highest open string (about the end of the fingerboard).
@@ -317,7 +327,16 @@ const GLIDE_EVERY: u32 = 64;
 #[derive(Debug, Clone)]
 pub struct Instrument {
     kind: InstrumentKind,
+    /// The rate the strings and body run at ([`INTERNAL_RATE_HZ`], or the host's for
+    /// [`Instrument::native`]).
     sample_rate_hz: f64,
+    /// The rate [`Instrument::tick`] is called at.
+    host_rate_hz: f64,
+    /// From the internal rate to the host's; `None` where they are the same.
+    /// Boxed: taking it out for a tick moves a pointer, not the resampler.
+    resampler: Option<Box<Resampler>>,
+    /// The probe of the last internal sample (what a resampled tick reports).
+    last: Frame,
     voices: [StringVoice; STRINGS],
     body: BodyModes,
     bend_semitones: f64,
@@ -344,8 +363,47 @@ pub struct Instrument {
 }
 
 impl Instrument {
-    /// Allocates everything for this sample rate; instrument changes later do not allocate.
-    pub fn new(kind: InstrumentKind, sample_rate_hz: f64) -> Self {
+    /// The instrument the plugin plays at host rate `host_rate_hz`: strings and body at
+    /// [`INTERNAL_RATE_HZ`], resampled to the host rate (no resampler at 48 kHz).
+    /// Allocates everything; instrument changes later do not allocate.
+    pub fn new(kind: InstrumentKind, host_rate_hz: f64) -> Self {
+        Self::with_internal_rate(kind, host_rate_hz, INTERNAL_RATE_HZ)
+    }
+
+    /// Strings and body at the host rate itself, no resampling: paper A's model as the
+    /// papers discretise it, for the convergence studies in the rate.
+    pub fn native(kind: InstrumentKind, sample_rate_hz: f64) -> Self {
+        Self::with_internal_rate(kind, sample_rate_hz, sample_rate_hz)
+    }
+
+    /// Strings and body at `internal_rate_hz`, resampled to `host_rate_hz`. A rate that is
+    /// not finite and positive is taken as 48 kHz.
+    pub fn with_internal_rate(
+        kind: InstrumentKind,
+        host_rate_hz: f64,
+        internal_rate_hz: f64,
+    ) -> Self {
+        let usable = |r: f64| {
+            if r.is_finite() && r > 0.0 {
+                r
+            } else {
+                INTERNAL_RATE_HZ
+            }
+        };
+        let (host_rate_hz, sample_rate_hz) = (usable(host_rate_hz), usable(internal_rate_hz));
+        let resampler = (host_rate_hz != sample_rate_hz).then(|| {
+            Box::new(
+                Resampler::fixed(sample_rate_hz, host_rate_hz)
+                    .expect("finite positive rates are always resampled"),
+            )
+        });
+        let mut instrument = Self::at_rate(kind, sample_rate_hz);
+        instrument.host_rate_hz = host_rate_hz;
+        instrument.resampler = resampler;
+        instrument
+    }
+
+    fn at_rate(kind: InstrumentKind, sample_rate_hz: f64) -> Self {
         // Lowest fundamental any instrument can reach: cello C bent down at the lowest
         // reference pitch.
         let lowest_hz = midi_to_hz(36.0 + LOWEST_TUNING_SEMITONES) * 0.99;
@@ -370,6 +428,9 @@ impl Instrument {
         Self {
             kind,
             sample_rate_hz,
+            host_rate_hz: sample_rate_hz,
+            resampler: None,
+            last: Frame::default(),
             voices,
             gliding: false,
             glide_countdown: 0,
@@ -392,8 +453,20 @@ impl Instrument {
         self.kind
     }
 
+    /// The host rate [`Instrument::tick`] runs at.
     pub fn sample_rate_hz(&self) -> f64 {
+        self.host_rate_hz
+    }
+
+    /// The rate the strings and body run at.
+    pub fn internal_rate_hz(&self) -> f64 {
         self.sample_rate_hz
+    }
+
+    /// How late the output is behind the strings, host samples (the resampler's delay;
+    /// 0 at the internal rate).
+    pub fn latency_samples(&self) -> f64 {
+        self.resampler.as_ref().map_or(0.0, |r| r.latency_samples())
     }
 
     /// Switches instrument: every string is replaced and silenced. Real-time safe.
@@ -426,6 +499,10 @@ impl Instrument {
         }
         self.gliding = false;
         self.body.reset();
+        if let Some(r) = &mut self.resampler {
+            r.reset();
+        }
+        self.last = Frame::default();
     }
 
     /// Stops the string for `note` and lands the bow on it. Returns the string index, or
@@ -662,6 +739,10 @@ impl Instrument {
         self.body_asleep = self.voices.iter().all(|v| !v.awake) && self.body.is_quiet(BODY_QUIET_N);
         if self.body_asleep {
             self.body.reset();
+            // What the resampler still holds is below -200 dB: asleep is silence.
+            if let Some(r) = &mut self.resampler {
+                r.reset();
+            }
         }
         for voice in &mut self.voices {
             if voice.awake
@@ -675,13 +756,46 @@ impl Instrument {
         }
     }
 
-    /// One sample.
+    /// One host sample: the internal samples it needs, resampled (the bow control holds
+    /// over them), or one internal sample where the rates are the same.
     #[inline]
     pub fn tick(&mut self, bow: BowControl) -> Frame {
+        if self.asleep() {
+            // Silence; the resampler was cleared when the instrument fell asleep.
+            return Frame::default();
+        }
+        let Some(mut resampler) = self.resampler.take() else {
+            return self.tick_internal(bow);
+        };
+        let mut out = [0.0];
+        resampler.process(
+            || {
+                let frame = self.tick_internal(bow);
+                self.last = frame;
+                frame.audio
+            },
+            &mut out,
+        );
+        self.resampler = Some(resampler);
+        Frame {
+            audio: super::filters::flush_tiny(out[0]),
+            ..self.last
+        }
+    }
+
+    /// Sleeping is on and nothing is awake: an internal sample is silence.
+    #[inline]
+    fn asleep(&self) -> bool {
+        self.skipping && self.body_asleep && self.voices.iter().all(|v| !v.awake)
+    }
+
+    /// One internal sample.
+    #[inline]
+    fn tick_internal(&mut self, bow: BowControl) -> Frame {
         let mut bridge = 0.0;
         let mut frame = Frame::default();
         let skipping = self.skipping;
-        if skipping && self.body_asleep && self.voices.iter().all(|v| !v.awake) {
+        if self.asleep() {
             return Frame::default();
         }
         self.body_asleep = false;

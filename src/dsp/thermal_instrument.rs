@@ -701,6 +701,11 @@ impl ThermalInstrument {
         }
     }
 
+    /// How late the output is behind the strings, host samples (the resampler's delay).
+    pub fn latency_samples(&self) -> f64 {
+        self.resampler.latency_samples()
+    }
+
     /// How often the non-finite guard in [`ThermalInstrument::tick`] has fired (it never
     /// should: the stress suite asserts zero).
     pub fn recoveries(&self) -> u64 {

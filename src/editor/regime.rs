@@ -36,6 +36,7 @@
 //! ```
 
 use super::live::ContactSample;
+use crate::dsp::instrument::INTERNAL_RATE_HZ;
 
 /// A sample slips where the relative velocity exceeds this fraction of the bow velocity.
 /// Sticking is `v_s = v_b` exactly for the point laws and within a creep far below `v_b` for
@@ -122,7 +123,7 @@ pub fn classify_regime(samples: &[ContactSample], sample_rate: f32, f0_hz: f32) 
         .collect();
     Some(
         (1..=MAX_SLIPS_PER_PERIOD)
-            .find(|&n| repeats_every_period(&onsets, n, period))
+            .find(|&n| repeats_every_period(&onsets, n, period, sample_rate))
             .map_or(Regime::Raucous, |n| match n {
                 1 => Regime::Helmholtz,
                 n => Regime::MultipleSlips(n as u8),
@@ -132,7 +133,7 @@ pub fn classify_regime(samples: &[ContactSample], sample_rate: f32, f0_hz: f32) 
 
 /// Whether every onset is followed `n` onsets later by one a period later (see the module
 /// doc), over at least two spans.
-fn repeats_every_period(onsets: &[usize], n: usize, period: f32) -> bool {
+fn repeats_every_period(onsets: &[usize], n: usize, period: f32, sample_rate: f32) -> bool {
     if onsets.len() < n + 2 {
         return false;
     }
@@ -143,8 +144,11 @@ fn repeats_every_period(onsets: &[usize], n: usize, period: f32) -> bool {
         .collect();
     spans.sort_by(f32::total_cmp);
     let median = spans[spans.len() / 2];
-    // Two samples: each onset is found to within one.
-    let tolerance = (PERIOD_JITTER * median).max(2.0);
+    // Two samples of the model: each onset is found to within one. The point strings run
+    // at 48 kHz whatever the host's rate and the probe holds their last sample, so above
+    // 48 kHz an onset moves in steps of several host samples.
+    let model_sample = (sample_rate / INTERNAL_RATE_HZ as f32).max(1.0);
+    let tolerance = (PERIOD_JITTER * median).max(2.0 * model_sample);
     (period / PERIOD_RANGE..=period * PERIOD_RANGE).contains(&median)
         && spans.iter().all(|s| (s - median).abs() <= tolerance)
 }
