@@ -5,7 +5,7 @@ use colophony::dsp::friction::FrictionModel;
 use colophony::dsp::instrument::{BowControl, InstrumentKind};
 use colophony::dsp::rubbed::RubbedPreset;
 use colophony::quality::Quality;
-use colophony_lab::render::{parse_note, render_with, write_wav, RenderSettings};
+use colophony_lab::render::{check, parse_note, render_frames, write_wav, RenderSettings, WavOut};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -316,16 +316,27 @@ fn main() -> ExitCode {
                 ..RenderSettings::default()
             };
             let started = std::time::Instant::now();
-            let rendered = if thermal {
+            let written = if thermal {
                 colophony_lab::render::render_thermal(&settings, nodes, bow_width)
+                    .and_then(|r| write_wav(&out, &r, probe))
             } else {
-                render_with(&settings, |instrument| {
-                    if let Some(t) = tolerance {
-                        instrument.set_newton_tolerance(t);
-                    }
-                })
+                // Streamed to the file: nothing of the render is kept in memory.
+                check(&settings)
+                    .and_then(|()| WavOut::create(&out, settings.sample_rate_hz, probe))
+                    .and_then(|mut wav| {
+                        render_frames(
+                            &settings,
+                            |instrument| {
+                                if let Some(t) = tolerance {
+                                    instrument.set_newton_tolerance(t);
+                                }
+                            },
+                            |frame| wav.push(frame),
+                        )?;
+                        wav.finish()
+                    })
             };
-            match rendered.and_then(|r| write_wav(&out, &r, probe)) {
+            match written {
                 Ok(()) => {
                     let took = started.elapsed().as_secs_f64();
                     println!(

@@ -9,7 +9,7 @@
 
 use colophony::dsp::friction::bristle::{BristleParams, SolverStats};
 use colophony::dsp::friction::FrictionModel;
-use colophony::dsp::instrument::{BowControl, Instrument, InstrumentKind};
+use colophony::dsp::instrument::{BowControl, Frame, Instrument, InstrumentKind};
 use colophony::dsp::rubbed::{RubbedPreset, RubbedScene};
 use std::fmt;
 use std::path::Path;
@@ -187,6 +187,26 @@ pub fn render_with(
     settings: &RenderSettings,
     configure: impl FnOnce(&mut Instrument),
 ) -> Result<Rendered, RenderError> {
+    let fs = settings.sample_rate_hz;
+    let mut out = Rendered::with_capacity(fs, (settings.seconds * fs).round().max(0.0) as usize);
+    out.newton = render_frames(settings, configure, |frame| {
+        out.audio.push(frame.audio);
+        out.bow_point_velocity_m_per_s
+            .push(frame.bow_point_velocity_m_per_s);
+        out.friction_force_n.push(frame.friction_force_n);
+        Ok(())
+    })?;
+    Ok(out)
+}
+
+/// [`render_with`], handing each frame to `each` as it is made instead of keeping them
+/// (the command line's `render` streams them to the file). Returns the bowed string's
+/// Newton statistics.
+pub fn render_frames(
+    settings: &RenderSettings,
+    configure: impl FnOnce(&mut Instrument),
+    mut each: impl FnMut(&Frame) -> Result<(), RenderError>,
+) -> Result<SolverStats, RenderError> {
     check(settings)?;
     let fs = settings.sample_rate_hz;
     let frames = (settings.seconds * fs).round() as usize;
@@ -209,7 +229,6 @@ pub fn render_with(
     instrument.set_reference_pitch(settings.reference_hz);
     configure(&mut instrument);
     instrument.note_on(settings.note);
-    let mut out = Rendered::with_capacity(fs, frames);
     for i in 0..frames {
         if i % BLOCK == 0 {
             instrument.update_sleep();
@@ -217,14 +236,9 @@ pub fn render_with(
         if Some(i) == release {
             instrument.note_off(settings.note);
         }
-        let frame = instrument.tick(settings.bow);
-        out.audio.push(frame.audio);
-        out.bow_point_velocity_m_per_s
-            .push(frame.bow_point_velocity_m_per_s);
-        out.friction_force_n.push(frame.friction_force_n);
+        each(&instrument.tick(settings.bow))?;
     }
-    out.newton = instrument.probed_solver_stats();
-    Ok(out)
+    Ok(instrument.probed_solver_stats())
 }
 
 /// Paper B's finite-width thermal bow on the string that plays `settings.note` (stopped
@@ -384,49 +398,111 @@ pub fn render_rubbed_with(
 /// channel 0 is the audio, 1 the string velocity at the bow (m/s), 2 the friction force
 /// (N). The file appears whole or not at all (written beside it, then renamed).
 pub fn write_wav(path: &Path, rendered: &Rendered, probe: bool) -> Result<(), RenderError> {
-    let io =
-        |e: &dyn fmt::Display| RenderError::Io(format!("cannot write {}: {e}", path.display()));
-    let spec = if probe {
-        hound::WavSpec {
-            channels: 3,
-            sample_rate: rendered.sample_rate_hz as u32,
-            bits_per_sample: 32,
-            sample_format: hound::SampleFormat::Float,
-        }
-    } else {
-        hound::WavSpec {
-            channels: 1,
-            sample_rate: rendered.sample_rate_hz as u32,
-            bits_per_sample: 16,
-            sample_format: hound::SampleFormat::Int,
-        }
-    };
-    let mut tmp_name = path
-        .file_name()
-        .ok_or_else(|| io(&"not a file path"))?
-        .to_os_string();
-    tmp_name.push(".partial");
-    let tmp = path.with_file_name(tmp_name);
-    let result = (|| -> Result<(), hound::Error> {
-        let mut w = hound::WavWriter::create(&tmp, spec)?;
-        for i in 0..rendered.audio.len() {
-            if probe {
-                w.write_sample(rendered.audio[i] as f32)?;
-                w.write_sample(rendered.bow_point_velocity_m_per_s[i] as f32)?;
-                w.write_sample(rendered.friction_force_n[i] as f32)?;
-            } else {
-                w.write_sample((rendered.audio[i].clamp(-1.0, 1.0) * 32767.0).round() as i16)?;
+    let mut w = WavOut::create(path, rendered.sample_rate_hz, probe)?;
+    for i in 0..rendered.audio.len() {
+        w.push(&Frame {
+            audio: rendered.audio[i],
+            // Renders without a probe (the performer's) leave these empty.
+            bow_point_velocity_m_per_s: rendered
+                .bow_point_velocity_m_per_s
+                .get(i)
+                .copied()
+                .unwrap_or(0.0),
+            friction_force_n: rendered.friction_force_n.get(i).copied().unwrap_or(0.0),
+        })?;
+    }
+    w.finish()
+}
+
+/// A WAV file written frame by frame: 16-bit mono audio, or with `probe` three 32-bit
+/// float channels (audio, string velocity at the bow, friction force). Written under a
+/// `.partial` name and renamed by [`WavOut::finish`], so a failed render leaves no file
+/// that looks whole.
+pub struct WavOut {
+    writer: Option<hound::WavWriter<std::io::BufWriter<std::fs::File>>>,
+    probe: bool,
+    path: std::path::PathBuf,
+    tmp: std::path::PathBuf,
+}
+
+impl WavOut {
+    pub fn create(path: &Path, sample_rate_hz: f64, probe: bool) -> Result<Self, RenderError> {
+        let spec = if probe {
+            hound::WavSpec {
+                channels: 3,
+                sample_rate: sample_rate_hz as u32,
+                bits_per_sample: 32,
+                sample_format: hound::SampleFormat::Float,
             }
-        }
+        } else {
+            hound::WavSpec {
+                channels: 1,
+                sample_rate: sample_rate_hz as u32,
+                bits_per_sample: 16,
+                sample_format: hound::SampleFormat::Int,
+            }
+        };
+        let mut tmp_name = path
+            .file_name()
+            .ok_or_else(|| io_error(path, &"not a file path"))?
+            .to_os_string();
+        tmp_name.push(".partial");
+        let tmp = path.with_file_name(tmp_name);
+        let writer = hound::WavWriter::create(&tmp, spec).map_err(|e| io_error(path, &e))?;
+        Ok(Self {
+            writer: Some(writer),
+            probe,
+            path: path.to_path_buf(),
+            tmp,
+        })
+    }
+
+    pub fn push(&mut self, frame: &Frame) -> Result<(), RenderError> {
+        let Some(w) = self.writer.as_mut() else {
+            return Ok(());
+        };
+        let written = if self.probe {
+            w.write_sample(frame.audio as f32)
+                .and_then(|()| w.write_sample(frame.bow_point_velocity_m_per_s as f32))
+                .and_then(|()| w.write_sample(frame.friction_force_n as f32))
+        } else {
+            w.write_sample(to_i16(frame.audio))
+        };
+        written.map_err(|e| io_error(&self.path, &e))
+    }
+
+    /// Completes the file and gives it its name.
+    pub fn finish(mut self) -> Result<(), RenderError> {
+        let Some(w) = self.writer.take() else {
+            return Ok(());
+        };
         w.finalize()
-    })();
-    match result {
-        Ok(()) => std::fs::rename(&tmp, path).map_err(|e| io(&e)),
-        Err(e) => {
-            let _ = std::fs::remove_file(&tmp);
-            Err(io(&e))
+            .map_err(|e| io_error(&self.path, &e))
+            .and_then(|()| {
+                std::fs::rename(&self.tmp, &self.path).map_err(|e| io_error(&self.path, &e))
+            })
+    }
+}
+
+impl Drop for WavOut {
+    /// An unfinished file (an error on the way) is removed.
+    fn drop(&mut self) {
+        if self.writer.take().is_some() {
+            let _ = std::fs::remove_file(&self.tmp);
         }
     }
+}
+
+fn io_error(path: &Path, e: &dyn fmt::Display) -> RenderError {
+    RenderError::Io(format!("cannot write {}: {e}", path.display()))
+}
+
+/// A sample in -1..=1 as 16-bit PCM, rounded half away from zero (what `f64::round`
+/// does, without its library call: the baseline x86-64 target has no rounding
+/// instruction).
+fn to_i16(x: f64) -> i16 {
+    let y = x.clamp(-1.0, 1.0) * 32767.0;
+    (y + 0.5f64.copysign(y)) as i16
 }
 
 /// Parses a note as a MIDI number (`50`) or a name with octave (`D3`, `F#4`, `Bb2`;

@@ -112,6 +112,8 @@ pub struct WaveguideString {
     dispersion_cap: usize,
     fraction: Allpass1,
     torsion: Torsion,
+    /// The bow position `bow_index` was computed for (NaN: recompute).
+    bow_beta: f64,
 }
 
 /// The string's torsional motion as the bow feels it: a high-pass admittance in parallel
@@ -187,6 +189,7 @@ impl WaveguideString {
                 enabled: true,
                 ..Torsion::default()
             },
+            bow_beta: f64::NAN,
         };
         s.stop_at(spec.open_hz);
         s
@@ -299,6 +302,7 @@ impl WaveguideString {
         self.fundamental_hz = f1_hz;
         // The torsion's corner follows the pitch: redesigned at the next bow position.
         self.torsion.index = usize::MAX;
+        self.bow_beta = f64::NAN;
     }
 
     /// The loop's delay in samples at angular frequency `w` (rad/sample): the two
@@ -327,6 +331,11 @@ impl WaveguideString {
     /// Moves the bow to `beta` (distance from the bridge over the vibrating length).
     #[inline]
     pub fn set_bow_position(&mut self, beta: f64) {
+        // Called every sample: the same position on the same loop changes nothing.
+        if beta == self.bow_beta && self.torsion.index == self.bow_index {
+            return;
+        }
+        self.bow_beta = beta;
         let k = ((beta * self.loop_samples - 1.0) * 0.5).round();
         self.bow_index = (k.max(0.0) as usize).min(self.m - 2);
         if self.bow_index != self.torsion.index {
