@@ -1068,3 +1068,28 @@ fn a_bridge_saved_with_the_project_plays_and_a_damaged_one_plays_the_shipped_bri
         "a damaged saved bridge plays the shipped one"
     );
 }
+
+/// The plugin reports its resampler's delay as latency (issue 16, item 3: the point
+/// strings run at 48 kHz inside): none at 48 kHz, where nothing is resampled; at other
+/// rates the delay `Instrument::latency_samples` measures (the resampler's tests check
+/// that the output is shifted by exactly that), rounded, and a fraction of a millisecond.
+#[test]
+fn the_reported_latency_is_the_resamplers_delay_at_every_rate() {
+    use colophony::dsp::instrument::{Instrument, InstrumentKind};
+    for sample_rate in [22_050.0, 44_100.0, 48_000.0, 96_000.0, 192_000.0] {
+        let mut plugin = active_plugin(sample_rate, BLOCK);
+        let reported = plugin.latency();
+        let delay = Instrument::new(InstrumentKind::Cello, sample_rate).latency_samples();
+        assert_eq!(reported, delay.round() as u32, "{sample_rate} Hz");
+        if sample_rate == 48_000.0 {
+            assert_eq!(reported, 0);
+        } else {
+            // Above zero, under 0.5 ms: the kernel's half width.
+            assert!(reported > 0, "{sample_rate} Hz: no latency reported");
+            assert!(
+                (reported as f64) < 0.5e-3 * sample_rate,
+                "{sample_rate} Hz: {reported} samples"
+            );
+        }
+    }
+}

@@ -19,6 +19,7 @@
 #![allow(dead_code)]
 
 use clack_extensions::audio_ports::{AudioPortInfoBuffer, PluginAudioPorts};
+use clack_extensions::latency::PluginLatency;
 use clack_extensions::note_ports::{NoteDialects, NotePortInfoBuffer, PluginNotePorts};
 use clack_extensions::params::{ParamInfoBuffer, PluginParams};
 use clack_extensions::state::PluginState;
@@ -351,6 +352,17 @@ impl HostedPlugin {
             .expect("no tail extension");
         let activation = self.activation.as_mut().expect("activate first");
         ext.get(&activation.processor.plugin_handle())
+    }
+
+    /// The latency the plugin reports, samples (CLAP latency extension, asked on the main
+    /// thread after activation, as hosts do).
+    #[allow(dead_code)]
+    pub fn latency(&mut self) -> u32 {
+        let mut handle = self.instance.plugin_handle();
+        let ext = handle
+            .get_extension::<PluginLatency>()
+            .expect("no latency extension");
+        ext.get(&mut handle)
     }
 
     /// The plugin's saved state (CLAP state extension).
