@@ -113,15 +113,19 @@ impl<R: Record> Ring<R> {
         self.written.load(Ordering::Acquire)
     }
 
-    /// Editor: replaces `out` with up to the `max` newest whole records, oldest first;
-    /// records overwritten or being written while they were copied are left out.
+    /// Editor: replaces `out` with up to the `max` newest whole records, oldest first and
+    /// consecutive: if the writer overwrote some while they were copied, only the run
+    /// after the last overwritten one is kept.
     pub fn copy_latest(&self, max: usize, out: &mut Vec<R>) {
         out.clear();
         let end = self.written();
         let start = end - (max.min(self.len()) as u64).min(end);
         for n in start..end {
-            if let Some(record) = self.read(n) {
-                out.push(record);
+            match self.read(n) {
+                Some(record) => out.push(record),
+                // The writer lapped the reader: this slot, and every older one, now holds
+                // a newer record. Keep only what follows, so the records stay consecutive.
+                None => out.clear(),
             }
         }
     }

@@ -378,11 +378,7 @@ impl Instrument {
 
     /// Strings and body at `internal_rate_hz`, resampled to `host_rate_hz`. A rate that is
     /// not finite and positive is taken as 48 kHz.
-    pub fn with_internal_rate(
-        kind: InstrumentKind,
-        host_rate_hz: f64,
-        internal_rate_hz: f64,
-    ) -> Self {
+    fn with_internal_rate(kind: InstrumentKind, host_rate_hz: f64, internal_rate_hz: f64) -> Self {
         let usable = |r: f64| {
             if r.is_finite() && r > 0.0 {
                 r
@@ -792,12 +788,10 @@ impl Instrument {
     /// One internal sample.
     #[inline]
     fn tick_internal(&mut self, bow: BowControl) -> Frame {
+        // `tick` checked that something is awake; sleep changes only between blocks.
         let mut bridge = 0.0;
         let mut frame = Frame::default();
         let skipping = self.skipping;
-        if self.asleep() {
-            return Frame::default();
-        }
         self.body_asleep = false;
         if self.gliding {
             if self.glide_countdown == 0 {
