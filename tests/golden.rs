@@ -5,8 +5,9 @@
 //!
 //! Each render is kept as a 64-bit FNV-1a hash of its samples' bits, with its RMS and
 //! peak for the failure message, in `tests/golden/renders.txt`. A change meant to be
-//! audible re-records them: `COLOPHONY_RECORD_GOLDEN=1 cargo test --test golden`, and the
-//! commit says why.
+//! audible re-records them: `COLOPHONY_RECORD_GOLDEN=1 cargo test --test golden --test
+//! state_fixtures` (the second re-records the saved state's render too), and the commit
+//! says why.
 //!
 //! Bits are comparable only where the math library takes the same code paths: glibc picks
 //! its `sin`, `exp`, `pow` variants by the CPU's features (FMA or not), which can change
@@ -17,7 +18,7 @@
 
 mod host;
 
-use host::{channel_f64, Event, HostedPlugin, Score};
+use host::{channel_f64, fnv1a, machine, Event, HostedPlugin, Score};
 use std::fmt::Write as _;
 
 const FS: f64 = 48_000.0;
@@ -26,17 +27,6 @@ const GOLDEN: &str = "tests/golden/renders.txt";
 
 fn secs(t: f64) -> u64 {
     (t * FS).round() as u64
-}
-
-fn fnv1a(samples: &[f32]) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for s in samples {
-        for b in s.to_bits().to_le_bytes() {
-            h ^= b as u64;
-            h = h.wrapping_mul(0x0000_0100_0000_01b3);
-        }
-    }
-    h
 }
 
 /// One scene: a name, the parameter texts to set, and the length in seconds.
@@ -125,22 +115,6 @@ fn render(scene: &Scene) -> Vec<f32> {
         .at(secs(0.75 * t), Event::note_off(low + 7));
     let out = plugin.render(secs(t) as usize, BLOCK, &score);
     out[0].clone()
-}
-
-/// The CPU features that choose the math library's code paths.
-fn machine() -> String {
-    #[cfg(target_arch = "x86_64")]
-    {
-        format!(
-            "# machine: x86_64 fma={} avx2={}",
-            std::is_x86_feature_detected!("fma"),
-            std::is_x86_feature_detected!("avx2")
-        )
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        format!("# machine: {}", std::env::consts::ARCH)
-    }
 }
 
 /// RMS and peak of a golden line.

@@ -684,3 +684,31 @@ pub fn write_wav(name: &str, sample_rate: f64, channels: &[Vec<f32>]) -> PathBuf
         .join(format!("{name}.wav"));
     write_wav_to(&path, sample_rate, channels)
 }
+
+/// A 64-bit FNV-1a hash of the samples' bits (golden renders and state fixtures).
+pub fn fnv1a(samples: &[f32]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for s in samples {
+        for b in s.to_bits().to_le_bytes() {
+            h ^= b as u64;
+            h = h.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    }
+    h
+}
+
+/// The CPU features that choose the math library's code paths.
+pub fn machine() -> String {
+    #[cfg(target_arch = "x86_64")]
+    {
+        format!(
+            "# machine: x86_64 fma={} avx2={}",
+            std::is_x86_feature_detected!("fma"),
+            std::is_x86_feature_detected!("avx2")
+        )
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        format!("# machine: {}", std::env::consts::ARCH)
+    }
+}
