@@ -378,10 +378,12 @@ impl Performer {
         }
     }
 
-    /// Plays paper B's thermal instrument of `kind` on `bridge` (a fitted or measured
-    /// modal bridge, [`crate::dsp::bridge_data`]) instead of the shipped one; `None` goes
-    /// back to the shipped bridge. Takes effect at the next [`Performer::activate`] (it
-    /// builds the engines: not for the audio thread).
+    /// Plays `kind` on `bridge` (a fitted or measured modal bridge,
+    /// [`crate::dsp::bridge_data`]) instead of the shipped one: paper B's thermal
+    /// instrument on the bridge itself, the point-bow instrument with the bridge's passive
+    /// reduction as its body ([`crate::dsp::body::body_from_bridge`]). `None` goes back to
+    /// the shipped bridge and the generic body. Takes effect at the next
+    /// [`Performer::activate`] (it builds the engines: not for the audio thread).
     pub fn set_user_bridge(&mut self, kind: InstrumentKind, bridge: Option<BridgeModes>) {
         if let Some(k) = InstrumentKind::ALL.iter().position(|&x| x == kind) {
             self.user_bridges[k] = bridge;
@@ -393,6 +395,14 @@ impl Performer {
         self.setup = *setup;
         let fs = sample_rate_hz;
         self.instrument = Instrument::new(setup.instrument, fs);
+        // The point-bow strings play a chosen bridge as their body: its passive
+        // reduction to the bowing direction's strongest modes.
+        for (k, kind) in InstrumentKind::ALL.into_iter().enumerate() {
+            if let Some(user) = &self.user_bridges[k] {
+                let (modes, _) = crate::dsp::body::body_from_bridge(&user.modes);
+                self.instrument.set_body(kind, Some(&modes));
+            }
+        }
         let settings = self.thermal_settings();
         self.thermal.clear();
         for (k, kind) in InstrumentKind::ALL.into_iter().enumerate() {
@@ -1167,6 +1177,62 @@ mod tests {
         p.activate(&setup, FS).unwrap();
         p.configure(&setup);
         p
+    }
+
+    #[test]
+    fn a_chosen_bridge_colours_the_point_bow_sound_and_leaves_the_string_alone() {
+        // The point-bow body only colours what radiates (it feeds nothing back): with a
+        // chosen bridge's reduction as the body the string moves exactly as before, and
+        // the sound changes, towards the bridge's strongest horizontal mode.
+        let bow = BowControl::default();
+        let play = |bridge: Option<BridgeModes>| {
+            let setup = Setup::default();
+            let mut p = Performer::new(InstrumentKind::Cello);
+            p.set_user_bridge(InstrumentKind::Cello, bridge);
+            p.activate(&setup, FS).unwrap();
+            p.configure(&setup);
+            p.note_on(50, 0.8);
+            let frames: Vec<Frame> = (0..(0.5 * FS) as usize).map(|_| p.tick(bow)).collect();
+            frames
+        };
+        let violin = bridge_data::shipped_violin_bridge();
+        let (modes, _) = crate::dsp::body::body_from_bridge(&violin.modes);
+        let generic = play(None);
+        let chosen = play(Some(violin));
+        let probe = |f: &[Frame]| -> Vec<u64> {
+            f.iter()
+                .map(|x| x.bow_point_velocity_m_per_s.to_bits())
+                .collect()
+        };
+        assert_eq!(probe(&generic), probe(&chosen), "the body moved the string");
+        assert!(chosen.iter().all(|f| f.audio.is_finite()));
+        let audio = |f: &[Frame]| -> Vec<f64> {
+            f[(0.2 * FS) as usize..].iter().map(|x| x.audio).collect()
+        };
+        let (a, b) = (audio(&generic), audio(&chosen));
+        assert_ne!(a, b, "the chosen bridge changed nothing");
+        // The strongest kept mode's band carries more of the sound than with the generic
+        // body (the D3 note's partials near it are lifted).
+        let near = |x: &[f64]| {
+            let f = modes[0].freq_hz;
+            (0..5)
+                .map(|k| {
+                    crate::analysis::partial_amplitude(
+                        x,
+                        FS,
+                        f * 2f64.powf((k as f64 - 2.0) / 24.0),
+                    )
+                })
+                .fold(0.0, f64::max)
+                / crate::analysis::rms(x)
+        };
+        assert!(
+            near(&b) > near(&a),
+            "{} vs {} at {} Hz",
+            near(&b),
+            near(&a),
+            modes[0].freq_hz
+        );
     }
 
     #[test]

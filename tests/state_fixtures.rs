@@ -72,7 +72,8 @@ fn record_full_state() -> Vec<u8> {
     let saved = plugin.save_state();
     let mut state: serde_json::Value = serde_json::from_slice(&saved[8..]).unwrap();
     let bridge = std::fs::read_to_string(workspace_root().join(BRIDGE_FILE)).unwrap();
-    let bridges = serde_json::json!({ BRIDGE_FOR: { "name": "violin-generic.json", "json": bridge } });
+    let bridges =
+        serde_json::json!({ BRIDGE_FOR: { "name": "violin-generic.json", "json": bridge } });
     state["fields"]["user-bridges"] = serde_json::Value::String(bridges.to_string());
     let mut again = HostedPlugin::load_test_build();
     again
@@ -97,7 +98,12 @@ fn render_fixture(plugin: &mut HostedPlugin) -> Vec<f32> {
 fn line(x: &[f32]) -> String {
     let y = channel_f64(&[x.to_vec()], 0);
     let peak = y.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    format!("v1-full {:016x} rms {:.6e} peak {:.6e}", fnv1a(x), rms(&y), peak)
+    format!(
+        "v1-full {:016x} rms {:.6e} peak {:.6e}",
+        fnv1a(x),
+        rms(&y),
+        peak
+    )
 }
 
 fn loaded(bytes: &[u8]) -> HostedPlugin {
@@ -123,7 +129,11 @@ fn a_state_with_every_parameter_changed_and_a_user_bridge_loads_and_renders_as_r
     for (name, text) in FULL {
         let want = reference.text_to_clap(name, text);
         assert_eq!(plugin.clap_value(name), want, "{name}");
-        assert_ne!(want, reference.param(name).default, "{name} is at its default");
+        assert_ne!(
+            want,
+            reference.param(name).default,
+            "{name} is at its default"
+        );
     }
     let listed: Vec<&str> = FULL.iter().map(|(n, _)| *n).collect();
     for p in reference.params() {
@@ -138,7 +148,10 @@ fn a_state_with_every_parameter_changed_and_a_user_bridge_loads_and_renders_as_r
     assert!(x.iter().all(|v| v.is_finite()));
     let mut state: serde_json::Value = serde_json::from_slice(&bytes[8..]).unwrap();
     let fields = state["fields"].as_object_mut().unwrap();
-    assert!(fields.contains_key("user-bridges"), "the fixture holds no bridge");
+    assert!(
+        fields.contains_key("user-bridges"),
+        "the fixture holds no bridge"
+    );
     fields.remove("user-bridges");
     let mut shipped = loaded(&with_length(&serde_json::to_vec(&state).unwrap()));
     let y = render_fixture(&mut shipped);
@@ -163,7 +176,10 @@ fn a_state_with_every_parameter_changed_and_a_user_bridge_loads_and_renders_as_r
         return;
     }
     let file = std::fs::read_to_string(&render_path).unwrap();
-    let recorded_on = file.lines().find(|l| l.starts_with("# machine:")).unwrap_or("");
+    let recorded_on = file
+        .lines()
+        .find(|l| l.starts_with("# machine:"))
+        .unwrap_or("");
     let want = file.lines().find(|l| !l.starts_with('#')).unwrap();
     if recorded_on == machine() {
         assert_eq!(got, want, "the fixture renders differently");
@@ -173,8 +189,14 @@ fn a_state_with_every_parameter_changed_and_a_user_bridge_loads_and_renders_as_r
             (f[3].parse().unwrap(), f[5].parse().unwrap())
         };
         let ((gr, gp), (wr, wp)) = (level(&got), level(want));
-        println!("recorded on '{recorded_on}', running on '{}': comparing levels", machine());
-        assert!((gr / wr - 1.0).abs() < 0.02 && (gp / wp - 1.0).abs() < 0.02, "now {got}, was {want}");
+        println!(
+            "recorded on '{recorded_on}', running on '{}': comparing levels",
+            machine()
+        );
+        assert!(
+            (gr / wr - 1.0).abs() < 0.02 && (gp / wp - 1.0).abs() < 0.02,
+            "now {got}, was {want}"
+        );
     }
 }
 
@@ -229,7 +251,12 @@ fn damage(good: &[u8], rng: &mut Rng) -> Vec<u8> {
         _ => {
             // Valid JSON, wrong content: a parameter or field of the wrong type or value.
             let mut state: serde_json::Value = serde_json::from_slice(&good[8..]).unwrap();
-            let keys: Vec<String> = state["params"].as_object().unwrap().keys().cloned().collect();
+            let keys: Vec<String> = state["params"]
+                .as_object()
+                .unwrap()
+                .keys()
+                .cloned()
+                .collect();
             let key = &keys[rng.below(keys.len())];
             let bad = [
                 serde_json::json!({ "f32": 1e30 }),
@@ -240,7 +267,8 @@ fn damage(good: &[u8], rng: &mut Rng) -> Vec<u8> {
             ][rng.below(5)]
             .clone();
             if rng.below(3) == 0 {
-                state["fields"]["user-bridges"] = serde_json::json!("{\"cello\":{\"name\":\"x\",\"json\":\"[1,\"}}");
+                state["fields"]["user-bridges"] =
+                    serde_json::json!("{\"cello\":{\"name\":\"x\",\"json\":\"[1,\"}}");
             } else {
                 state["params"][key.as_str()] = bad;
             }
@@ -269,14 +297,22 @@ fn a_thousand_damaged_states_are_refused_or_load_into_range_and_play() {
             Err(_) => {
                 refused += 1;
                 for (name, value) in names.iter().zip(&before) {
-                    assert_eq!(plugin.clap_value(name), *value, "case {i}: {name} lost after a refused state");
+                    assert_eq!(
+                        plugin.clap_value(name),
+                        *value,
+                        "case {i}: {name} lost after a refused state"
+                    );
                 }
             }
             Ok(()) => {
                 accepted += 1;
                 for p in plugin.params().to_vec() {
                     let v = plugin.clap_value(&p.name);
-                    assert!(v.is_finite() && v >= p.min && v <= p.max, "case {i}: {} = {v}", p.name);
+                    assert!(
+                        v.is_finite() && v >= p.min && v <= p.max,
+                        "case {i}: {} = {v}",
+                        p.name
+                    );
                 }
             }
         }
@@ -287,16 +323,27 @@ fn a_thousand_damaged_states_are_refused_or_load_into_range_and_play() {
         let out = plugin.render(
             BLOCK * 2,
             BLOCK,
-            &Score::new().at(0, Event::note_on(50)).at(BLOCK as u64, Event::note_off(50)),
+            &Score::new()
+                .at(0, Event::note_on(50))
+                .at(BLOCK as u64, Event::note_off(50)),
         );
-        let bad = out.iter().flatten().find(|x| !(x.is_finite() && (**x == 0.0 || x.is_normal())));
+        let bad = out
+            .iter()
+            .flatten()
+            .find(|x| !(x.is_finite() && (**x == 0.0 || x.is_normal())));
         assert_eq!(bad, None, "case {i}");
-        assert!(out.iter().flatten().all(|x| x.abs() < 1.0), "case {i}: full scale");
+        assert!(
+            out.iter().flatten().all(|x| x.abs() < 1.0),
+            "case {i}: full scale"
+        );
         if i % 100 == 99 {
             // Back to the good state now and then, so later damage starts from it.
             plugin.load_state(&bytes).unwrap();
         }
     }
     println!("1000 damaged states: {refused} refused, {accepted} accepted");
-    assert!(refused > 0 && accepted > 0, "the damage exercised both paths");
+    assert!(
+        refused > 0 && accepted > 0,
+        "the damage exercised both paths"
+    );
 }

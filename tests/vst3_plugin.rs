@@ -29,8 +29,7 @@ fn load() -> Vst3Plugin {
 fn log_path() -> &'static PathBuf {
     static LOG: OnceLock<PathBuf> = OnceLock::new();
     LOG.get_or_init(|| {
-        let log =
-            std::env::temp_dir().join(format!("colophony-vst3-{}.log", std::process::id()));
+        let log = std::env::temp_dir().join(format!("colophony-vst3-{}.log", std::process::id()));
         let _ = std::fs::remove_file(&log);
         std::env::set_var("NICE_LOG", &log);
         log
@@ -55,7 +54,10 @@ fn automated_score(clap: &mut HostedPlugin, sample_rate: f64) -> Score {
     let at = |s: f64| (s * sample_rate) as u64;
     let mut score = Score::new().at(0, Event::note_on(50));
     for (i, t) in [0.2, 0.35, 0.5, 0.65].into_iter().enumerate() {
-        score.push(at(t) + 7, clap.plain("Bow Velocity", 0.08 + 0.02 * i as f64));
+        score.push(
+            at(t) + 7,
+            clap.plain("Bow Velocity", 0.08 + 0.02 * i as f64),
+        );
         score.push(at(t) + 131, clap.plain("Bow Force", 0.9 + 0.1 * i as f64));
     }
     score.push(at(1.0), Event::note_off(50));
@@ -92,13 +94,17 @@ fn the_vst3_wrapper_plays_the_same_samples_as_the_clap_wrapper() {
         }
         let a = clap.render(frames, block, &score);
         let b = vst3.render(frames, block, &score);
-        assert!(b.iter().flatten().all(|x| x.is_finite()), "{sample_rate} Hz: not finite");
+        assert!(
+            b.iter().flatten().all(|x| x.is_finite()),
+            "{sample_rate} Hz: not finite"
+        );
         let first_difference = a[0]
             .iter()
             .zip(&b[0])
             .position(|(x, y)| x.to_bits() != y.to_bits());
         assert_eq!(
-            first_difference, None,
+            first_difference,
+            None,
             "{sample_rate} Hz, blocks of {block}: the formats differ (CLAP, VST3 at the first \
              difference: {:?})",
             first_difference.map(|i| (a[0][i], b[0][i]))

@@ -87,9 +87,10 @@ enum Command {
         /// With --midi: only this track (0 = the first in the file); default all.
         #[arg(long)]
         track: Option<usize>,
-        /// With --friction thermal: play the instrument on this bridge (JSON, as
-        /// `colophony fit-bridge` writes) instead of the shipped one, through the
-        /// plugin's thermal instrument (four strings, modal bridge, resampler).
+        /// Play the instrument on this bridge (JSON, as `colophony fit-bridge` writes)
+        /// instead of the shipped one, through the plugin's performer: the thermal
+        /// model on the modal bridge itself, a point law with the bridge's passive
+        /// reduction (its strongest modes in the bowing direction) as the body.
         #[arg(long)]
         bridge: Option<PathBuf>,
     },
@@ -226,12 +227,6 @@ fn main() -> ExitCode {
             let note = note.unwrap_or(DEFAULT_NOTE);
             let bridge = match bridge {
                 None => None,
-                Some(_) if friction != FrictionArg::Thermal => {
-                    return report(Err(
-                        "--bridge is for the thermal model's bridge: add --friction thermal"
-                            .into(),
-                    ))
-                }
                 Some(path) => match colophony::dsp::bridge_data::load_bridge(&path) {
                     Ok(b) => Some(b),
                     Err(e) => return report(Err(e)),
@@ -244,7 +239,7 @@ fn main() -> ExitCode {
             };
             let source = match (midi, bridge.is_some()) {
                 (Some(midi), _) => Some(Score::File(midi, track)),
-                // A note on a chosen bridge plays through the plugin's thermal instrument.
+                // A note on a chosen bridge plays through the plugin's performer.
                 (None, true) => Some(Score::Note {
                     note,
                     seconds,
@@ -512,9 +507,10 @@ fn render_performed(
             release,
         } => play_note(&how, note, seconds, release, out).map(|(written, peak)| {
             format!(
-                "wrote {} ({written:.1} s, peak {:.1} dBFS, the plugin's thermal {} on the given bridge)",
+                "wrote {} ({written:.1} s, peak {:.1} dBFS, the plugin's {} {} on the given bridge)",
                 out.display(),
                 20.0 * (peak.max(1e-30) as f64).log10(),
+                if friction == FrictionArg::Thermal { "thermal" } else { "point-bow" },
                 instrument.name()
             )
         }),

@@ -381,14 +381,15 @@ fn wav_samples(path: &std::path::Path) -> Vec<f32> {
 }
 
 #[test]
-fn a_chosen_bridge_plays_through_the_plugins_thermal_instrument() {
+fn a_chosen_bridge_plays_through_the_plugins_instruments() {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
     let bridge = |name: &str| root.join("assets/bridges").join(name);
-    let render = |file: &std::path::Path, out: &std::path::Path| {
+    // One note on a bridge file, with the model `friction` ("hyperbolic": a point law).
+    let on_bridge = |friction: &str, file: &std::path::Path, out: &std::path::Path| {
         colophony(&[
             "render",
             "--friction",
-            "thermal",
+            friction,
             "--instrument",
             "cello",
             "--note",
@@ -401,6 +402,7 @@ fn a_chosen_bridge_plays_through_the_plugins_thermal_instrument() {
             out.to_str().unwrap(),
         ])
     };
+    let render = |file: &std::path::Path, out: &std::path::Path| on_bridge("thermal", file, out);
     // The shipped cello bridge's own file gives the bits the plugin's performer gives on
     // its shipped bridge (the same chain, the same data).
     let shipped = scratch("bridge-shipped.wav");
@@ -469,7 +471,38 @@ fn a_chosen_bridge_plays_through_the_plugins_thermal_instrument() {
         .filter(|(a, b)| (*a - *b).abs() > step)
         .count();
     assert!(differing > 1000, "only {differing} samples differ");
-    // A broken bridge file, a missing one, or a bridge for a point law: one line, no file.
+    // A point law plays the bridge's passive reduction as its body: the cello with the
+    // violin's bridge sounds unlike the cello with its own, and both sound.
+    let point = |file: &std::path::Path, out: &std::path::Path| on_bridge("hyperbolic", file, out);
+    let (own, violin) = (
+        scratch("point-bridge-own.wav"),
+        scratch("point-bridge-violin.wav"),
+    );
+    for (file, out) in [
+        ("cello-generic.json", &own),
+        ("violin-generic.json", &violin),
+    ] {
+        let run = point(&bridge(file), out);
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        assert!(
+            String::from_utf8_lossy(&run.stdout).contains("point-bow cello on the given bridge"),
+            "{}",
+            String::from_utf8_lossy(&run.stdout)
+        );
+    }
+    let (a, b) = (wav_samples(&own), wav_samples(&violin));
+    assert!(a.iter().any(|v| v.abs() > 1e-3) && b.iter().any(|v| v.abs() > 1e-3));
+    let differing = a
+        .iter()
+        .zip(&b)
+        .filter(|(x, y)| (*x - *y).abs() > step)
+        .count();
+    assert!(differing > 1000, "only {differing} samples differ");
+    // A broken bridge file or a missing one: one line, no file.
     let broken = scratch("broken-bridge.json");
     std::fs::write(
         &broken,
@@ -489,14 +522,7 @@ fn a_chosen_bridge_plays_through_the_plugins_thermal_instrument() {
             "--bridge",
             "/nonexistent/bridge.json",
         ],
-        vec![
-            "--bridge",
-            bridge("cello-generic.json")
-                .to_str()
-                .unwrap()
-                .to_owned()
-                .leak(),
-        ],
+        vec!["--bridge", broken.to_str().unwrap()],
     ] {
         let out = scratch("bridge-error.wav");
         let mut all = vec!["render", "--out", out.to_str().unwrap()];

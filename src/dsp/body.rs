@@ -12,7 +12,9 @@
 //! assert!(impulse.iter().all(|x| x.is_finite()));
 //! ```
 
+use super::bridge::BridgeMode;
 use super::filters::Bandpass;
+use std::f64::consts::PI;
 
 pub const MAX_BODY_MODES: usize = 6;
 
@@ -77,5 +79,118 @@ impl BodyModes {
         self.filters[..self.count]
             .iter()
             .all(|f| f.state_magnitude() < level)
+    }
+}
+
+/// A fitted or measured bridge ([`crate::dsp::bridge_data`]) reduced to a body for the
+/// point-bow instrument: a passive reduction of its admittance in the bowing direction.
+///
+/// The point-bow string moves in the bowing (horizontal) plane only, so the bridge it
+/// drives is `Y_hh(s) = sum_m G_hh,m s / (s^2 + 2 pi b_m s + w_m^2)`. Each `G_hh,m` is a
+/// diagonal entry of a positive semidefinite gain, so it is `>= 0` and each term is
+/// positive real; any subset of the terms is positive real too, so keeping the
+/// [`MAX_BODY_MODES`] terms with the largest peak admittance `G_hh / (2 pi b)` leaves a
+/// passive admittance. Each kept mode becomes a unit-peak band-pass at `f_m` with
+/// `Q = f_m / b_m`, its gain the mode's peak over the strongest's (so the strongest
+/// mode's gain is 1, as in the generic bodies, and the loudness stays the instrument's);
+/// the body's direct path stays 1. Modes with no horizontal part are dropped. Returns
+/// the modes, strongest first, and the share of the summed peak admittance kept.
+pub fn body_from_bridge(bridge: &[BridgeMode]) -> (Vec<BodyMode>, f64) {
+    let mut peaks: Vec<(f64, &BridgeMode)> = bridge
+        .iter()
+        .filter(|m| m.freq_hz > 0.0 && m.bandwidth_hz > 0.0 && m.gain[0][0] > 0.0)
+        .map(|m| (m.gain[0][0] / (2.0 * PI * m.bandwidth_hz), m))
+        .filter(|(p, _)| p.is_finite())
+        .collect();
+    peaks.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let total: f64 = peaks.iter().map(|(p, _)| p).sum();
+    peaks.truncate(MAX_BODY_MODES);
+    let strongest = peaks.first().map_or(1.0, |(p, _)| *p);
+    let kept: f64 = peaks.iter().map(|(p, _)| p).sum();
+    let modes = peaks
+        .iter()
+        .map(|(p, m)| BodyMode {
+            freq_hz: m.freq_hz,
+            q: m.freq_hz / m.bandwidth_hz,
+            gain: p / strongest,
+        })
+        .collect();
+    (modes, if total > 0.0 { kept / total } else { 0.0 })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dsp::bridge_data::{
+        shipped_cello_bridge, shipped_viola_bridge, shipped_violin_bridge,
+    };
+
+    #[test]
+    fn a_bridge_reduces_to_its_strongest_horizontal_modes() {
+        let mode = |f: f64, b: f64, hh: f64, vv: f64| BridgeMode {
+            freq_hz: f,
+            bandwidth_hz: b,
+            gain: [[hh, 0.0], [0.0, vv]],
+        };
+        // Peaks G_hh / (2 pi b): 1/(2 pi) * [1, 0.5, 4, 0 (vertical only), 2, 3, 0.1, 5].
+        let bridge = [
+            mode(100.0, 1.0, 1.0, 1.0),
+            mode(200.0, 2.0, 1.0, 0.0),
+            mode(300.0, 1.0, 4.0, 0.0),
+            mode(400.0, 1.0, 0.0, 9.0),
+            mode(500.0, 1.0, 2.0, 0.0),
+            mode(600.0, 1.0, 3.0, 0.0),
+            mode(700.0, 10.0, 1.0, 0.0),
+            mode(800.0, 1.0, 5.0, 0.0),
+        ];
+        let (modes, kept) = body_from_bridge(&bridge);
+        let freqs: Vec<f64> = modes.iter().map(|m| m.freq_hz).collect();
+        // The six largest horizontal peaks, strongest first; the vertical-only mode and
+        // the weakest horizontal one (700 Hz) are dropped.
+        assert_eq!(freqs, [800.0, 300.0, 600.0, 500.0, 100.0, 200.0]);
+        for (m, want) in modes.iter().zip([1.0, 0.8, 0.6, 0.4, 0.2, 0.1]) {
+            // Ratios of peaks: exact but for rounding.
+            assert!(
+                (m.gain - want).abs() < 1e-12,
+                "{} Hz: {}",
+                m.freq_hz,
+                m.gain
+            );
+        }
+        assert_eq!(modes[1].q, 300.0);
+        assert_eq!(modes[5].q, 100.0);
+        // Kept: 15.5 of 15.6.
+        assert!((kept - 15.5 / 15.6).abs() < 1e-12, "{kept}");
+    }
+
+    #[test]
+    fn the_shipped_bridges_reduce_to_stable_bodies_that_keep_most_of_their_admittance() {
+        for bridge in [
+            shipped_cello_bridge(),
+            shipped_viola_bridge(),
+            shipped_violin_bridge(),
+        ] {
+            let (modes, kept) = body_from_bridge(&bridge.modes);
+            println!(
+                "{} modes -> {}: {:.1} % of the summed peak kept",
+                bridge.modes.len(),
+                modes.len(),
+                100.0 * kept
+            );
+            assert_eq!(modes.len(), MAX_BODY_MODES);
+            assert!(modes
+                .iter()
+                .all(|m| m.q > 0.0 && m.gain > 0.0 && m.gain <= 1.0));
+            // Six of fourteen modes: the strong ones carry most of the peak admittance.
+            assert!(kept > 0.5 && kept <= 1.0, "{kept}");
+            let mut body = BodyModes::new(&modes, 1.0, 48_000.0);
+            let y: Vec<f64> = (0..48_000)
+                .map(|i| body.tick(if i == 0 { 1.0 } else { 0.0 }))
+                .collect();
+            assert!(y.iter().all(|v| v.is_finite()));
+            // Rings down: the last 10 ms far below the first.
+            let tail = y[47_520..].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            assert!(tail < 1e-3, "{tail}");
+        }
     }
 }

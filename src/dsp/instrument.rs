@@ -21,7 +21,7 @@
 //! assert!(peak > 0.01 && peak < 1.0);
 //! ```
 
-use super::body::{BodyMode, BodyModes};
+use super::body::{BodyMode, BodyModes, MAX_BODY_MODES};
 use super::friction::bristle::{BristleParams, SolverStats};
 use super::friction::{AnyFriction, BowInput, FrictionContact, FrictionModel};
 use super::intonation::{self, IntonationTable, MAX_CORRECTION_CENTS};
@@ -339,6 +339,9 @@ pub struct Instrument {
     last: Frame,
     voices: [StringVoice; STRINGS],
     body: BodyModes,
+    /// Each instrument's body in place of the generic one ([`Instrument::set_body`]):
+    /// modes and their count, per [`InstrumentKind::ALL`] index.
+    custom_bodies: [Option<([BodyMode; MAX_BODY_MODES], usize)>; 3],
     bend_semitones: f64,
     /// Whether a finger glides, and the samples to its next step.
     gliding: bool,
@@ -431,6 +434,7 @@ impl Instrument {
             gliding: false,
             glide_countdown: 0,
             body: BodyModes::new(&kind.body_modes(), 1.0, sample_rate_hz),
+            custom_bodies: [None; 3],
             bend_semitones: 0.0,
             reference_semitones: 0.0,
             preferred_string: None,
@@ -479,8 +483,41 @@ impl Instrument {
             voice.bowed = false;
             voice.awake = false;
         }
-        self.body = BodyModes::new(&kind.body_modes(), 1.0, self.sample_rate_hz);
+        self.body = self.body_of(kind);
         self.output_scale = kind.output_scale_per_n();
+    }
+
+    /// Plays `kind`'s body as `modes` (at most [`MAX_BODY_MODES`]; a fitted bridge's
+    /// passive reduction, [`super::body::body_from_bridge`]) instead of the generic one;
+    /// `None` goes back to it. Takes effect now if `kind` is playing, else when it is
+    /// chosen. Real-time safe.
+    pub fn set_body(&mut self, kind: InstrumentKind, modes: Option<&[BodyMode]>) {
+        let Some(k) = InstrumentKind::ALL.iter().position(|&x| x == kind) else {
+            return;
+        };
+        self.custom_bodies[k] = modes.map(|m| {
+            let mut kept = [BodyMode {
+                freq_hz: 0.0,
+                q: 1.0,
+                gain: 0.0,
+            }; MAX_BODY_MODES];
+            let n = m.len().min(MAX_BODY_MODES);
+            kept[..n].copy_from_slice(&m[..n]);
+            (kept, n)
+        });
+        if kind == self.kind {
+            self.body = self.body_of(kind);
+            self.body_asleep = false;
+        }
+    }
+
+    /// The body `kind` plays: its custom one if set, else the generic one.
+    fn body_of(&self, kind: InstrumentKind) -> BodyModes {
+        let k = InstrumentKind::ALL.iter().position(|&x| x == kind);
+        match k.and_then(|k| self.custom_bodies[k].as_ref()) {
+            Some((modes, n)) => BodyModes::new(&modes[..*n], 1.0, self.sample_rate_hz),
+            None => BodyModes::new(&kind.body_modes(), 1.0, self.sample_rate_hz),
+        }
     }
 
     pub fn reset(&mut self) {

@@ -1,7 +1,8 @@
-//! The editor's bridge row (with paper B's thermal model): the bridge the current
-//! instrument plays, a file to load in its place, and the way back to the shipped one
+//! The editor's bridge row (with the strings): the bridge the current instrument plays,
+//! a file to load in its place, and the way back to the shipped one
 //! ([`crate::user_bridges`]). A new bridge asks the host to restart the plugin, which
-//! rebuilds the thermal instruments on it.
+//! rebuilds the thermal instruments on it and the point-bow body from its passive
+//! reduction ([`crate::dsp::body::body_from_bridge`]).
 
 use crate::dsp::instrument::InstrumentKind;
 use crate::params::ColophonyParams;

@@ -6,7 +6,7 @@
 //! * [`view`]: the editor's contents, drawn into any `egui::Ui` ([`EditorUi`]).
 //! * [`live`]: the live views and the wait-free ring that feeds them from the audio thread.
 //! * [`nodes`]: the thermal bow's temperature and slip views and their wait-free ring.
-//! * [`bridge`]: the thermal model's bridge: load a fitted one, or the shipped one.
+//! * [`bridge`]: the instrument's bridge: load a fitted one, or the shipped one.
 //! * [`presets`]: the preset selector and "save as" ([`crate::presets`]).
 //! * [`regime`]: the regime the string is in, classified from the live samples (pure).
 //! * This file: the window glue. [`ColophonyEditor`] is the plugin's `Editor`;

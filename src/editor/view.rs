@@ -57,7 +57,7 @@ pub struct EditorUi {
     records: Vec<NodeRecord>,
     /// The preset selector and "save as".
     presets: PresetBar,
-    /// The thermal model's bridge.
+    /// The instrument's bridge.
     bridge: BridgeBar,
 }
 
@@ -177,9 +177,9 @@ impl EditorUi {
             ui.checkbox(&mut self.live, "Live views");
         });
         ui.horizontal_wrapped(|ui| self.presets.show(ui, &context));
-        if params.friction_model.value() == FrictionChoice::Thermal
-            && params.resonator.value() == ResonatorChoice::Strings
-        {
+        // Every string model plays a chosen bridge: the thermal model on the bridge
+        // itself, the point laws with its reduction as the body.
+        if params.resonator.value() == ResonatorChoice::Strings {
             ui.horizontal_wrapped(|ui| self.bridge.show(ui, &params, &context));
         }
         ui.separator();

@@ -19,13 +19,13 @@ use std::path::Path;
 use std::ptr;
 
 use vst3::Steinberg::Vst::{
-    AudioBusBuffers, AudioBusBuffers__type0, BusDirections_, Event as VstEvent, Event__type0,
-    Event_::EventTypes_, IAudioProcessor, IAudioProcessorTrait, IComponent, IComponentTrait,
-    IEditController, IEditControllerTrait, IEventList, IEventListTrait, IParamValueQueue,
-    IParamValueQueueTrait, IParameterChanges, IParameterChangesTrait, MediaTypes_,
-    NoteExpressionValueEvent, NoteOffEvent, NoteOnEvent, ParamID, ParamValue, ParameterInfo,
-    ParameterInfo_::ParameterFlags_, ProcessContext, ProcessData, ProcessModes_, ProcessSetup,
-    SpeakerArr, SpeakerArrangement, SymbolicSampleSizes_,
+    AudioBusBuffers, AudioBusBuffers__type0, BusDirections_, Event as VstEvent,
+    Event_::EventTypes_, Event__type0, IAudioProcessor, IAudioProcessorTrait, IComponent,
+    IComponentTrait, IEditController, IEditControllerTrait, IEventList, IEventListTrait,
+    IParamValueQueue, IParamValueQueueTrait, IParameterChanges, IParameterChangesTrait,
+    MediaTypes_, NoteExpressionValueEvent, NoteOffEvent, NoteOnEvent, ParamID, ParamValue,
+    ParameterInfo, ParameterInfo_::ParameterFlags_, ProcessContext, ProcessData, ProcessModes_,
+    ProcessSetup, SpeakerArr, SpeakerArrangement, SymbolicSampleSizes_,
 };
 use vst3::Steinberg::{
     int32, kInvalidArgument, kResultFalse, kResultOk, tresult, IPluginBaseTrait, IPluginFactory,
@@ -196,7 +196,11 @@ impl IParameterChangesTrait for ParamChanges {
             .map_or(ptr::null_mut(), |r| r.as_ptr())
     }
 
-    unsafe fn addParameterData(&self, _id: *const ParamID, _index: *mut int32) -> *mut IParamValueQueue {
+    unsafe fn addParameterData(
+        &self,
+        _id: *const ParamID,
+        _index: *mut int32,
+    ) -> *mut IParamValueQueue {
         ptr::null_mut()
     }
 }
@@ -210,7 +214,10 @@ impl Drop for Module {
     fn drop(&mut self) {
         // SAFETY: the symbol has this signature in every VST3 module for Linux.
         unsafe {
-            if let Ok(exit) = self.library.get::<unsafe extern "C" fn() -> bool>(b"ModuleExit") {
+            if let Ok(exit) = self
+                .library
+                .get::<unsafe extern "C" fn() -> bool>(b"ModuleExit")
+            {
                 exit();
             }
         }
@@ -239,7 +246,11 @@ fn wide_to_string(s: &[u16]) -> String {
 }
 
 fn c_to_string(s: &[std::ffi::c_char]) -> String {
-    let bytes: Vec<u8> = s.iter().take_while(|&&c| c != 0).map(|&c| c as u8).collect();
+    let bytes: Vec<u8> = s
+        .iter()
+        .take_while(|&&c| c != 0)
+        .map(|&c| c as u8)
+        .collect();
     String::from_utf8_lossy(&bytes).into_owned()
 }
 
@@ -285,8 +296,12 @@ impl Vst3Plugin {
             assert_eq!(component.initialize(ptr::null_mut()), kResultOk);
             // nice-plug's plugins are single-component: processor and controller are the
             // same object.
-            let processor = component.cast::<IAudioProcessor>().expect("IAudioProcessor");
-            let controller = component.cast::<IEditController>().expect("IEditController");
+            let processor = component
+                .cast::<IAudioProcessor>()
+                .expect("IAudioProcessor");
+            let controller = component
+                .cast::<IEditController>()
+                .expect("IEditController");
             let params = (0..controller.getParameterCount())
                 .map(|i| {
                     let mut p: ParameterInfo = std::mem::zeroed();
@@ -442,10 +457,11 @@ impl Vst3Plugin {
             Event::NoteOn { key, velocity } => note(true, key, velocity, 0),
             Event::NoteOff { key } => note(false, key, 0.0, 0),
             Event::Param { id, value } => self.changes.add(u32::from(id), offset, value),
-            Event::Controller { cc, value } => {
-                self.changes
-                    .add(midi_param(0, cc as u32 & 0x7f), offset, value as f64 / 127.0)
-            }
+            Event::Controller { cc, value } => self.changes.add(
+                midi_param(0, cc as u32 & 0x7f),
+                offset,
+                value as f64 / 127.0,
+            ),
             Event::PitchBend { amount } => {
                 let v = (8192.0 + amount * 8192.0).round().clamp(0.0, 16383.0);
                 self.changes.add(midi_param(0, 129), offset, v / 16383.0)
@@ -455,15 +471,18 @@ impl Vst3Plugin {
                 match status & 0xf0 {
                     0x90 if b > 0 => note(true, a, b as f64 / 127.0, channel as i16),
                     0x80 | 0x90 => note(false, a, 0.0, channel as i16),
-                    0xb0 => self
-                        .changes
-                        .add(midi_param(channel, a as u32 & 0x7f), offset, b as f64 / 127.0),
+                    0xb0 => self.changes.add(
+                        midi_param(channel, a as u32 & 0x7f),
+                        offset,
+                        b as f64 / 127.0,
+                    ),
                     0xd0 => self
                         .changes
                         .add(midi_param(channel, 128), offset, a as f64 / 127.0),
                     0xe0 => {
                         let v = ((b as u32) << 7 | a as u32) as f64;
-                        self.changes.add(midi_param(channel, 129), offset, v / 16383.0)
+                        self.changes
+                            .add(midi_param(channel, 129), offset, v / 16383.0)
                     }
                     _ => panic!("the VST3 host does not send MIDI status {status:#x}"),
                 }
@@ -494,7 +513,10 @@ impl Vst3Plugin {
     /// `block` of 0 is not allowed; see [`flush`](Self::flush) for a parameter flush.
     pub fn render(&mut self, frames: usize, block: usize, score: &Score) -> Vec<Vec<f32>> {
         let (sample_rate, max_block) = self.active.expect("activate the plugin before rendering");
-        assert!(block >= 1 && block <= max_block, "block size {block} outside 1..={max_block}");
+        assert!(
+            block >= 1 && block <= max_block,
+            "block size {block} outside 1..={max_block}"
+        );
         let events = score.events();
         let mut out = vec![Vec::with_capacity(frames); 2];
         let mut buffers = vec![vec![0.0f32; block]; 2];
