@@ -22,6 +22,7 @@
 //! ```
 
 use super::body::{BodyMode, BodyModes, MAX_BODY_MODES};
+use super::fingering::{BowEnvelope, Fingering};
 use super::friction::bristle::{BristleParams, SolverStats};
 use super::friction::{AnyFriction, BowInput, FrictionContact, FrictionModel};
 use super::intonation::{self, IntonationTable, MAX_CORRECTION_CENTS};
@@ -306,18 +307,11 @@ pub const MAX_NOTE_BETA: f64 = 0.5;
 struct StringVoice {
     string: WaveguideString,
     contact: AnyFriction,
-    note: Option<u8>,
-    /// Bow envelope, 0 (lifted) to 1 (full force).
-    bow_gain: f64,
-    bowed: bool,
+    bow: BowEnvelope,
     awake: bool,
-    /// A finger glide (portamento) under way: semitones still to go to the note (0: none),
-    /// and the change per retune.
-    glide: f64,
+    /// A finger glide's change per retune, semitones ([`Fingering::glide`] is what is left).
     glide_step: f64,
-    /// The note's own expression ([`NoteExpression::NEUTRAL`] until one arrives).
-    expression: NoteExpression,
-    /// Whether it is not neutral (one test per sample instead of three).
+    /// Whether the note's expression is not neutral (one test per sample instead of three).
     expressive: bool,
 }
 
@@ -338,18 +332,15 @@ pub struct Instrument {
     /// The probe of the last internal sample (what a resampled tick reports).
     last: Frame,
     voices: [StringVoice; STRINGS],
+    /// Notes, fingers and tuning ([`Fingering`]).
+    fingering: Fingering,
     body: BodyModes,
     /// Each instrument's body in place of the generic one ([`Instrument::set_body`]):
     /// modes and their count, per [`InstrumentKind::ALL`] index.
     custom_bodies: [Option<([BodyMode; MAX_BODY_MODES], usize)>; 3],
-    bend_semitones: f64,
     /// Whether a finger glides, and the samples to its next step.
     gliding: bool,
     glide_countdown: u32,
-    /// The reference pitch's offset from A4 = 440 Hz ([`reference_semitones`]).
-    reference_semitones: f64,
-    /// The string the player asks notes to go to (0 = lowest), `None` for the usual choice.
-    preferred_string: Option<usize>,
     probed: usize,
     ramp_step: f64,
     output_scale: f64,
@@ -359,10 +350,6 @@ pub struct Instrument {
     body_asleep: bool,
     /// Times the non-finite guard in [`Instrument::tick`] reset the instrument.
     recoveries: u64,
-    /// Tuning by the bowed sound ([`super::intonation`]); `None` tunes by the free decay.
-    intonation: Option<&'static IntonationTable>,
-    /// The friction model's row of the intonation table.
-    intonation_model: usize,
 }
 
 impl Instrument {
@@ -415,13 +402,9 @@ impl Instrument {
                 sample_rate_hz,
             )
             .expect("the built-in bristle parameters are valid"),
-            note: None,
-            bow_gain: 0.0,
-            bowed: false,
+            bow: BowEnvelope::default(),
             awake: false,
-            glide: 0.0,
             glide_step: 0.0,
-            expression: NoteExpression::NEUTRAL,
             expressive: false,
         });
         Self {
@@ -433,19 +416,18 @@ impl Instrument {
             voices,
             gliding: false,
             glide_countdown: 0,
+            fingering: Fingering::new(
+                kind,
+                Some(intonation::model_index(FrictionModel::Hyperbolic.name())),
+            ),
             body: BodyModes::new(&kind.body_modes(), 1.0, sample_rate_hz),
             custom_bodies: [None; 3],
-            bend_semitones: 0.0,
-            reference_semitones: 0.0,
-            preferred_string: None,
             probed: 0,
             ramp_step: 1.0 / (BOW_RAMP_S * sample_rate_hz),
             output_scale: kind.output_scale_per_n(),
             skipping: true,
             body_asleep: true,
             recoveries: 0,
-            intonation: Some(intonation::shipped()),
-            intonation_model: intonation::model_index(FrictionModel::Hyperbolic.name()),
         }
     }
 
@@ -475,12 +457,11 @@ impl Instrument {
             return;
         }
         self.kind = kind;
+        self.fingering.set_kind(kind);
         for (voice, spec) in self.voices.iter_mut().zip(kind.strings()) {
             voice.string.set_spec(spec);
             voice.contact.reset();
-            voice.note = None;
-            voice.bow_gain = 0.0;
-            voice.bowed = false;
+            voice.bow = BowEnvelope::default();
             voice.awake = false;
         }
         self.body = self.body_of(kind);
@@ -524,12 +505,10 @@ impl Instrument {
         for voice in &mut self.voices {
             voice.string.reset();
             voice.contact.reset();
-            voice.note = None;
-            voice.bow_gain = 0.0;
-            voice.bowed = false;
+            voice.bow = BowEnvelope::default();
             voice.awake = false;
-            voice.glide = 0.0;
         }
+        self.fingering.release_all();
         self.gliding = false;
         self.body.reset();
         if let Some(r) = &mut self.resampler {
@@ -541,15 +520,13 @@ impl Instrument {
     /// Stops the string for `note` and lands the bow on it. Returns the string index, or
     /// `None` if the instrument cannot play the note (it is then ignored).
     pub fn note_on(&mut self, note: u8) -> Option<usize> {
-        let index = self.kind.string_for_note_on(note, self.preferred_string)?;
-        self.voices[index].expression = NoteExpression::NEUTRAL;
-        self.voices[index].expressive = false;
-        self.voices[index].glide = 0.0;
-        let hz = self.tuned_hz(index, note);
+        let index = self.fingering.string_for_note_on(note)?;
+        self.fingering.start(index, note);
+        let hz = self.fingering.tuned_hz(index);
         let voice = &mut self.voices[index];
+        voice.expressive = false;
         voice.string.stop_at(hz);
-        voice.note = Some(note);
-        voice.bowed = true;
+        voice.bow.bowed = true;
         voice.awake = voice.string.is_playable();
         self.probed = index;
         Some(index)
@@ -560,24 +537,22 @@ impl Instrument {
     /// `glide_s` seconds (linearly in semitones, retuned every [`GLIDE_EVERY`] samples);
     /// otherwise, or with `glide_s` not positive, as [`Instrument::note_on`].
     pub fn note_on_gliding(&mut self, note: u8, glide_s: f64) -> Option<usize> {
-        let index = self.kind.string_for_note_on(note, self.preferred_string)?;
+        let index = self.fingering.string_for_note_on(note)?;
         let voice = &self.voices[index];
-        let from = match voice.note {
-            Some(old) if voice.bowed && voice.awake && glide_s > 0.0 && glide_s.is_finite() => {
-                old as f64 + voice.glide
+        let from = match self.fingering.note(index) {
+            Some(old) if voice.bow.bowed && voice.awake && glide_s > 0.0 && glide_s.is_finite() => {
+                old as f64 + self.fingering.glide(index)
             }
             _ => return self.note_on(note),
         };
         let distance = from - note as f64;
         let steps = (glide_s * self.sample_rate_hz / GLIDE_EVERY as f64).max(1.0);
-        let voice = &mut self.voices[index];
-        voice.note = Some(note);
-        voice.glide = distance;
-        voice.glide_step = distance.abs() / steps;
+        self.fingering.glide_to(index, note, distance);
+        self.voices[index].glide_step = distance.abs() / steps;
         self.probed = index;
         self.gliding = distance != 0.0;
         self.glide_countdown = 0;
-        let hz = self.tuned_hz(index, note);
+        let hz = self.fingering.tuned_hz(index);
         self.voices[index].string.bend_to(hz);
         Some(index)
     }
@@ -586,18 +561,12 @@ impl Instrument {
     fn advance_glides(&mut self) {
         let mut any = false;
         for i in 0..STRINGS {
-            let v = &mut self.voices[i];
-            if v.glide == 0.0 {
+            if self.fingering.glide(i) == 0.0 {
                 continue;
             }
-            v.glide = if v.glide > 0.0 {
-                (v.glide - v.glide_step).max(0.0)
-            } else {
-                (v.glide + v.glide_step).min(0.0)
-            };
-            any |= v.glide != 0.0;
-            if let Some(note) = v.note {
-                let hz = self.tuned_hz(i, note);
+            any |= self.fingering.advance_glide(i, self.voices[i].glide_step);
+            if self.fingering.note(i).is_some() {
+                let hz = self.fingering.tuned_hz(i);
                 self.voices[i].string.bend_to(hz);
             }
         }
@@ -606,9 +575,9 @@ impl Instrument {
 
     /// Lifts the bow from the string playing `note`, if any.
     pub fn note_off(&mut self, note: u8) {
-        for voice in &mut self.voices {
-            if voice.note == Some(note) {
-                voice.bowed = false;
+        for (i, voice) in self.voices.iter_mut().enumerate() {
+            if self.fingering.note(i) == Some(note) {
+                voice.bow.bowed = false;
             }
         }
     }
@@ -616,7 +585,7 @@ impl Instrument {
     /// Lifts the bow from every string.
     pub fn all_notes_off(&mut self) {
         for voice in &mut self.voices {
-            voice.bowed = false;
+            voice.bow.bowed = false;
         }
     }
 
@@ -624,87 +593,60 @@ impl Instrument {
     /// them ([`InstrumentKind::string_for_note_on`]); `None` restores the usual choice.
     /// Notes already sounding stay where they are.
     pub fn set_preferred_string(&mut self, preferred: Option<usize>) {
-        self.preferred_string = preferred.filter(|&p| p < STRINGS);
+        self.fingering.set_preferred_string(preferred);
     }
 
     /// Pitch bend in semitones (clamped to [`MAX_BEND_RANGE_SEMITONES`]): moves every
     /// stopping point, as far as the string reaches ([`intonation::tuned_hz`]).
     pub fn set_pitch_bend(&mut self, semitones: f64) {
-        if semitones.is_nan() {
-            return;
+        if self.fingering.set_pitch_bend(semitones) {
+            self.retune();
         }
-        let semitones = semitones.clamp(-MAX_BEND_RANGE_SEMITONES, MAX_BEND_RANGE_SEMITONES);
-        if semitones == self.bend_semitones {
-            return;
-        }
-        self.bend_semitones = semitones;
-        self.retune();
     }
 
     /// Gives string `index` its note's own expression (sanitized; see
     /// [`NoteExpression`]); a changed bend retunes it at once. A new note on the string
     /// starts neutral again.
     pub fn set_note_expression(&mut self, index: usize, expression: NoteExpression) {
-        let Some(voice) = self.voices.get_mut(index) else {
+        if index >= STRINGS {
             return;
-        };
-        let bent = voice.expression.replace(expression);
-        voice.expressive = voice.expression != NoteExpression::NEUTRAL;
-        if let (true, Some(note)) = (bent, voice.note) {
-            let hz = self.tuned_hz(index, note);
+        }
+        let bent = self.fingering.set_expression(index, expression);
+        self.voices[index].expressive = self.fingering.expression(index) != NoteExpression::NEUTRAL;
+        if bent {
+            let hz = self.fingering.tuned_hz(index);
             self.voices[index].string.bend_to(hz);
         }
     }
 
     /// String `index`'s note expression.
     pub fn note_expression(&self, index: usize) -> NoteExpression {
-        self.voices
-            .get(index)
-            .map_or(NoteExpression::NEUTRAL, |v| v.expression)
+        self.fingering.expression(index)
     }
 
     /// Tunes every note from the reference pitch `a4_hz` (415..466 Hz; see
     /// [`reference_semitones`]); sounding notes follow at once.
     pub fn set_reference_pitch(&mut self, a4_hz: f64) {
-        let semitones = reference_semitones(a4_hz);
-        if semitones == self.reference_semitones {
-            return;
+        if self.fingering.set_reference_pitch(a4_hz) {
+            self.retune();
         }
-        self.reference_semitones = semitones;
-        self.retune();
     }
 
     /// Moves every stopped note to its pitch under the current bend and reference.
     fn retune(&mut self) {
         for i in 0..STRINGS {
-            if let Some(note) = self.voices[i].note {
-                let hz = self.tuned_hz(i, note);
+            if self.fingering.note(i).is_some() {
+                let hz = self.fingering.tuned_hz(i);
                 self.voices[i].string.bend_to(hz);
             }
         }
-    }
-
-    /// The free-decay pitch string `string` is stopped at for `note`: equal temperament
-    /// under the bend and reference, moved by the intonation table.
-    fn tuned_hz(&self, string: usize, note: u8) -> f64 {
-        intonation::tuned_hz(
-            self.intonation,
-            self.intonation_model,
-            self.kind,
-            string,
-            note,
-            self.bend_semitones
-                + self.voices[string].glide
-                + self.voices[string].expression.bend_semitones,
-            self.reference_semitones,
-        )
     }
 
     /// Tunes by the bowed sound with `table` (the default is the shipped one), or by the
     /// free decay with `None` (paper A's scenes, the free-string tuning tests). Sounding
     /// notes follow at once.
     pub fn set_intonation(&mut self, table: Option<&'static IntonationTable>) {
-        self.intonation = table;
+        self.fingering.set_intonation(table);
         self.retune();
     }
 
@@ -712,7 +654,7 @@ impl Instrument {
     /// How far the bow rests on string `index`: 0 lifted, 1 fully on (it ramps between
     /// over [`BOW_RAMP_S`]); 0 for a string that does not exist.
     pub fn bow_gain(&self, index: usize) -> f64 {
-        self.voices.get(index).map_or(0.0, |v| v.bow_gain)
+        self.voices.get(index).map_or(0.0, |v| v.bow.gain)
     }
 
     pub fn string(&self, index: usize) -> &WaveguideString {
@@ -752,7 +694,7 @@ impl Instrument {
     fn strings_ring_out_s(&self) -> Option<f64> {
         let mut longest = 0.0f64;
         for voice in self.voices.iter().filter(|v| v.awake) {
-            if voice.bowed || voice.bow_gain > 0.0 {
+            if !voice.bow.is_lifted() {
                 return None;
             }
             let s = &voice.string;
@@ -778,11 +720,7 @@ impl Instrument {
             }
         }
         for voice in &mut self.voices {
-            if voice.awake
-                && !voice.bowed
-                && voice.bow_gain == 0.0
-                && voice.string.energy_j() < SLEEP_ENERGY_J
-            {
+            if voice.awake && voice.bow.is_lifted() && voice.string.energy_j() < SLEEP_ENERGY_J {
                 voice.string.reset();
                 voice.awake = false;
             }
@@ -841,18 +779,11 @@ impl Instrument {
             if !voice.awake && skipping {
                 continue;
             }
-            let target = if voice.bowed { 1.0 } else { 0.0 };
-            if voice.bow_gain != target {
-                voice.bow_gain = if voice.bowed {
-                    (voice.bow_gain + self.ramp_step).min(1.0)
-                } else {
-                    (voice.bow_gain - self.ramp_step).max(0.0)
-                };
-            }
-            let e = &voice.expression;
+            let bow_gain = voice.bow.advance(self.ramp_step);
             let (force, beta) = if !voice.expressive {
                 (bow.force_n, bow.position_beta)
             } else {
+                let e = self.fingering.expression(i);
                 (
                     bow.force_n * e.force_scale,
                     (bow.position_beta * e.position_scale).clamp(MIN_NOTE_BETA, MAX_NOTE_BETA),
@@ -861,7 +792,7 @@ impl Instrument {
             voice.string.set_bow_position(beta);
             let input = BowInput {
                 velocity_m_per_s: bow.velocity_m_per_s,
-                normal_force_n: force * voice.bow_gain,
+                normal_force_n: force * bow_gain,
             };
             let out = voice.string.tick(&mut voice.contact, input);
             bridge += out.bridge_force_n;
@@ -910,9 +841,10 @@ impl Instrument {
         for voice in &mut self.voices {
             voice.contact.set_model(model);
         }
-        let row = intonation::model_index(model.name());
-        if row != self.intonation_model {
-            self.intonation_model = row;
+        if self
+            .fingering
+            .set_intonation_row(intonation::model_index(model.name()))
+        {
             self.retune();
         }
     }

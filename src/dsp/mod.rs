@@ -9,6 +9,7 @@ pub mod bridge;
 pub mod bridge_data;
 pub mod engine;
 pub mod filters;
+pub mod fingering;
 pub mod friction;
 pub mod instrument;
 pub mod intonation;

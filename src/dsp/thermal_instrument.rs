@@ -46,10 +46,11 @@
 
 use super::bridge::{solve_junction, BridgeMode, ModalBridge};
 use super::filters::flush_tiny;
+use super::fingering::{BowEnvelope, Fingering};
 use super::instrument::{
-    midi_to_hz, reference_semitones, BowControl, Frame, InstrumentKind, NoteExpression, BOW_RAMP_S,
-    HIGHEST_TUNING_SEMITONES, LOWEST_TUNING_SEMITONES, MAX_BEND_RANGE_SEMITONES, MAX_NOTE_BETA,
-    MIN_NOTE_BETA, SLEEP_ENERGY_J, STRINGS,
+    midi_to_hz, BowControl, Frame, InstrumentKind, NoteExpression, BOW_RAMP_S,
+    HIGHEST_TUNING_SEMITONES, LOWEST_TUNING_SEMITONES, MAX_NOTE_BETA, MIN_NOTE_BETA,
+    SLEEP_ENERGY_J, STRINGS,
 };
 use super::intonation::{self, IntonationTable};
 use super::resample::Resampler;
@@ -104,27 +105,6 @@ impl ThermalSettings {
         Self {
             nodes: self.nodes.clamp(1, MAX_NODES),
             width_m,
-        }
-    }
-}
-
-#[derive(Debug, Clone, Copy)]
-struct Voice {
-    note: Option<u8>,
-    bowed: bool,
-    /// Bow envelope, 0 (lifted) to 1 (full force).
-    bow_gain: f64,
-    /// The note's own expression (neutral until one arrives).
-    expression: NoteExpression,
-}
-
-impl Default for Voice {
-    fn default() -> Self {
-        Self {
-            note: None,
-            bowed: false,
-            bow_gain: 0.0,
-            expression: NoteExpression::NEUTRAL,
         }
     }
 }
@@ -214,14 +194,12 @@ pub struct ThermalInstrument {
     fade_step: f64,
     core: Core,
     resampler: Resampler,
-    voices: [Voice; STRINGS],
+    /// The bow on each string.
+    bows: [BowEnvelope; STRINGS],
+    /// Notes, fingers and tuning ([`Fingering`]).
+    fingering: Fingering,
     /// Wave speed of each string, m/s.
     wave_speeds: [f64; STRINGS],
-    bend_semitones: f64,
-    /// The reference pitch's offset from A4 = 440 Hz ([`reference_semitones`]).
-    reference_semitones: f64,
-    /// The string the player asks notes to go to (0 = lowest), `None` for the usual choice.
-    preferred_string: Option<usize>,
     /// The bow's width on the lowest string at the current settings, m (the force is
     /// spread over it).
     contact_width_m: f64,
@@ -235,8 +213,6 @@ pub struct ThermalInstrument {
     wide_simd: bool,
     /// Times the non-finite guard in [`ThermalInstrument::tick`] reset the instrument.
     recoveries: u64,
-    /// Tuning by the bowed sound ([`super::intonation`]); `None` tunes by the free decay.
-    intonation: Option<&'static IntonationTable>,
 }
 
 impl ThermalInstrument {
@@ -305,11 +281,9 @@ impl ThermalInstrument {
                 probe: (0.0, 0.0),
             },
             resampler: Resampler::with_capacity(rate, host_rate_hz, max_rate)?,
-            voices: [Voice::default(); STRINGS],
+            bows: [BowEnvelope::default(); STRINGS],
+            fingering: Fingering::new(kind, Some(intonation::THERMAL_ROW)),
             wave_speeds,
-            bend_semitones: 0.0,
-            reference_semitones: 0.0,
-            preferred_string: None,
             contact_width_m: settings.width_m,
             ramp_step: 1.0 / (BOW_RAMP_S * host_rate_hz).max(1.0),
             output_scale: kind.output_scale_per_n(),
@@ -317,7 +291,6 @@ impl ThermalInstrument {
             skipping: true,
             wide_simd: super::detect_wide_simd(),
             recoveries: 0,
-            intonation: Some(intonation::shipped()),
         };
         instrument
             .apply_settings(settings)
@@ -393,16 +366,20 @@ impl ThermalInstrument {
         // Within capacity by construction (rate <= the maximum rate).
         let _ = self.resampler.set_input_rate(rate);
         for i in 0..STRINGS {
-            self.voices[i].bow_gain = 0.0;
-            let f0 = match self.voices[i].note {
-                Some(note) => self.tuned_hz(i, note),
-                None => self.kind.strings()[i].open_hz * 2f64.powf(self.reference_semitones / 12.0),
+            self.bows[i].gain = 0.0;
+            let f0 = match self.fingering.note(i) {
+                Some(_) => self.fingering.tuned_hz(i),
+                None => {
+                    self.kind.strings()[i].open_hz
+                        * 2f64.powf(self.fingering.reference_semitones() / 12.0)
+                }
             };
             if !self.tune(i, f0) {
-                self.voices[i] = Voice::default();
+                self.bows[i] = BowEnvelope::default();
+                self.fingering.clear_string(i);
             }
         }
-        self.awake = self.voices.iter().any(|v| v.bowed);
+        self.awake = self.bows.iter().any(|b| b.bowed);
         Ok(())
     }
 
@@ -441,16 +418,15 @@ impl ThermalInstrument {
     /// Stops the string for `note` and lands the bow. `None` (ignored) if no string can
     /// play it with this bow.
     pub fn note_on(&mut self, note: u8) -> Option<usize> {
-        let index = self.kind.string_for_note_on(note, self.preferred_string)?;
-        let before = std::mem::replace(&mut self.voices[index].expression, NoteExpression::NEUTRAL);
-        let f0 = self.tuned_hz(index, note);
+        let index = self.fingering.string_for_note_on(note)?;
+        let before = (self.fingering.note(index), self.fingering.expression(index));
+        self.fingering.start(index, note);
+        let f0 = self.fingering.tuned_hz(index);
         if !self.tune(index, f0) {
-            self.voices[index].expression = before;
+            self.fingering.restore(index, before.0, before.1);
             return None;
         }
-        let voice = &mut self.voices[index];
-        voice.note = Some(note);
-        voice.bowed = true;
+        self.bows[index].bowed = true;
         self.core.probed = index;
         self.awake = true;
         Some(index)
@@ -458,16 +434,16 @@ impl ThermalInstrument {
 
     /// Lifts the bow from the string playing `note`, if any.
     pub fn note_off(&mut self, note: u8) {
-        for voice in &mut self.voices {
-            if voice.note == Some(note) {
-                voice.bowed = false;
+        for (i, bow) in self.bows.iter_mut().enumerate() {
+            if self.fingering.note(i) == Some(note) {
+                bow.bowed = false;
             }
         }
     }
 
     pub fn all_notes_off(&mut self) {
-        for voice in &mut self.voices {
-            voice.bowed = false;
+        for bow in &mut self.bows {
+            bow.bowed = false;
         }
     }
 
@@ -475,33 +451,24 @@ impl ThermalInstrument {
     /// them ([`InstrumentKind::string_for_note_on`]); `None` restores the usual choice.
     /// Notes already sounding stay where they are.
     pub fn set_preferred_string(&mut self, preferred: Option<usize>) {
-        self.preferred_string = preferred.filter(|&p| p < STRINGS);
+        self.fingering.set_preferred_string(preferred);
     }
 
     /// Pitch bend in semitones (clamped to the bend range).
     pub fn set_pitch_bend(&mut self, semitones: f64) {
-        if semitones.is_nan() {
-            return;
+        if self.fingering.set_pitch_bend(semitones) {
+            self.retune();
         }
-        let semitones = semitones.clamp(-MAX_BEND_RANGE_SEMITONES, MAX_BEND_RANGE_SEMITONES);
-        if semitones == self.bend_semitones {
-            return;
-        }
-        self.bend_semitones = semitones;
-        self.retune();
     }
 
     /// Gives string `index` its note's own expression (sanitized; see [`NoteExpression`]):
     /// a changed bend retunes it (a bend the bow cannot follow lifts it, as the shared
     /// bend does). A new note on the string starts neutral again.
     pub fn set_note_expression(&mut self, index: usize, expression: NoteExpression) {
-        let Some(voice) = self.voices.get_mut(index) else {
-            return;
-        };
-        if let (true, Some(note)) = (voice.expression.replace(expression), voice.note) {
-            let f0 = self.tuned_hz(index, note);
+        if self.fingering.set_expression(index, expression) {
+            let f0 = self.fingering.tuned_hz(index);
             if !self.tune(index, f0) {
-                self.voices[index].bowed = false;
+                self.bows[index].bowed = false;
             }
         }
     }
@@ -509,43 +476,26 @@ impl ThermalInstrument {
     /// Tunes every note from the reference pitch `a4_hz` (415..466 Hz; see
     /// [`reference_semitones`]); sounding notes follow at once.
     pub fn set_reference_pitch(&mut self, a4_hz: f64) {
-        let semitones = reference_semitones(a4_hz);
-        if semitones == self.reference_semitones {
-            return;
+        if self.fingering.set_reference_pitch(a4_hz) {
+            self.retune();
         }
-        self.reference_semitones = semitones;
-        self.retune();
-    }
-
-    /// The free-decay pitch string `string` is stopped at for `note`: equal temperament
-    /// under the bend and reference, moved by the intonation table.
-    fn tuned_hz(&self, string: usize, note: u8) -> f64 {
-        intonation::tuned_hz(
-            self.intonation,
-            intonation::THERMAL_ROW,
-            self.kind,
-            string,
-            note,
-            self.bend_semitones + self.voices[string].expression.bend_semitones,
-            self.reference_semitones,
-        )
     }
 
     /// Tunes by the bowed sound with `table` (the default is the shipped one), or by the
     /// free decay with `None`. Sounding notes follow at once.
     pub fn set_intonation(&mut self, table: Option<&'static IntonationTable>) {
-        self.intonation = table;
+        self.fingering.set_intonation(table);
         self.retune();
     }
 
     /// Moves every stopped note to its pitch under the current bend and reference.
     fn retune(&mut self) {
         for i in 0..STRINGS {
-            if let Some(note) = self.voices[i].note {
-                let f0 = self.tuned_hz(i, note);
+            if self.fingering.note(i).is_some() {
+                let f0 = self.fingering.tuned_hz(i);
                 if !self.tune(i, f0) {
                     // Tuned out of what the bow allows: lift it, the string rings on.
-                    self.voices[i].bowed = false;
+                    self.bows[i].bowed = false;
                 }
             }
         }
@@ -557,9 +507,8 @@ impl ThermalInstrument {
         }
         self.core.bridge.reset();
         self.resampler.reset();
-        for voice in &mut self.voices {
-            *voice = Voice::default();
-        }
+        self.bows = [BowEnvelope::default(); STRINGS];
+        self.fingering.clear();
         self.core.probe = (0.0, 0.0);
         self.awake = false;
     }
@@ -600,7 +549,7 @@ impl ThermalInstrument {
         if !self.awake {
             return Some(0.0);
         }
-        if self.pending.is_some() || self.voices.iter().any(|v| v.bowed || v.bow_gain > 0.0) {
+        if self.pending.is_some() || self.bows.iter().any(|b| !b.is_lifted()) {
             return None;
         }
         let longest = self
@@ -622,8 +571,8 @@ impl ThermalInstrument {
             return;
         }
         let mut all_asleep = true;
-        for (voice, string) in self.voices.iter().zip(&mut self.core.strings) {
-            if !voice.bowed && voice.bow_gain == 0.0 {
+        for (bow, string) in self.bows.iter().zip(&mut self.core.strings) {
+            if bow.is_lifted() {
                 string.sleep_quiet_polarisations(SLEEP_ENERGY_J);
             }
             all_asleep &= string.is_asleep();
@@ -655,26 +604,24 @@ impl ThermalInstrument {
             }
         }
         let force_per_m = bow.force_n.max(0.0) / self.contact_width_m;
-        for (voice, control) in self.voices.iter_mut().zip(self.core.bows.iter_mut()) {
-            let target = if voice.bowed { 1.0 } else { 0.0 };
-            if voice.bow_gain != target {
-                voice.bow_gain = if voice.bowed {
-                    (voice.bow_gain + self.ramp_step).min(1.0)
-                } else {
-                    (voice.bow_gain - self.ramp_step).max(0.0)
-                };
-            }
-            let e = &voice.expression;
-            *control = if *e == NoteExpression::NEUTRAL {
+        for (i, (envelope, control)) in self
+            .bows
+            .iter_mut()
+            .zip(self.core.bows.iter_mut())
+            .enumerate()
+        {
+            let bow_gain = envelope.advance(self.ramp_step);
+            let e = self.fingering.expression(i);
+            *control = if e == NoteExpression::NEUTRAL {
                 ThermalBowControl {
                     velocity_m_per_s: bow.velocity_m_per_s,
-                    force_per_m: force_per_m * voice.bow_gain,
+                    force_per_m: force_per_m * bow_gain,
                     position_beta: bow.position_beta,
                 }
             } else {
                 ThermalBowControl {
                     velocity_m_per_s: bow.velocity_m_per_s,
-                    force_per_m: force_per_m * e.force_scale * voice.bow_gain,
+                    force_per_m: force_per_m * e.force_scale * bow_gain,
                     position_beta: (bow.position_beta * e.position_scale)
                         .clamp(MIN_NOTE_BETA, MAX_NOTE_BETA),
                 }

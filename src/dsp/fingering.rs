@@ -1,0 +1,261 @@
+//! What both string instruments (the point-bow [`super::instrument::Instrument`] and
+//! paper B's [`super::thermal_instrument::ThermalInstrument`]) share between a note and
+//! their strings: which string a note goes to, where the finger stops it (equal
+//! temperament under the pitch bend, the note's own bend, a finger glide and the
+//! reference pitch, moved by the intonation table), and the bow's envelope on each
+//! string. The instruments keep what differs: their strings, how a string is retuned, and
+//! how they sleep.
+//!
+//! ```
+//! use colophony::dsp::fingering::{BowEnvelope, Fingering};
+//! use colophony::dsp::instrument::InstrumentKind;
+//! let mut f = Fingering::new(InstrumentKind::Cello, Some(0));
+//! let string = f.string_for_note_on(50).unwrap(); // D3: the D string
+//! f.start(string, 50);
+//! let free = f.tuned_hz(string);
+//! assert!(f.set_pitch_bend(1.0)); // a changed bend: the instrument retunes
+//! assert!(f.tuned_hz(string) > free);
+//! let mut bow = BowEnvelope::default();
+//! bow.bowed = true;
+//! assert_eq!(bow.advance(0.5), 0.5);
+//! ```
+
+use super::instrument::{
+    reference_semitones, InstrumentKind, NoteExpression, MAX_BEND_RANGE_SEMITONES, STRINGS,
+};
+use super::intonation::{self, IntonationTable};
+
+/// The bow on one string: whether it is down, and how far it rests on the string, 0
+/// (lifted) to 1 (full force), ramping between.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct BowEnvelope {
+    pub bowed: bool,
+    pub gain: f64,
+}
+
+impl BowEnvelope {
+    /// One step of the ramp toward 1 (bowed) or 0 (lifted) by `step`; returns the gain.
+    #[inline(always)]
+    pub fn advance(&mut self, step: f64) -> f64 {
+        let target = if self.bowed { 1.0 } else { 0.0 };
+        if self.gain != target {
+            self.gain = if self.bowed {
+                (self.gain + step).min(1.0)
+            } else {
+                (self.gain - step).max(0.0)
+            };
+        }
+        self.gain
+    }
+
+    /// Lifted and at rest.
+    pub fn is_lifted(&self) -> bool {
+        !self.bowed && self.gain == 0.0
+    }
+}
+
+/// Notes, fingers and tuning of the four strings (see the module doc).
+#[derive(Debug, Clone)]
+pub struct Fingering {
+    kind: InstrumentKind,
+    notes: [Option<u8>; STRINGS],
+    /// Each note's own expression ([`NoteExpression::NEUTRAL`] until one arrives).
+    expressions: [NoteExpression; STRINGS],
+    /// A finger glide under way: semitones still to go to the note (0: none).
+    glides: [f64; STRINGS],
+    /// The string the player asks notes to go to (0 = lowest), `None` for the usual choice.
+    preferred_string: Option<usize>,
+    bend_semitones: f64,
+    /// The reference pitch's offset from A4 = 440 Hz ([`reference_semitones`]).
+    reference_semitones: f64,
+    /// Tuning by the bowed sound; `None` tunes by the free decay.
+    intonation: Option<&'static IntonationTable>,
+    /// The intonation table's row (the friction model).
+    intonation_row: usize,
+}
+
+impl Fingering {
+    /// `kind`'s strings with no note, tuned by the shipped intonation table's row
+    /// `intonation_row` (`None`: by the free decay).
+    pub fn new(kind: InstrumentKind, intonation_row: Option<usize>) -> Self {
+        Self {
+            kind,
+            notes: [None; STRINGS],
+            expressions: [NoteExpression::NEUTRAL; STRINGS],
+            glides: [0.0; STRINGS],
+            preferred_string: None,
+            bend_semitones: 0.0,
+            reference_semitones: 0.0,
+            intonation: intonation_row.map(|_| intonation::shipped()),
+            intonation_row: intonation_row.unwrap_or(0),
+        }
+    }
+
+    pub fn kind(&self) -> InstrumentKind {
+        self.kind
+    }
+
+    /// Another instrument: every note forgotten (the bend, the reference and the
+    /// expressions stay; a new note starts neutral).
+    pub fn set_kind(&mut self, kind: InstrumentKind) {
+        self.kind = kind;
+        self.notes = [None; STRINGS];
+    }
+
+    /// Every note and glide forgotten (the expressions stay; a new note starts neutral).
+    pub fn release_all(&mut self) {
+        self.notes = [None; STRINGS];
+        self.glides = [0.0; STRINGS];
+    }
+
+    /// The string a new note goes to ([`InstrumentKind::string_for_note_on`], with the
+    /// preferred string), `None` if no string can play it.
+    pub fn string_for_note_on(&self, note: u8) -> Option<usize> {
+        self.kind.string_for_note_on(note, self.preferred_string)
+    }
+
+    /// Asks later notes to go to string `preferred` (0 = the lowest) where it can play
+    /// them; `None` restores the usual choice. Notes already sounding stay where they are.
+    pub fn set_preferred_string(&mut self, preferred: Option<usize>) {
+        self.preferred_string = preferred.filter(|&p| p < STRINGS);
+    }
+
+    /// A new note on `string`: neutral expression, no glide.
+    pub fn start(&mut self, string: usize, note: u8) {
+        self.notes[string] = Some(note);
+        self.expressions[string] = NoteExpression::NEUTRAL;
+        self.glides[string] = 0.0;
+    }
+
+    /// `string`'s note becomes `note` with the finger `glide` semitones away from it,
+    /// keeping the note's expression (a legato glide).
+    pub fn glide_to(&mut self, string: usize, note: u8, glide: f64) {
+        self.notes[string] = Some(note);
+        self.glides[string] = glide;
+    }
+
+    /// The note on `string`, if any.
+    pub fn note(&self, string: usize) -> Option<u8> {
+        self.notes.get(string).copied().flatten()
+    }
+
+    /// Semitones `string`'s finger still has to glide.
+    pub fn glide(&self, string: usize) -> f64 {
+        self.glides[string]
+    }
+
+    /// Moves `string`'s glide `step` semitones toward 0; returns whether it still glides.
+    pub fn advance_glide(&mut self, string: usize, step: f64) -> bool {
+        let g = &mut self.glides[string];
+        *g = if *g > 0.0 {
+            (*g - step).max(0.0)
+        } else {
+            (*g + step).min(0.0)
+        };
+        *g != 0.0
+    }
+
+    /// `string`'s note expression.
+    pub fn expression(&self, string: usize) -> NoteExpression {
+        self.expressions
+            .get(string)
+            .copied()
+            .unwrap_or(NoteExpression::NEUTRAL)
+    }
+
+    /// Gives `string` its note's own expression (sanitized; see [`NoteExpression`]).
+    /// Returns whether a sounding note must be retuned (its bend changed); `false` for a
+    /// string that does not exist.
+    pub fn set_expression(&mut self, string: usize, expression: NoteExpression) -> bool {
+        let Some(e) = self.expressions.get_mut(string) else {
+            return false;
+        };
+        e.replace(expression) && self.notes[string].is_some()
+    }
+
+    /// Puts `string`'s note and expression back (a note the string refused).
+    pub fn restore(&mut self, string: usize, note: Option<u8>, expression: NoteExpression) {
+        self.notes[string] = note;
+        self.expressions[string] = expression;
+    }
+
+    /// `string` with no note, a neutral expression and no glide.
+    pub fn clear_string(&mut self, string: usize) {
+        self.notes[string] = None;
+        self.expressions[string] = NoteExpression::NEUTRAL;
+        self.glides[string] = 0.0;
+    }
+
+    /// Every string cleared ([`Fingering::clear_string`]).
+    pub fn clear(&mut self) {
+        for i in 0..STRINGS {
+            self.clear_string(i);
+        }
+    }
+
+    /// The reference pitch's offset from A4 = 440 Hz, semitones.
+    pub fn reference_semitones(&self) -> f64 {
+        self.reference_semitones
+    }
+
+    /// Pitch bend in semitones (clamped to [`MAX_BEND_RANGE_SEMITONES`]; NaN ignored).
+    /// Returns whether it changed (every sounding note must be retuned).
+    pub fn set_pitch_bend(&mut self, semitones: f64) -> bool {
+        if semitones.is_nan() {
+            return false;
+        }
+        let semitones = semitones.clamp(-MAX_BEND_RANGE_SEMITONES, MAX_BEND_RANGE_SEMITONES);
+        if semitones == self.bend_semitones {
+            return false;
+        }
+        self.bend_semitones = semitones;
+        true
+    }
+
+    /// Tunes every note from the reference pitch `a4_hz` (415..466 Hz; see
+    /// [`reference_semitones`]). Returns whether it changed.
+    pub fn set_reference_pitch(&mut self, a4_hz: f64) -> bool {
+        let semitones = reference_semitones(a4_hz);
+        if semitones == self.reference_semitones {
+            return false;
+        }
+        self.reference_semitones = semitones;
+        true
+    }
+
+    /// Tunes by the bowed sound with `table`, or by the free decay with `None`. Every
+    /// sounding note must then be retuned.
+    pub fn set_intonation(&mut self, table: Option<&'static IntonationTable>) {
+        self.intonation = table;
+    }
+
+    /// The intonation table's row in use (the friction model); returns whether it changed.
+    pub fn set_intonation_row(&mut self, row: usize) -> bool {
+        let changed = row != self.intonation_row;
+        self.intonation_row = row;
+        changed
+    }
+
+    /// The free-decay pitch `string` is stopped at for its note (0 Hz for none): equal
+    /// temperament under the bend, the note's own bend, the glide and the reference,
+    /// moved by the intonation table ([`intonation::tuned_hz`]).
+    pub fn tuned_hz(&self, string: usize) -> f64 {
+        match self.notes[string] {
+            Some(note) => self.tuned_hz_for(string, note),
+            None => 0.0,
+        }
+    }
+
+    /// As [`Fingering::tuned_hz`] for `note` on `string`.
+    pub fn tuned_hz_for(&self, string: usize, note: u8) -> f64 {
+        intonation::tuned_hz(
+            self.intonation,
+            self.intonation_row,
+            self.kind,
+            string,
+            note,
+            self.bend_semitones + self.glides[string] + self.expressions[string].bend_semitones,
+            self.reference_semitones,
+        )
+    }
+}
