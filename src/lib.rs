@@ -14,6 +14,7 @@ pub mod analysis;
 pub mod dsp;
 pub mod editor;
 pub mod editor_state;
+pub mod midi_learn;
 pub mod params;
 pub mod performer;
 pub mod presets;
@@ -36,6 +37,8 @@ pub struct Colophony {
     editor_link: Arc<editor::EditorLink>,
     /// The thermal bow's nodes, summed for the editor while it listens.
     node_probe: editor::nodes::NodeProbe,
+    /// The MIDI map's sequence number the performer has ([`midi_learn::SharedMidiMap`]).
+    midi_map_seen: u32,
 }
 
 impl Default for Colophony {
@@ -46,6 +49,7 @@ impl Default for Colophony {
             performer: Performer::new(kind),
             editor_link: Arc::new(editor::EditorLink::default()),
             node_probe: editor::nodes::NodeProbe::default(),
+            midi_map_seen: 0,
             params,
         }
     }
@@ -74,7 +78,10 @@ impl Colophony {
             }
             NoteEvent::MidiCC {
                 channel, cc, value, ..
-            } => p.set_controller_channel(channel, cc, value),
+            } => {
+                self.params.last_controller.record(cc);
+                p.set_controller_channel(channel, cc, value)
+            }
             NoteEvent::MidiChannelPressure {
                 channel, pressure, ..
             } => p.set_pressure_channel(channel, pressure),
@@ -198,6 +205,15 @@ impl Plugin for Colophony {
         context: &mut impl ProcessContext<Self>,
     ) -> ProcessStatus {
         self.performer.configure(&self.params.setup());
+        // The editor or a loaded state changed the MIDI map (a read that overlaps a write
+        // waits for the next block).
+        if let Some(map) = self
+            .params
+            .midi_map
+            .read_if_changed(&mut self.midi_map_seen)
+        {
+            self.performer.set_midi_map(&map);
+        }
         // The editor's live views are fed only while an editor shows them.
         let live = self.editor_link.is_listening();
         let mut next_event = context.next_event();

@@ -252,6 +252,12 @@ pub struct ColophonyParams {
     /// The state's version, for migrations ([`crate::presets::migrate_state`]).
     #[persist = "state-version"]
     pub state_version: crate::presets::StateVersion,
+    /// Which controller moves what, saved with the project ([`crate::midi_learn`]; not a
+    /// parameter). The editor's mapping page edits it.
+    #[persist = "midi-map"]
+    pub midi_map: crate::midi_learn::SharedMidiMap,
+    /// The last controller received, for MIDI learn (not saved).
+    pub last_controller: crate::midi_learn::LastController,
 }
 
 pub fn bow_velocity_range() -> FloatRange {
@@ -388,6 +394,8 @@ impl Default for ColophonyParams {
             editor_state: Default::default(),
             user_bridges: Default::default(),
             state_version: crate::presets::StateVersion,
+            midi_map: Default::default(),
+            last_controller: Default::default(),
         }
     }
 }

@@ -25,6 +25,7 @@
 //! ```
 
 pub mod direct;
+pub mod midi_map;
 pub mod mpe;
 pub mod stroke;
 
@@ -40,6 +41,7 @@ use crate::dsp::thermal::ThermalString;
 use crate::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
 use crate::quality::{self, Quality};
 use direct::DirectBow;
+use midi_map::{MidiMap, Target};
 use mpe::{Handled, Mpe, NoteState};
 use stroke::{Stroke, StrokeMode};
 
@@ -222,6 +224,8 @@ pub enum Status {
 
 /// See the module documentation.
 pub struct Performer {
+    /// Which controller moves what ([`midi_map`]).
+    midi_map: MidiMap,
     instrument: Instrument,
     /// Paper B's instrument, one per kind (violin, viola, cello), allocated in
     /// [`Performer::activate`]: switching kind or model lets the one switched away from
@@ -352,6 +356,7 @@ impl Performer {
     /// [`Performer::activate`] before playing).
     pub fn new(kind: InstrumentKind) -> Self {
         Self {
+            midi_map: MidiMap::default(),
             instrument: Instrument::new(kind, 48_000.0),
             thermal: Vec::new(),
             rubbed: RubbedInstrument::new(48_000.0),
@@ -754,33 +759,33 @@ impl Performer {
         }
     }
 
-    /// A MIDI controller at `value` (0..=1, as nice-plug delivers it): CC1 (mod wheel)
-    /// sets the vibrato depth, CC11 (expression) and CC2 (breath) the dynamics; CC101 and
-    /// CC100 select a registered parameter and CC6 / CC38 set it (RPN 0: the pitch-bend
-    /// range, semitones and cents); CC65 turns portamento on (64 and up); CC19 sets the
-    /// vibrato rate (3..9 Hz, over the setup's until that changes); CC21, CC22 and CC23 the bow's speed, force and position
-    /// ([`direct`]); others are ignored.
+    /// Controllers move what `map` says from now on ([`midi_map`]). Real-time safe.
+    pub fn set_midi_map(&mut self, map: &MidiMap) {
+        self.midi_map = *map;
+    }
+
+    /// The MIDI map in use.
+    pub fn midi_map(&self) -> &MidiMap {
+        &self.midi_map
+    }
+
+    /// A MIDI controller at `value` (0..=1, as nice-plug delivers it). CC101 and CC100
+    /// select a registered parameter and CC6 / CC38 set it (RPN 0: the pitch-bend range,
+    /// semitones and cents); every other controller does what the MIDI map says
+    /// ([`midi_map`]; by default CC1 the vibrato depth, CC2 and CC11 the dynamics, CC19
+    /// the vibrato rate, CC21-23 the bow's speed, force and position ([`direct`]), CC65
+    /// portamento), or nothing.
     pub fn set_controller(&mut self, cc: u8, value: f32) {
         if !value.is_finite() {
             return;
         }
         self.steady = None;
         let v = (value as f64).clamp(0.0, 1.0);
-        if self.direct.set_controller(cc, v) {
-            return;
-        }
         // The 7-bit value of a data byte.
         let byte = (v * 127.0).round() as u8;
         match cc {
-            1 => self.gesture.vibrato_cents = v * MAX_VIBRATO_CENTS,
-            2 | 11 => self.gesture.set_expression(v),
-            65 => self.gesture.portamento_pedal = byte >= 64,
-            19 => {
-                self.gesture.cc_rate_hz =
-                    Some(VIBRATO_RATE_MIN_HZ + v * (VIBRATO_RATE_MAX_HZ - VIBRATO_RATE_MIN_HZ))
-            }
-            101 => self.gesture.rpn.0 = byte,
-            100 => self.gesture.rpn.1 = byte,
+            101 => return self.gesture.rpn.0 = byte,
+            100 => return self.gesture.rpn.1 = byte,
             6 | 38 if self.gesture.rpn == (0, 0) => {
                 let range = self.bend_range();
                 let (semitones, cents) = (range.trunc(), (range.fract() * 100.0).round());
@@ -791,8 +796,35 @@ impl Performer {
                 };
                 self.gesture.rpn_bend_range = Some(range.min(MAX_BEND_RANGE_SEMITONES));
                 self.set_bend(self.gesture.wheel * self.bend_range());
+                return;
             }
             _ => {}
+        }
+        let map = self.midi_map;
+        for (target, x) in map.route(cc, v) {
+            self.move_target(target, x);
+        }
+    }
+
+    /// A mapped controller's value `x` (0..=1 of the target's range) lands on `target`.
+    fn move_target(&mut self, target: Target, x: f64) {
+        match target {
+            Target::Dynamics => self.gesture.set_expression(x),
+            Target::VibratoDepth => self.gesture.vibrato_cents = x * MAX_VIBRATO_CENTS,
+            Target::VibratoRate => {
+                self.gesture.cc_rate_hz =
+                    Some(VIBRATO_RATE_MIN_HZ + x * (VIBRATO_RATE_MAX_HZ - VIBRATO_RATE_MIN_HZ))
+            }
+            Target::BowVelocity => {
+                self.direct.set_controller(direct::CC_BOW_VELOCITY, x);
+            }
+            Target::BowForce => {
+                self.direct.set_controller(direct::CC_BOW_FORCE, x);
+            }
+            Target::BowPosition => {
+                self.direct.set_controller(direct::CC_BOW_POSITION, x);
+            }
+            Target::Portamento => self.gesture.portamento_pedal = (x * 127.0).round() >= 64.0,
         }
     }
 
@@ -1607,6 +1639,47 @@ mod tests {
         };
         p.tick(automated);
         assert_eq!(p.bow().force_n, 2.0);
+    }
+
+    #[test]
+    fn a_custom_midi_map_routes_a_controller_to_its_targets_and_unmaps_the_rest() {
+        // CC74 drives the bow force over the lower half of its controller range and the
+        // vibrato depth; CC22 and CC11, unmapped, do nothing.
+        let mut map = MidiMap::empty();
+        let mut force = midi_map::Mapping::new(74, Target::BowForce);
+        force.max = 0.5;
+        map.add(force);
+        map.add(midi_map::Mapping::new(74, Target::VibratoDepth));
+        let mut p = cello();
+        p.set_midi_map(&map);
+        p.note_on(50, 0.5);
+        let bow = BowControl::default();
+        let run = |p: &mut Performer| {
+            for _ in 0..(0.2 * FS) as usize {
+                p.tick(bow);
+            }
+        };
+        run(&mut p);
+        let before = p.bow();
+        p.set_controller(direct::CC_BOW_FORCE, 1.0);
+        p.set_controller(11, 0.2);
+        run(&mut p);
+        assert_eq!(p.bow(), before, "an unmapped controller moved the bow");
+        assert_eq!(p.gesture.vibrato_cents, 0.0);
+        p.set_controller(74, 1.0);
+        run(&mut p);
+        // The force controller's curve at half its travel (the mapping's top).
+        assert!(
+            (p.bow().force_n - direct::force_at(0.5)).abs() < 1e-9,
+            "{:?}",
+            p.bow()
+        );
+        assert_eq!(p.gesture.vibrato_cents, MAX_VIBRATO_CENTS);
+        // Back to the default map: CC22 is the force again.
+        p.set_midi_map(&MidiMap::default());
+        p.set_controller(direct::CC_BOW_FORCE, 1.0);
+        run(&mut p);
+        assert!((p.bow().force_n - direct::force_at(1.0)).abs() < 1e-9);
     }
 
     #[test]

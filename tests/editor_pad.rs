@@ -638,3 +638,65 @@ fn the_pad_marks_the_bow_as_played_where_it_leaves_the_parameters() {
         "marking sends nothing to the host"
     );
 }
+
+#[test]
+fn the_midi_map_page_learns_a_controller_and_edits_the_shared_map() {
+    use colophony::editor::midi_map_page::{
+        ADD_MAPPING_LABEL, DEFAULT_MAP_LABEL, LEARNING_LABEL, LEARN_LABEL, REMOVE_LABEL,
+    };
+    use colophony::performer::midi_map::{MidiMap, Target};
+    let mut f = fixture();
+    f.editor.show_midi_map = true;
+    let params = f.params.clone();
+    let map = || params.midi_map.snapshot();
+    assert_eq!(map(), MidiMap::default());
+    {
+        let mut h = harness(&mut f.editor);
+        // Learn on the first row (CC1, vibrato depth), then a controller arrives.
+        h.get_all_by_label(LEARN_LABEL).next().unwrap().click();
+        h.run();
+        assert!(h.query_by_label(LEARNING_LABEL).is_some(), "the row waits");
+        f.params.last_controller.record(74);
+        h.run();
+        assert!(
+            h.query_by_label(LEARNING_LABEL).is_none(),
+            "the row stopped waiting"
+        );
+    }
+    let first = map().get(0).unwrap();
+    assert_eq!((first.cc, first.target), (74, Target::VibratoDepth));
+    assert_eq!(
+        f.editor.midi_map_page().status(),
+        Some("Vibrato depth learned CC 74")
+    );
+    // Remove it, add a new one, and go back to the defaults.
+    {
+        let mut h = harness(&mut f.editor);
+        h.get_all_by_label(REMOVE_LABEL).next().unwrap().click();
+        h.run();
+    }
+    assert_eq!(map().get(0), None);
+    assert_eq!(
+        map().mappings().count(),
+        MidiMap::default().mappings().count() - 1
+    );
+    {
+        let mut h = harness(&mut f.editor);
+        h.get_by_label(ADD_MAPPING_LABEL).click();
+        h.run();
+    }
+    assert_eq!(
+        map().mappings().count(),
+        MidiMap::default().mappings().count()
+    );
+    {
+        let mut h = harness(&mut f.editor);
+        h.get_by_label(DEFAULT_MAP_LABEL).click();
+        h.run();
+    }
+    assert_eq!(map(), MidiMap::default());
+    assert!(
+        f.recorder.calls().is_empty(),
+        "the map is not a host parameter"
+    );
+}

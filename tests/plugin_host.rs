@@ -922,8 +922,8 @@ fn states_saved_by_every_version_load_with_their_values() {
             &Score::new().at(0, Event::note_on(62)),
         );
         assert!(rms(&channel_f64(&out, 0)) > 1e-3, "{fixture}: silent");
-        // Saved again, it carries this build's version.
-        let resaved = String::from_utf8(plugin.save_state()).unwrap();
+        // Saved again, it carries this build's version (the JSON after the 8-byte length).
+        let resaved = String::from_utf8(plugin.save_state()[8..].to_vec()).unwrap();
         assert!(resaved.contains(r#""state-version":"1""#), "{resaved}");
     }
     // A damaged state (a value far outside its range): loads, clamped to the range's end.
@@ -1092,4 +1092,47 @@ fn the_reported_latency_is_the_resamplers_delay_at_every_rate() {
             );
         }
     }
+}
+
+#[test]
+fn the_midi_map_travels_with_the_state_and_routes_the_controllers() {
+    // A project whose map sends CC74 to the dynamics over the bottom 5 % of their range
+    // (and has no CC11): CC74 at its top then plays softly, CC11 does nothing. The
+    // default map ignores CC74.
+    let play = |plugin: &mut HostedPlugin| {
+        let score = Score::new()
+            .at(0, Event::note_on(50))
+            .at(0, Event::Controller { cc: 74, value: 127 })
+            .at(0, Event::Controller { cc: 11, value: 127 });
+        let out = plugin.render(secs(0.8, FS) as usize, BLOCK, &score);
+        rms(&channel_f64(&out, 0)[secs(0.4, FS) as usize..])
+    };
+    let mut default = active_plugin(FS, BLOCK);
+    let saved = String::from_utf8(default.save_state()[8..].to_vec()).unwrap();
+    assert!(
+        saved.contains("midi-map"),
+        "the state carries the map: {saved}"
+    );
+    let loud = play(&mut default);
+    let mut state: serde_json::Value = serde_json::from_slice(&default.save_state()[8..]).unwrap();
+    state["fields"]["midi-map"] = serde_json::Value::String(
+        r#"{"slots":[{"cc":74,"target":"dynamics","min":0.0,"max":0.05,"curve":0.0}]}"#.into(),
+    );
+    let json = serde_json::to_vec(&state).unwrap();
+    let mut bytes = (json.len() as u64).to_le_bytes().to_vec();
+    bytes.extend_from_slice(&json);
+    let mut mapped = HostedPlugin::load_test_build();
+    mapped.load_state(&bytes).unwrap();
+    mapped.activate(FS, BLOCK);
+    let soft = play(&mut mapped);
+    println!("default map {loud:.4}, CC74 to soft dynamics {soft:.4}");
+    assert!(loud > 1e-3, "the default plays");
+    // Dynamics at 5 %: the bow's speed and force a twentieth (-26 dB): well under half.
+    assert!(
+        soft < 0.5 * loud,
+        "the mapped controller did not reach the dynamics"
+    );
+    // Saved again, the map is the loaded one.
+    let resaved = String::from_utf8(mapped.save_state()[8..].to_vec()).unwrap();
+    assert!(resaved.contains(r#"\"cc\":74"#), "{resaved}");
 }

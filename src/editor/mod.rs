@@ -7,6 +7,7 @@
 //! * [`live`]: the live views and the wait-free ring that feeds them from the audio thread.
 //! * [`nodes`]: the thermal bow's temperature and slip views and their wait-free ring.
 //! * [`bridge`]: the instrument's bridge: load a fitted one, or the shipped one.
+//! * [`midi_map_page`]: the MIDI map page: controllers to targets, ranges, curves, learn.
 //! * [`presets`]: the preset selector and "save as" ([`crate::presets`]).
 //! * [`regime`]: the regime the string is in, classified from the live samples (pure).
 //! * This file: the window glue. [`ColophonyEditor`] is the plugin's `Editor`;
@@ -25,6 +26,7 @@
 pub mod bridge;
 pub mod live;
 pub mod mapping;
+pub mod midi_map_page;
 pub mod nodes;
 pub mod pad;
 pub mod presets;

@@ -6,6 +6,7 @@
 use super::bridge::BridgeBar;
 use super::live::{paint_friction_loop, paint_velocity_trace, ContactSample, SCOPE_LEN};
 use super::mapping::SchellengWindow;
+use super::midi_map_page::MidiMapPage;
 use super::nodes::{paint_slip_image, paint_temperature_profile, NodeRecord, RING_LEN};
 use super::pad::{format_force, format_velocity, XyPad, MAX_FORCE_COLOUR, MIN_FORCE_COLOUR};
 use super::presets::PresetBar;
@@ -21,6 +22,8 @@ use nice_plug_egui::widgets::ParamSlider;
 use std::sync::Arc;
 use std::time::Duration;
 
+/// The checkbox that shows the MIDI map page.
+pub const MIDI_MAP_LABEL: &str = "MIDI map";
 /// Width of the side panel, points.
 const SIDE_WIDTH: f32 = 290.0;
 /// Height of the live views' row, points.
@@ -59,6 +62,9 @@ pub struct EditorUi {
     presets: PresetBar,
     /// The instrument's bridge.
     bridge: BridgeBar,
+    /// Whether the MIDI map page is shown in place of the pad.
+    pub show_midi_map: bool,
+    midi_map: MidiMapPage,
 }
 
 impl EditorUi {
@@ -74,7 +80,14 @@ impl EditorUi {
             records: Vec::with_capacity(RING_LEN),
             presets: PresetBar::default(),
             bridge: BridgeBar::default(),
+            show_midi_map: false,
+            midi_map: MidiMapPage::default(),
         }
+    }
+
+    /// The MIDI map page (its learn state and last message).
+    pub fn midi_map_page(&self) -> &MidiMapPage {
+        &self.midi_map
     }
 
     /// The bridge row's last message (an error, or what was loaded).
@@ -175,6 +188,7 @@ impl EditorUi {
             enum_selector(ui, "Quality", &params.quality, &setter);
             enum_selector(ui, "Resonator", &params.resonator, &setter);
             ui.checkbox(&mut self.live, "Live views");
+            ui.checkbox(&mut self.show_midi_map, MIDI_MAP_LABEL);
         });
         ui.horizontal_wrapped(|ui| self.presets.show(ui, &context));
         // Every string model plays a chosen bridge: the thermal model on the bridge
@@ -183,6 +197,13 @@ impl EditorUi {
             ui.horizontal_wrapped(|ui| self.bridge.show(ui, &params, &context));
         }
         ui.separator();
+        if self.show_midi_map {
+            egui::ScrollArea::vertical().show(ui, |ui| {
+                self.midi_map
+                    .show(ui, &params.midi_map, &params.last_controller)
+            });
+            return;
+        }
 
         if self.live {
             self.refresh_live(ui);
