@@ -233,23 +233,52 @@ impl Plugin for Colophony {
             self.editor_link.set_played_bow(None);
             return host_status(self.performer.status(buffer.samples()));
         }
-        for (sample, mut channels) in buffer.iter_samples().enumerate() {
+        let samples = buffer.samples();
+        let channels = buffer.as_slice();
+        let mut sample = 0;
+        while sample < samples {
             while let Some(event) = next_event.filter(|e| e.timing() <= sample as u32) {
                 self.handle_event(event);
                 next_event = context.next_event();
             }
             let p = &self.params;
+            let settled = !(p.bow_velocity.smoothed.is_smoothing()
+                || p.bow_force.smoothed.is_smoothing()
+                || p.bow_position.smoothed.is_smoothing()
+                || p.gain.smoothed.is_smoothing());
             let bow = BowControl {
                 velocity_m_per_s: p.bow_velocity.smoothed.next() as f64,
                 force_n: p.bow_force.smoothed.next() as f64,
                 position_beta: p.bow_position.smoothed.next() as f64,
             };
             let gain = util::db_to_gain(p.gain.smoothed.next()) as f64;
+            if settled && !live {
+                // Up to the next event the bow and gain hold (a settled smoother returns
+                // its target): the performer renders the run as a block, the same samples
+                // as ticking it.
+                let end = next_event.map_or(samples, |e| {
+                    (e.timing() as usize).clamp(sample + 1, samples)
+                });
+                let mut chunk = [0.0f64; 64];
+                while sample < end {
+                    let n = (end - sample).min(chunk.len());
+                    self.performer.tick_block(bow, &mut chunk[..n]);
+                    for (k, audio) in chunk[..n].iter().enumerate() {
+                        let out =
+                            dsp::filters::safety_limit(dsp::filters::flush_tiny(audio * gain));
+                        for channel in channels.iter_mut() {
+                            channel[sample + k] = out as f32;
+                        }
+                    }
+                    sample += n;
+                }
+                continue;
+            }
             let frame = self.performer.tick(bow);
             if live {
                 let played = self.performer.bow();
-                let sample = editor::live::ContactSample::new(&frame, &played);
-                self.editor_link.scope.push(sample);
+                let contact = editor::live::ContactSample::new(&frame, &played);
+                self.editor_link.scope.push(contact);
                 if let Some(string) = self.performer.probed_thermal_string() {
                     self.node_probe.add_from(
                         string.node_temperatures(),
@@ -259,9 +288,10 @@ impl Plugin for Colophony {
                 }
             }
             let out = dsp::filters::safety_limit(dsp::filters::flush_tiny(frame.audio * gain));
-            for s in channels.iter_mut() {
-                *s = out as f32;
+            for channel in channels.iter_mut() {
+                channel[sample] = out as f32;
             }
+            sample += 1;
         }
         // Events at or after the block's end (none should be) are still applied.
         while let Some(event) = next_event {

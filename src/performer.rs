@@ -1011,17 +1011,8 @@ impl Performer {
     /// rings on); the contact probe is the source's.
     #[inline]
     pub fn tick(&mut self, bow: BowControl) -> Frame {
-        let bow = match self.steady {
-            Some((v, f, 1.0)) => BowControl {
-                velocity_m_per_s: bow.velocity_m_per_s * v,
-                force_n: bow.force_n * f,
-                ..bow
-            },
-            Some((v, f, away)) => BowControl {
-                velocity_m_per_s: bow.velocity_m_per_s * v,
-                force_n: bow.force_n * f,
-                position_beta: (bow.position_beta * away).clamp(MIN_NOTE_BETA, MAX_NOTE_BETA),
-            },
+        let bow = match self.steady_bow(bow) {
+            Some(played) => played,
             None => self.shape(bow),
         };
         self.bow_now = bow;
@@ -1043,6 +1034,46 @@ impl Performer {
             frame.audio += self.rubbed.tick_bow(&bow);
         }
         frame
+    }
+
+    /// The bow as played while the gesture is steady (see [`Performer::shape`]): the
+    /// factors on `bow`; `None` while the gesture moves.
+    #[inline]
+    fn steady_bow(&self, bow: BowControl) -> Option<BowControl> {
+        Some(match self.steady? {
+            (v, f, 1.0) => BowControl {
+                velocity_m_per_s: bow.velocity_m_per_s * v,
+                force_n: bow.force_n * f,
+                ..bow
+            },
+            (v, f, away) => BowControl {
+                velocity_m_per_s: bow.velocity_m_per_s * v,
+                force_n: bow.force_n * f,
+                position_beta: (bow.position_beta * away).clamp(MIN_NOTE_BETA, MAX_NOTE_BETA),
+            },
+        })
+    }
+
+    /// `out.len()` samples of audio with the bow held at `bow` and no event between: the
+    /// same samples as as many [`Performer::tick`]s. Once the gesture is steady and only
+    /// the waveguide strings sound, the strings run alone over the rest (the gesture has
+    /// nothing to do per sample), which is what makes the performance layer cost nothing
+    /// per sample (issue 18's budget).
+    pub fn tick_block(&mut self, bow: BowControl, out: &mut [f64]) {
+        let mut i = 0;
+        while i < out.len() {
+            if !self.others_awake {
+                if let Some(played) = self.steady_bow(bow) {
+                    self.bow_now = played;
+                    for sample in &mut out[i..] {
+                        *sample = self.instrument.tick(played).audio;
+                    }
+                    return;
+                }
+            }
+            out[i] = self.tick(bow).audio;
+            i += 1;
+        }
     }
 
     /// The waveguide strings (for tools and tests: energy, solver statistics, and the
@@ -1680,6 +1711,42 @@ mod tests {
         p.set_controller(direct::CC_BOW_FORCE, 1.0);
         run(&mut p);
         assert!((p.bow().force_n - direct::force_at(1.0)).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_block_gives_the_same_samples_as_ticking_it() {
+        // Through an attack, a steady stretch, a controller and a second note, with blocks
+        // of every size from 1 to 700: the block path is only a shortcut.
+        let bow = BowControl::default();
+        let events = |p: &mut Performer, at: usize| match at {
+            0 => p.note_on(50, 0.8),
+            20_000 => p.set_controller(11, 0.6),
+            30_000 => p.note_on(57, 0.4),
+            40_000 => p.note_off(50),
+            _ => {}
+        };
+        let marks = [0, 20_000, 30_000, 40_000, 48_000];
+        let mut ticked = cello();
+        let mut want = Vec::new();
+        for at in 0..48_000 {
+            events(&mut ticked, at);
+            want.push(ticked.tick(bow).audio.to_bits());
+        }
+        for block in [1, 7, 64, 511, 700] {
+            let mut p = cello();
+            let mut got = Vec::new();
+            let mut at = 0;
+            while at < 48_000 {
+                events(&mut p, at);
+                let next = marks.iter().copied().find(|&m| m > at).unwrap_or(48_000);
+                let n = block.min(next - at);
+                let mut out = vec![0.0; n];
+                p.tick_block(bow, &mut out);
+                got.extend(out.iter().map(|x| x.to_bits()));
+                at += n;
+            }
+            assert_eq!(got, want, "blocks of {block}");
+        }
     }
 
     #[test]

@@ -117,6 +117,23 @@ fn performer_tick(c: &mut Criterion) {
         b.iter(|| black_box(performer.tick(black_box(bow))))
     });
     group.finish();
+    // As the plugin plays a settled block: the strings' own loop against the performer's
+    // block path (the gesture steady).
+    let mut group = c.benchmark_group("cello D3 bowed, a block of 512");
+    let mut block = [0.0f64; 512];
+    group.bench_function("instrument", |b| {
+        b.iter(|| {
+            bare.process(black_box(bow), &mut block);
+            black_box(block[511])
+        })
+    });
+    group.bench_function("through the performer", |b| {
+        b.iter(|| {
+            performer.tick_block(black_box(bow), &mut block);
+            black_box(block[511])
+        })
+    });
+    group.finish();
 }
 
 fn thermal_tick(c: &mut Criterion) {
