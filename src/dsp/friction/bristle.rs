@@ -408,6 +408,11 @@ impl BristleFriction {
                 break;
             }
             let step = -gy / dg;
+            if step.abs() <= self.newton_tolerance_m_per_s * y.abs().max(1.0) {
+                // Converged: the full step is what the damped loop below accepts here
+                // (near the root `|g|` falls along it), without evaluating `g` there.
+                return (y + step, Some(iteration));
+            }
             let mut t = 1.0;
             let mut accepted = None;
             for _ in 0..=MAX_DAMPING_HALVINGS {
