@@ -28,8 +28,8 @@ use vst3::Steinberg::Vst::{
     ProcessSetup, SpeakerArr, SpeakerArrangement, SymbolicSampleSizes_,
 };
 use vst3::Steinberg::{
-    int32, kInvalidArgument, kResultFalse, kResultOk, tresult, IPluginBaseTrait, IPluginFactory,
-    IPluginFactoryTrait, PClassInfo,
+    int32, int64, kInvalidArgument, kResultFalse, kResultOk, tresult, IBStream, IBStreamTrait,
+    IPluginBaseTrait, IPluginFactory, IPluginFactoryTrait, PClassInfo,
 };
 use vst3::{Class, ComPtr, ComWrapper, Interface};
 
@@ -202,6 +202,83 @@ impl IParameterChangesTrait for ParamChanges {
         _index: *mut int32,
     ) -> *mut IParamValueQueue {
         ptr::null_mut()
+    }
+}
+
+/// A memory stream for the plugin state (`IBStream`): seekable, growing on write.
+struct MemoryStream {
+    bytes: RefCell<Vec<u8>>,
+    pos: Cell<usize>,
+}
+
+impl Class for MemoryStream {
+    type Interfaces = (IBStream,);
+}
+
+impl IBStreamTrait for MemoryStream {
+    unsafe fn read(&self, buffer: *mut c_void, num_bytes: int32, num_read: *mut int32) -> tresult {
+        let bytes = self.bytes.borrow();
+        let pos = self.pos.get().min(bytes.len());
+        let n = (num_bytes.max(0) as usize).min(bytes.len() - pos);
+        // SAFETY: the caller hands a buffer of `num_bytes` bytes.
+        unsafe {
+            std::ptr::copy_nonoverlapping(bytes[pos..].as_ptr(), buffer as *mut u8, n);
+            if !num_read.is_null() {
+                *num_read = n as int32;
+            }
+        }
+        self.pos.set(pos + n);
+        kResultOk
+    }
+
+    unsafe fn write(
+        &self,
+        buffer: *mut c_void,
+        num_bytes: int32,
+        num_written: *mut int32,
+    ) -> tresult {
+        let n = num_bytes.max(0) as usize;
+        // SAFETY: the caller hands `num_bytes` bytes.
+        let data = unsafe { std::slice::from_raw_parts(buffer as *const u8, n) };
+        let mut bytes = self.bytes.borrow_mut();
+        let pos = self.pos.get();
+        if bytes.len() < pos + n {
+            bytes.resize(pos + n, 0);
+        }
+        bytes[pos..pos + n].copy_from_slice(data);
+        self.pos.set(pos + n);
+        if !num_written.is_null() {
+            // SAFETY: as above.
+            unsafe { *num_written = n as int32 };
+        }
+        kResultOk
+    }
+
+    unsafe fn seek(&self, pos: int64, mode: int32, result: *mut int64) -> tresult {
+        let len = self.bytes.borrow().len() as int64;
+        // kIBSeekSet, kIBSeekCur, kIBSeekEnd
+        let base = match mode {
+            0 => 0,
+            1 => self.pos.get() as int64,
+            2 => len,
+            _ => return kInvalidArgument,
+        };
+        let to = (base + pos).clamp(0, len);
+        self.pos.set(to as usize);
+        if !result.is_null() {
+            // SAFETY: the caller hands a pointer to fill.
+            unsafe { *result = to };
+        }
+        kResultOk
+    }
+
+    unsafe fn tell(&self, pos: *mut int64) -> tresult {
+        if pos.is_null() {
+            return kInvalidArgument;
+        }
+        // SAFETY: checked above.
+        unsafe { *pos = self.pos.get() as int64 };
+        kResultOk
     }
 }
 
@@ -408,6 +485,55 @@ impl Vst3Plugin {
                 self.component.setActive(0);
             }
         }
+    }
+
+    /// The plugin's state, as a host saves it with a project (`IComponent::getState`).
+    pub fn save_state(&self) -> Vec<u8> {
+        let stream = ComWrapper::new(MemoryStream {
+            bytes: RefCell::new(Vec::new()),
+            pos: Cell::new(0),
+        });
+        let ptr = stream.as_com_ref::<IBStream>().unwrap().as_ptr();
+        // SAFETY: the stream lives across the call.
+        let result = unsafe { self.component.getState(ptr) };
+        assert_eq!(result, kResultOk, "getState failed");
+        let bytes = stream.bytes.borrow().clone();
+        bytes
+    }
+
+    /// Loads a saved state as a host reopening a project does (`IComponent::setState`,
+    /// then the controller's `setComponentState`); `Err` if the plugin refuses it.
+    pub fn load_state(&self, bytes: &[u8]) -> Result<(), tresult> {
+        let stream = ComWrapper::new(MemoryStream {
+            bytes: RefCell::new(bytes.to_vec()),
+            pos: Cell::new(0),
+        });
+        let ptr = stream.as_com_ref::<IBStream>().unwrap().as_ptr();
+        // SAFETY: the stream lives across the calls.
+        unsafe {
+            let result = self.component.setState(ptr);
+            if result != kResultOk {
+                return Err(result);
+            }
+            stream.pos.set(0);
+            self.controller.setComponentState(ptr);
+        }
+        Ok(())
+    }
+
+    /// The text the plugin shows for parameter `title` at its current value.
+    pub fn value_text(&self, title: &str) -> String {
+        let id = self.param(title).id;
+        let mut text = [0u16; 128];
+        // SAFETY: plain controller calls with a buffer of the size VST3 defines.
+        unsafe {
+            let value = self.controller.getParamNormalized(id);
+            assert_eq!(
+                self.controller.getParamStringByValue(id, value, &mut text),
+                kResultOk
+            );
+        }
+        wide_to_string(&text)
     }
 
     /// The plugin's latency in samples, as a VST3 host asks for it.
