@@ -217,81 +217,34 @@ impl Plugin for Colophony {
         // The editor's live views are fed only while an editor shows them.
         let live = self.editor_link.is_listening();
         let mut next_event = context.next_event();
-        let p = &self.params;
-        let settled = !(p.bow_velocity.smoothed.is_smoothing()
-            || p.bow_force.smoothed.is_smoothing()
-            || p.bow_position.smoothed.is_smoothing()
-            || p.gain.smoothed.is_smoothing());
-        if next_event.is_none() && settled && self.performer.is_asleep() {
-            // Nothing sounds and nothing lands in this block: silence, without a per-sample
-            // call (the performer's gesture clocks still advance).
-            for channel in buffer.as_slice() {
-                channel.fill(0.0);
-            }
-            self.performer.skip(buffer.samples(), p.bow());
-            self.editor_link.set_note(self.performer.last_note());
-            self.editor_link.set_played_bow(None);
-            return host_status(self.performer.status(buffer.samples()));
-        }
         let samples = buffer.samples();
         let channels = buffer.as_slice();
+        if next_event.is_none() && self.settled() && self.performer.is_asleep() {
+            // Nothing sounds and nothing lands in this block: silence, without a per-sample
+            // call (the performer's gesture clocks still advance).
+            channels.iter_mut().for_each(|c| c.fill(0.0));
+            self.performer.skip(samples, self.params.bow());
+            self.editor_link.set_note(self.performer.last_note());
+            self.editor_link.set_played_bow(None);
+            return host_status(self.performer.status(samples));
+        }
         let mut sample = 0;
         while sample < samples {
             while let Some(event) = next_event.filter(|e| e.timing() <= sample as u32) {
                 self.handle_event(event);
                 next_event = context.next_event();
             }
-            let p = &self.params;
-            let settled = !(p.bow_velocity.smoothed.is_smoothing()
-                || p.bow_force.smoothed.is_smoothing()
-                || p.bow_position.smoothed.is_smoothing()
-                || p.gain.smoothed.is_smoothing());
-            let bow = BowControl {
-                velocity_m_per_s: p.bow_velocity.smoothed.next() as f64,
-                force_n: p.bow_force.smoothed.next() as f64,
-                position_beta: p.bow_position.smoothed.next() as f64,
-            };
-            let gain = util::db_to_gain(p.gain.smoothed.next()) as f64;
-            if settled && !live {
-                // Up to the next event the bow and gain hold (a settled smoother returns
-                // its target): the performer renders the run as a block, the same samples
-                // as ticking it.
+            if self.settled() && !live {
+                // Up to the next event the bow and gain hold: one run.
                 let end = next_event.map_or(samples, |e| {
                     (e.timing() as usize).clamp(sample + 1, samples)
                 });
-                let mut chunk = [0.0f64; 64];
-                while sample < end {
-                    let n = (end - sample).min(chunk.len());
-                    self.performer.tick_block(bow, &mut chunk[..n]);
-                    for (k, audio) in chunk[..n].iter().enumerate() {
-                        let out =
-                            dsp::filters::safety_limit(dsp::filters::flush_tiny(audio * gain));
-                        for channel in channels.iter_mut() {
-                            channel[sample + k] = out as f32;
-                        }
-                    }
-                    sample += n;
-                }
-                continue;
+                self.play_run(channels, sample, end);
+                sample = end;
+            } else {
+                self.play_sample(channels, sample, live);
+                sample += 1;
             }
-            let frame = self.performer.tick(bow);
-            if live {
-                let played = self.performer.bow();
-                let contact = editor::live::ContactSample::new(&frame, &played);
-                self.editor_link.scope.push(contact);
-                if let Some(string) = self.performer.probed_thermal_string() {
-                    self.node_probe.add_from(
-                        string.node_temperatures(),
-                        string.slipping(),
-                        &self.editor_link,
-                    );
-                }
-            }
-            let out = dsp::filters::safety_limit(dsp::filters::flush_tiny(frame.audio * gain));
-            for channel in channels.iter_mut() {
-                channel[sample] = out as f32;
-            }
-            sample += 1;
         }
         // Events at or after the block's end (none should be) are still applied.
         while let Some(event) = next_event {
@@ -300,7 +253,74 @@ impl Plugin for Colophony {
         }
         self.editor_link.set_note(self.performer.last_note());
         self.editor_link.set_played_bow(self.performer.bowed_bow());
-        host_status(self.performer.status(buffer.samples()))
+        host_status(self.performer.status(samples))
+    }
+}
+
+impl Colophony {
+    /// Whether no bow parameter and not the gain is still smoothing (a settled smoother
+    /// returns its target on every call).
+    fn settled(&self) -> bool {
+        let p = &self.params;
+        !(p.bow_velocity.smoothed.is_smoothing()
+            || p.bow_force.smoothed.is_smoothing()
+            || p.bow_position.smoothed.is_smoothing()
+            || p.gain.smoothed.is_smoothing())
+    }
+
+    /// The next sample's bow and output gain from the (smoothed) parameters.
+    fn next_controls(&self) -> (BowControl, f64) {
+        let p = &self.params;
+        let bow = BowControl {
+            velocity_m_per_s: p.bow_velocity.smoothed.next() as f64,
+            force_n: p.bow_force.smoothed.next() as f64,
+            position_beta: p.bow_position.smoothed.next() as f64,
+        };
+        (bow, util::db_to_gain(p.gain.smoothed.next()) as f64)
+    }
+
+    /// Samples `from..to` with the parameters settled and no event between: the performer
+    /// renders them as a block ([`Performer::tick_block`]), the same samples as ticking.
+    fn play_run(&mut self, channels: &mut [&mut [f32]], from: usize, to: usize) {
+        let (bow, gain) = self.next_controls();
+        let mut chunk = [0.0f64; 64];
+        let mut at = from;
+        while at < to {
+            let n = (to - at).min(chunk.len());
+            self.performer.tick_block(bow, &mut chunk[..n]);
+            for (k, audio) in chunk[..n].iter().enumerate() {
+                write_frame(channels, at + k, *audio * gain);
+            }
+            at += n;
+        }
+    }
+
+    /// One sample, feeding the editor's live views while they listen.
+    fn play_sample(&mut self, channels: &mut [&mut [f32]], sample: usize, live: bool) {
+        let (bow, gain) = self.next_controls();
+        let frame = self.performer.tick(bow);
+        if live {
+            let played = self.performer.bow();
+            let contact = editor::live::ContactSample::new(&frame, &played);
+            self.editor_link.scope.push(contact);
+            if let Some(string) = self.performer.probed_thermal_string() {
+                self.node_probe.add_from(
+                    string.node_temperatures(),
+                    string.slipping(),
+                    &self.editor_link,
+                );
+            }
+        }
+        write_frame(channels, sample, frame.audio * gain);
+    }
+}
+
+/// One output sample on every channel: subnormals flushed, the safety limiter applied.
+#[inline]
+fn write_frame(channels: &mut [&mut [f32]], sample: usize, audio: f64) {
+    let out = dsp::filters::safety_limit(dsp::filters::flush_tiny(audio)) as f32;
+    for channel in channels.iter_mut() {
+        channel[sample] = out;
     }
 }
 
