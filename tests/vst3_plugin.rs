@@ -287,3 +287,35 @@ fn a_vst3_project_keeps_its_state_and_reopens_the_clap_fixtures() {
     }
     assert_no_event_overflow();
 }
+
+#[test]
+fn vst3_activates_and_plays_finite_at_extreme_rates_and_block_sizes() {
+    // A host may run at 8 or 384 kHz and hand blocks of one frame: activation succeeds,
+    // every sample is finite and not subnormal (clap-validator's rule), below full scale.
+    let mut vst3 = load();
+    for (sample_rate, block) in [
+        (8_000.0, 1),
+        (8_000.0, 4096),
+        (384_000.0, 4096),
+        (384_000.0, 7),
+    ] {
+        vst3.activate(sample_rate, block);
+        let at = |t: f64| (t * sample_rate) as u64;
+        let score = Score::new()
+            .at(0, Event::note_on(50))
+            .at(at(0.05), Event::note_on(81))
+            .at(at(0.2), Event::note_off(50))
+            .at(at(0.2), Event::note_off(81));
+        let out = vst3.render(at(0.3) as usize, block, &score);
+        let bad = out
+            .iter()
+            .flatten()
+            .find(|x| !(x.is_finite() && (**x == 0.0 || x.is_normal())));
+        assert_eq!(bad, None, "{sample_rate} Hz, blocks of {block}");
+        assert!(
+            out.iter().flatten().all(|x| x.abs() < 1.0),
+            "{sample_rate} Hz: full scale"
+        );
+    }
+    assert_no_event_overflow();
+}
