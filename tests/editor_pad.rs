@@ -700,3 +700,53 @@ fn the_midi_map_page_learns_a_controller_and_edits_the_shared_map() {
         "the map is not a host parameter"
     );
 }
+
+#[test]
+fn the_bridge_picker_lists_a_folders_bridges_and_chooses_one() {
+    use colophony::editor::bridge::{bridge_entries, BROWSE_LABEL};
+    let folder = workspace_file("assets/bridges");
+    // The shipped folder: its three bridges, no CSV, sorted.
+    let names: Vec<String> = bridge_entries(std::path::Path::new(&folder))
+        .iter()
+        .map(|(p, _)| p.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "cello-generic.json",
+            "viola-generic.json",
+            "violin-generic.json"
+        ]
+    );
+    let mut f = fixture();
+    unsafe {
+        f.params
+            .friction_model
+            .as_ptr()
+            ._internal_set_normalized_value(
+                f.params
+                    .friction_model
+                    .preview_normalized(FrictionChoice::Thermal),
+            );
+    }
+    f.editor.bridge_mut().set_path(&folder);
+    {
+        let mut h = harness(&mut f.editor);
+        h.get_by_label(BROWSE_LABEL).click();
+        h.run();
+        h.get_by_label("violin-generic.json").click();
+        h.run();
+        h.get_by_label(LOAD_BRIDGE_LABEL).click();
+        h.run();
+    }
+    assert!(f
+        .editor
+        .bridge_mut()
+        .path()
+        .ends_with("violin-generic.json"));
+    let cello = colophony::dsp::instrument::InstrumentKind::Cello;
+    assert_eq!(
+        colophony::user_bridges::chosen_name(&f.params.user_bridges, cello).as_deref(),
+        Some("violin-generic.json")
+    );
+}

@@ -95,6 +95,11 @@ impl EditorUi {
         self.bridge.status()
     }
 
+    /// The bridge row (its path field and picker).
+    pub fn bridge_mut(&mut self) -> &mut BridgeBar {
+        &mut self.bridge
+    }
+
     /// The preset selector and "save as" (to choose another user preset folder).
     pub fn presets_mut(&mut self) -> &mut PresetBar {
         &mut self.presets
