@@ -560,16 +560,7 @@ fn loading_a_bridge_keeps_it_in_the_project_and_restarts_and_a_bad_file_changes_
         (fitted.as_str(), true, ""),
     ] {
         let mut f = fixture();
-        unsafe {
-            f.params
-                .friction_model
-                .as_ptr()
-                ._internal_set_normalized_value(
-                    f.params
-                        .friction_model
-                        .preview_normalized(FrictionChoice::Thermal),
-                );
-        }
+        play_thermal(&f);
         {
             let mut h = harness(&mut f.editor);
             h.get_by_role_and_label(egui::Role::TextInput, BRIDGE_FILE_LABEL)
@@ -602,6 +593,21 @@ fn loading_a_bridge_keeps_it_in_the_project_and_restarts_and_a_bad_file_changes_
             assert_eq!(restarts, 0);
             assert!(status.contains(error), "{path}: {status}");
         }
+    }
+}
+
+/// The thermal model, as a host would set it (the bridge row shows with the strings).
+fn play_thermal(f: &Fixture) {
+    // SAFETY: the pointer is into the fixture's live parameters.
+    unsafe {
+        f.params
+            .friction_model
+            .as_ptr()
+            ._internal_set_normalized_value(
+                f.params
+                    .friction_model
+                    .preview_normalized(FrictionChoice::Thermal),
+            );
     }
 }
 
@@ -719,16 +725,7 @@ fn the_bridge_picker_lists_a_folders_bridges_and_chooses_one() {
         ]
     );
     let mut f = fixture();
-    unsafe {
-        f.params
-            .friction_model
-            .as_ptr()
-            ._internal_set_normalized_value(
-                f.params
-                    .friction_model
-                    .preview_normalized(FrictionChoice::Thermal),
-            );
-    }
+    play_thermal(&f);
     f.editor.bridge_mut().set_path(&folder);
     {
         let mut h = harness(&mut f.editor);
