@@ -234,7 +234,7 @@ impl Plugin for Colophony {
                 self.handle_event(event);
                 next_event = context.next_event();
             }
-            if self.settled() && !live {
+            if !live && self.settled() {
                 // Up to the next event the bow and gain hold: one run.
                 let end = next_event.map_or(samples, |e| {
                     (e.timing() as usize).clamp(sample + 1, samples)

@@ -764,11 +764,6 @@ impl Performer {
         self.midi_map = *map;
     }
 
-    /// The MIDI map in use.
-    pub fn midi_map(&self) -> &MidiMap {
-        &self.midi_map
-    }
-
     /// A MIDI controller at `value` (0..=1, as nice-plug delivers it). CC101 and CC100
     /// select a registered parameter and CC6 / CC38 set it (RPN 0: the pitch-bend range,
     /// semitones and cents); every other controller does what the MIDI map says

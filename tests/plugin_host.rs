@@ -9,7 +9,10 @@ mod host;
 
 use colophony::analysis::{cents, peak_frequency_hz, rms};
 use colophony::dsp::instrument::{midi_to_hz, InstrumentKind, BOW_RAMP_S};
-use host::{channel_f64, workspace_root, write_wav, Event, HostedPlugin, Score};
+use host::{
+    channel_f64, clap_state, first_unsafe_sample, workspace_root, write_wav, Event, HostedPlugin,
+    Score,
+};
 
 const FS: f64 = 48_000.0;
 const BLOCK: usize = 512;
@@ -661,10 +664,7 @@ fn extreme_sample_rates_and_block_sizes_stay_finite_and_free_of_subnormals() {
                 .at(secs(0.2, sample_rate), Event::note_off(50))
                 .at(secs(0.2, sample_rate), Event::note_off(81));
             let out = plugin.render(secs(0.3, sample_rate) as usize, block, &score);
-            let bad = out
-                .iter()
-                .flatten()
-                .find(|x| !(x.is_finite() && (**x == 0.0 || x.is_normal())));
+            let bad = first_unsafe_sample(&out);
             assert_eq!(bad, None, "{sample_rate} Hz, block {block}");
             let peak = out.iter().flatten().fold(0.0f32, |m, x| m.max(x.abs()));
             println!("{sample_rate} Hz, block {block}: peak {peak:.3}");
@@ -930,9 +930,7 @@ fn states_saved_by_every_version_load_with_their_values() {
     let bytes = std::fs::read(&v1).unwrap();
     let mut state: serde_json::Value = serde_json::from_slice(&bytes[8..]).unwrap();
     state["params"]["bow_force"] = serde_json::json!({ "f32": 5000.0 });
-    let json = serde_json::to_vec(&state).unwrap();
-    let mut damaged = (json.len() as u64).to_le_bytes().to_vec();
-    damaged.extend_from_slice(&json);
+    let damaged = clap_state(&serde_json::to_vec(&state).unwrap());
     let mut plugin = HostedPlugin::load_test_build();
     plugin.load_state(&damaged).unwrap();
     plugin.activate(FS, BLOCK);
@@ -1118,9 +1116,7 @@ fn the_midi_map_travels_with_the_state_and_routes_the_controllers() {
     state["fields"]["midi-map"] = serde_json::Value::String(
         r#"{"slots":[{"cc":74,"target":"dynamics","min":0.0,"max":0.05,"curve":0.0}]}"#.into(),
     );
-    let json = serde_json::to_vec(&state).unwrap();
-    let mut bytes = (json.len() as u64).to_le_bytes().to_vec();
-    bytes.extend_from_slice(&json);
+    let bytes = clap_state(&serde_json::to_vec(&state).unwrap());
     let mut mapped = HostedPlugin::load_test_build();
     mapped.load_state(&bytes).unwrap();
     mapped.activate(FS, BLOCK);

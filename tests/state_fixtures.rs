@@ -15,7 +15,10 @@
 mod host;
 
 use colophony::analysis::rms;
-use host::{channel_f64, fnv1a, machine, workspace_root, Event, HostedPlugin, Score};
+use host::{
+    channel_f64, clap_state, first_unsafe_sample, fnv1a, machine, workspace_root, Event,
+    HostedPlugin, Score,
+};
 
 const FS: f64 = 48_000.0;
 const BLOCK: usize = 256;
@@ -52,12 +55,6 @@ const FULL: &[(&str, &str)] = &[
 const BRIDGE_FOR: &str = "viola";
 const BRIDGE_FILE: &str = "assets/bridges/violin-generic.json";
 
-fn with_length(json: &[u8]) -> Vec<u8> {
-    let mut bytes = (json.len() as u64).to_le_bytes().to_vec();
-    bytes.extend_from_slice(json);
-    bytes
-}
-
 /// Records `v1-full.state` the way a user makes one: parameters set by the host, the
 /// bridge chosen (the editor stores the file's text in the state's `user-bridges` field;
 /// here it is put there directly), the state loaded and saved again by the plugin.
@@ -77,7 +74,7 @@ fn record_full_state() -> Vec<u8> {
     state["fields"]["user-bridges"] = serde_json::Value::String(bridges.to_string());
     let mut again = HostedPlugin::load_test_build();
     again
-        .load_state(&with_length(&serde_json::to_vec(&state).unwrap()))
+        .load_state(&clap_state(&serde_json::to_vec(&state).unwrap()))
         .expect("the plugin refused the state with a bridge");
     again.activate(FS, BLOCK);
     again.save_state()
@@ -153,7 +150,7 @@ fn a_state_with_every_parameter_changed_and_a_user_bridge_loads_and_renders_as_r
         "the fixture holds no bridge"
     );
     fields.remove("user-bridges");
-    let mut shipped = loaded(&with_length(&serde_json::to_vec(&state).unwrap()));
+    let mut shipped = loaded(&clap_state(&serde_json::to_vec(&state).unwrap()));
     let y = render_fixture(&mut shipped);
     let (a, b) = (channel_f64(&[x.clone()], 0), channel_f64(&[y], 0));
     let strings = &a[14_400..52_800];
@@ -272,7 +269,7 @@ fn damage(good: &[u8], rng: &mut Rng) -> Vec<u8> {
             } else {
                 state["params"][key.as_str()] = bad;
             }
-            b = with_length(&serde_json::to_vec(&state).unwrap());
+            b = clap_state(&serde_json::to_vec(&state).unwrap());
         }
     }
     b
@@ -327,10 +324,7 @@ fn a_thousand_damaged_states_are_refused_or_load_into_range_and_play() {
                 .at(0, Event::note_on(50))
                 .at(BLOCK as u64, Event::note_off(50)),
         );
-        let bad = out
-            .iter()
-            .flatten()
-            .find(|x| !(x.is_finite() && (**x == 0.0 || x.is_normal())));
+        let bad = first_unsafe_sample(&out);
         assert_eq!(bad, None, "case {i}");
         assert!(
             out.iter().flatten().all(|x| x.abs() < 1.0),

@@ -17,7 +17,7 @@ use std::path::PathBuf;
 use std::sync::OnceLock;
 
 use colophony::analysis::{cents, peak_frequency_hz, rms};
-use host::{channel_f64, test_plugin_path, Event, HostedPlugin, Score};
+use host::{channel_f64, first_unsafe_sample, test_plugin_path, Event, HostedPlugin, Score};
 use vst3_host::Vst3Plugin;
 
 /// Every test loads through here, so the log goes to the file before the first load.
@@ -307,10 +307,7 @@ fn vst3_activates_and_plays_finite_at_extreme_rates_and_block_sizes() {
             .at(at(0.2), Event::note_off(50))
             .at(at(0.2), Event::note_off(81));
         let out = vst3.render(at(0.3) as usize, block, &score);
-        let bad = out
-            .iter()
-            .flatten()
-            .find(|x| !(x.is_finite() && (**x == 0.0 || x.is_normal())));
+        let bad = first_unsafe_sample(&out);
         assert_eq!(bad, None, "{sample_rate} Hz, blocks of {block}");
         assert!(
             out.iter().flatten().all(|x| x.abs() < 1.0),

@@ -91,10 +91,6 @@ impl Fingering {
         }
     }
 
-    pub fn kind(&self) -> InstrumentKind {
-        self.kind
-    }
-
     /// Another instrument: every note forgotten (the bend, the reference and the
     /// expressions stay; a new note starts neutral).
     pub fn set_kind(&mut self, kind: InstrumentKind) {

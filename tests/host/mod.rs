@@ -712,3 +712,20 @@ pub fn machine() -> String {
         format!("# machine: {}", std::env::consts::ARCH)
     }
 }
+
+/// A saved CLAP state from its JSON: nice-plug's CLAP wrapper puts the length (u64,
+/// little-endian) before it.
+pub fn clap_state(json: &[u8]) -> Vec<u8> {
+    let mut bytes = (json.len() as u64).to_le_bytes().to_vec();
+    bytes.extend_from_slice(json);
+    bytes
+}
+
+/// The first sample that is not finite or is subnormal (what clap-validator fails), if
+/// any.
+pub fn first_unsafe_sample(out: &[Vec<f32>]) -> Option<f32> {
+    out.iter()
+        .flatten()
+        .copied()
+        .find(|x| !(x.is_finite() && (*x == 0.0 || x.is_normal())))
+}
