@@ -35,6 +35,10 @@
 //! Values paper B does not publish are chosen here and justified in
 //! [`ThermalParams::default`] and [`HairParams::default`].
 //!
+//! **Parts.** `hair` holds the bow's nodes and their stick/slip solve (both planes),
+//! `grid` the thermal grid of eq. (1) and its FTCS update; this module joins them to the
+//! string's waves and terminations ([`ThermalString`]).
+//!
 //! | symbol | meaning | unit |
 //! |---|---|---|
 //! | `N_B`, `w`, `dx` | nodes, bow width, node spacing `w / N_B` | 1, m, m |
@@ -46,7 +50,12 @@
 //! | `C_H` | heating per unit frictional power per length | K m/J |
 //! | `F_b` | bow force per unit length | N/m |
 
-use super::filters::{flush_tiny, Allpass1, OnePoleLoss, FLUSH_BELOW};
+use super::filters::{flush_tiny, Allpass1, OnePoleLoss};
+use grid::ThermalGrid;
+use hair::{solve_nodes, sum_lanes, NodeConsts, Nodes};
+
+mod grid;
+mod hair;
 use std::f64::consts::PI;
 
 /// Largest `alpha dt / dx^2` used per thermal sub-step (the bound is 1/2).
@@ -250,63 +259,6 @@ pub struct ThermalFrame {
 /// bits as before the type was introduced.)
 pub type NodeReal = f32;
 
-/// Structure-of-arrays state of the contact nodes.
-#[derive(Debug, Clone, Default)]
-struct Nodes {
-    hair_x: Vec<NodeReal>,
-    hair_v: Vec<NodeReal>,
-    vy: Vec<NodeReal>,
-    y: Vec<NodeReal>,
-    fy: Vec<NodeReal>,
-    force: Vec<NodeReal>,
-    v_delta: Vec<NodeReal>,
-    normal: Vec<NodeReal>,
-    slipping: Vec<bool>,
-    /// Incoming horizontal and vertical velocity per node (gathered each sample).
-    vp: Vec<NodeReal>,
-    vp_y: Vec<NodeReal>,
-}
-
-impl Nodes {
-    fn with_capacity(n: usize) -> Self {
-        let v = || Vec::with_capacity(n);
-        Self {
-            hair_x: v(),
-            hair_v: v(),
-            vy: v(),
-            y: v(),
-            fy: v(),
-            force: v(),
-            v_delta: v(),
-            normal: v(),
-            slipping: Vec::with_capacity(n),
-            vp: v(),
-            vp_y: v(),
-        }
-    }
-
-    /// `n` nodes at rest; never allocates within the capacity.
-    fn resize(&mut self, n: usize) {
-        for v in [
-            &mut self.hair_x,
-            &mut self.hair_v,
-            &mut self.vy,
-            &mut self.y,
-            &mut self.fy,
-            &mut self.force,
-            &mut self.v_delta,
-            &mut self.normal,
-            &mut self.vp,
-            &mut self.vp_y,
-        ] {
-            v.clear();
-            v.resize(n, 0.0);
-        }
-        self.slipping.clear();
-        self.slipping.resize(n, false);
-    }
-}
-
 /// Why a configuration of a thermal string was refused (no allocation: the audio thread
 /// may ask).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -359,186 +311,6 @@ pub struct ThermalCapacity {
     pub lowest_hz: f64,
 }
 
-/// Per-sample constants of the node solve (see [`ThermalString::tick_contact`]).
-#[derive(Debug, Clone, Copy, Default)]
-struct NodeConsts {
-    dt: NodeReal,
-    a: NodeReal,
-    k_h: NodeReal,
-    k_y: NodeReal,
-    e_y: NodeReal,
-    inv_d_y: NodeReal,
-    inv_y_load: NodeReal,
-    inv_x_load: NodeReal,
-    half_y: NodeReal,
-    f_b: NodeReal,
-    v_b: NodeReal,
-    mu_cold: NodeReal,
-    mu_slope: NodeReal,
-    t_cold: NodeReal,
-    mu_lo: NodeReal,
-    mu_hi: NodeReal,
-}
-
-/// `a > b ? a : b`: one `maxpd` (`f64::max` adds NaN handling the solve does not need: its
-/// inputs are finite, and a NaN would already have broken the string).
-#[inline(always)]
-fn max_fast(a: NodeReal, b: NodeReal) -> NodeReal {
-    if a > b {
-        a
-    } else {
-        b
-    }
-}
-
-/// `a < b ? a : b`: one `minpd` (see [`max_fast`]).
-#[inline(always)]
-fn min_fast(a: NodeReal, b: NodeReal) -> NodeReal {
-    if a < b {
-        a
-    } else {
-        b
-    }
-}
-
-/// The node state [`solve_nodes_body`] reads and writes, as separate slices: passed as
-/// function arguments they are known not to overlap, so the vectorised loop needs no
-/// run-time overlap checks before it starts.
-#[inline(always)]
-fn node_slices(nodes: &mut Nodes, n_b: usize) -> NodeSlices<'_> {
-    NodeSlices {
-        fy: &mut nodes.fy[..n_b],
-        vy: &mut nodes.vy[..n_b],
-        y: &mut nodes.y[..n_b],
-        vp_y: &nodes.vp_y[..n_b],
-        vp: &nodes.vp[..n_b],
-        hair_x: &mut nodes.hair_x[..n_b],
-        hair_v: &mut nodes.hair_v[..n_b],
-        force: &mut nodes.force[..n_b],
-        normal: &mut nodes.normal[..n_b],
-        v_delta: &mut nodes.v_delta[..n_b],
-    }
-}
-
-struct NodeSlices<'a> {
-    fy: &'a mut [NodeReal],
-    vy: &'a mut [NodeReal],
-    y: &'a mut [NodeReal],
-    vp_y: &'a [NodeReal],
-    vp: &'a [NodeReal],
-    hair_x: &'a mut [NodeReal],
-    hair_v: &'a mut [NodeReal],
-    force: &'a mut [NodeReal],
-    normal: &'a mut [NodeReal],
-    v_delta: &'a mut [NodeReal],
-}
-
-/// Every node's vertical junction and horizontal stick/slip solve for one sample: the
-/// nodes are independent within a sample, so the loop runs over equal-length slices,
-/// branch-free, and vectorises.
-#[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn solve_nodes_body(
-    k: NodeConsts,
-    fy_s: &mut [NodeReal],
-    vy_s: &mut [NodeReal],
-    y_s: &mut [NodeReal],
-    vp_y: &[NodeReal],
-    vp: &[NodeReal],
-    hx: &mut [NodeReal],
-    hv: &mut [NodeReal],
-    force_s: &mut [NodeReal],
-    normal_s: &mut [NodeReal],
-    vd_s: &mut [NodeReal],
-    temps: &[NodeReal],
-) {
-    let n_b = temps.len();
-    let (fy_s, vy_s, y_s, vp_y, vp) = (
-        &mut fy_s[..n_b],
-        &mut vy_s[..n_b],
-        &mut y_s[..n_b],
-        &vp_y[..n_b],
-        &vp[..n_b],
-    );
-    let (hx, hv, force_s, normal_s, vd_s) = (
-        &mut hx[..n_b],
-        &mut hv[..n_b],
-        &mut force_s[..n_b],
-        &mut normal_s[..n_b],
-        &mut vd_s[..n_b],
-    );
-    for i in 0..n_b {
-        // Vertical junction: the string and the hair mass move together.
-        let rhs = -0.5 * fy_s[i] + k.e_y * vy_s[i] - k.k_y * y_s[i];
-        let fy = (rhs * k.inv_d_y - vp_y[i]) * k.inv_y_load;
-        let vy = vp_y[i] + fy * k.half_y;
-        y_s[i] += 0.5 * k.dt * (vy + vy_s[i]);
-        vy_s[i] = vy;
-        fy_s[i] = fy;
-        let f_n = max_fast(k.f_b + fy, 0.0);
-        // Horizontal: Friedlander with the hair's compliance; the clamp is the stick/slip
-        // decision (slip exactly when |F_stick| > mu F_N). mu(T) is ThermalParams::mu
-        // written out with min/max.
-        let b = -k.a * k.k_h * (hx[i] + 0.5 * k.dt * hv[i]);
-        let mu = min_fast(
-            max_fast(k.mu_cold + k.mu_slope * (temps[i] - k.t_cold), k.mu_lo),
-            k.mu_hi,
-        );
-        let limit = mu * f_n;
-        let f_stick = (k.v_b + b - vp[i]) * k.inv_x_load;
-        let force = min_fast(max_fast(f_stick, -limit), limit);
-        let v_h = -k.a * force + b;
-        hx[i] += 0.5 * k.dt * (v_h + hv[i]);
-        hv[i] = v_h;
-        force_s[i] = force;
-        normal_s[i] = f_n;
-        // v_s - (v_b + v_h) = (F - F_stick)(1 / 2Z + a): exactly 0 while sticking.
-        vd_s[i] = (force - f_stick) * (k.half_y + k.a);
-    }
-}
-
-/// The same loop compiled for AVX2 (four lanes of f64 instead of SSE2's two); chosen at
-/// run time. No FMA contraction happens (Rust keeps `a * b + c` as two roundings), so both
-/// paths give bit-identical results.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn solve_nodes_avx2(k: NodeConsts, s: NodeSlices<'_>, temps: &[NodeReal]) {
-    solve_nodes_body(
-        k, s.fy, s.vy, s.y, s.vp_y, s.vp, s.hair_x, s.hair_v, s.force, s.normal, s.v_delta, temps,
-    )
-}
-
-#[inline]
-fn solve_nodes(wide_simd: bool, k: NodeConsts, nodes: &mut Nodes, temps: &[NodeReal], n_b: usize) {
-    let s = node_slices(nodes, n_b);
-    let temps = &temps[..n_b];
-    #[cfg(target_arch = "x86_64")]
-    if wide_simd {
-        // SAFETY: `wide_simd` is true only where AVX2 was detected at run time.
-        unsafe { solve_nodes_avx2(k, s, temps) };
-        return;
-    }
-    let _ = wide_simd;
-    solve_nodes_body(
-        k, s.fy, s.vy, s.y, s.vp_y, s.vp, s.hair_x, s.hair_v, s.force, s.normal, s.v_delta, temps,
-    )
-}
-
-/// A sum in four interleaved partial sums (independent chains, so it vectorises instead
-/// of waiting on one addition after another); deterministic for the same input.
-#[inline]
-fn sum_lanes(x: &[NodeReal]) -> f64 {
-    let mut acc = [0.0; 4];
-    let chunks = x.chunks_exact(4);
-    let rest: f64 = chunks.remainder().iter().map(|x| f64::from(*x)).sum();
-    for c in chunks {
-        for k in 0..4 {
-            acc[k] += f64::from(c[k]);
-        }
-    }
-    (acc[0] + acc[1]) + (acc[2] + acc[3]) + rest
-}
-
 /// A string with a finite-width thermal bow (see the module doc).
 #[derive(Debug, Clone)]
 pub struct ThermalString {
@@ -546,8 +318,6 @@ pub struct ThermalString {
     wide_simd: bool,
     /// The node solve's constants for the current configuration.
     consts: NodeConsts,
-    /// Eq. (1)'s constants for the current configuration.
-    ftcs: FtcsConsts,
     /// `1 / 2Z`: the velocity a node's force adds to each travelling wave, m/s per N.
     half_y: f64,
     spec: ThermalStringSpec,
@@ -577,11 +347,7 @@ pub struct ThermalString {
     t: usize,
     nodes: Nodes,
     /// Temperature grid: margin, bow nodes, margin.
-    temperature: Vec<NodeReal>,
-    temperature_next: Vec<NodeReal>,
-    grid_capacity: usize,
-    margin_nodes: usize,
-    substeps: usize,
+    grid: ThermalGrid,
     /// Whether the hair touched the string last sample (its state needs clearing on lift).
     contact_active: bool,
     /// Whether any grid point is above ambient (else the FTCS update is skipped).
@@ -746,7 +512,6 @@ impl ThermalString {
         Ok(Self {
             wide_simd: super::detect_wide_simd(),
             consts: NodeConsts::default(),
-            ftcs: FtcsConsts::default(),
             spec,
             thermal,
             hair,
@@ -764,11 +529,7 @@ impl ThermalString {
             mask: ring - 1,
             t: 0,
             nodes: Nodes::with_capacity(max_nodes),
-            temperature: Vec::with_capacity(grid_capacity),
-            temperature_next: Vec::with_capacity(grid_capacity),
-            grid_capacity,
-            margin_nodes: 0,
-            substeps: 1,
+            grid: ThermalGrid::with_capacity(grid_capacity),
             contact_active: true,
             thermal_active: true,
             loss: [OnePoleLoss::default(); 2],
@@ -810,7 +571,7 @@ impl ThermalString {
         if substeps > MAX_THERMAL_SUBSTEPS {
             return Err(ThermalConfigError::GridTooFine { ratio: r, substeps });
         }
-        if nodes > self.nodes.hair_x.capacity() || grid > self.grid_capacity {
+        if nodes > self.nodes.hair_x.capacity() || grid > self.grid.capacity() {
             return Err(ThermalConfigError::Capacity);
         }
         let (loss, m, a) = loop_tuning(
@@ -830,14 +591,14 @@ impl ThermalString {
         self.width_m = width_m;
         self.dx_m = dx;
         self.internal_rate_hz = fs;
-        self.margin_nodes = margin_nodes;
-        self.substeps = substeps;
+        self.grid.set_layout(margin_nodes, substeps);
         self.set_nodes_under_bow(nodes.min(m - BOW_CLEARANCE));
         self.m = m;
         self.loss = [loss; 2];
         self.fraction = [Allpass1::new(a); 2];
         self.consts = self.node_consts();
-        self.ftcs = self.ftcs_consts();
+        self.grid
+            .set_constants(&self.thermal, self.dx_m, self.internal_rate_hz);
         self.reset();
         Ok(())
     }
@@ -848,26 +609,9 @@ impl ThermalString {
         self.nodes_count = n;
         self.narrowing = self.nodes_configured as f64 / n as f64;
         self.nodes.resize(n);
-        let grid = n + 2 * self.margin_nodes;
-        for v in [&mut self.temperature, &mut self.temperature_next] {
-            v.clear();
-            v.resize(grid, 0.0);
-        }
+        self.grid.cover(n);
     }
 
-    /// Eq. (1)'s sub-step constants at the current rate, spacing and sub-step count.
-    fn ftcs_consts(&self) -> FtcsConsts {
-        let p = self.thermal;
-        let dx = self.dx_m;
-        let h = 1.0 / self.internal_rate_hz / self.substeps as f64;
-        let r = p.diffusivity_m2_per_s * h / (dx * dx);
-        FtcsConsts {
-            r: r as NodeReal,
-            heat: (h * p.c_h_kelvin_m_per_j / dx) as NodeReal,
-            cool: (h * p.c_c_per_m) as NodeReal,
-            max_cool: (1.0 - 2.0 * r).max(0.0) as NodeReal,
-        }
-    }
 
     /// The node solve's constants at the current rate and spacing (divisions done once
     /// per configuration, not per sample); the bow's force and velocity are filled in per
@@ -1005,13 +749,13 @@ impl ThermalString {
 
     /// Thermal sub-steps per sample chosen from the FTCS bound.
     pub fn thermal_substeps(&self) -> usize {
-        self.substeps
+        self.grid.substeps()
     }
 
     /// `alpha dt / dx^2` per sub-step (always below 1/2).
     pub fn ftcs_ratio(&self) -> f64 {
         self.thermal.diffusivity_m2_per_s
-            / (self.internal_rate_hz * self.substeps as f64)
+            / (self.internal_rate_hz * self.grid.substeps() as f64)
             / (self.dx_m * self.dx_m)
     }
 
@@ -1022,12 +766,12 @@ impl ThermalString {
 
     /// Temperatures of the bow nodes, K above ambient.
     pub fn node_temperatures(&self) -> &[NodeReal] {
-        &self.temperature[self.margin_nodes..self.margin_nodes + self.nodes_count]
+        self.grid.under_bow(self.nodes_count)
     }
 
     /// The whole thermal grid (margins included).
     pub fn temperature_grid(&self) -> &[NodeReal] {
-        &self.temperature
+        self.grid.all()
     }
 
     /// Which nodes slipped on the last sample.
@@ -1156,7 +900,7 @@ impl ThermalString {
             v.fill(0.0);
         }
         n.slipping.fill(false);
-        self.temperature.fill(0.0);
+        self.grid.clear();
         self.asleep = [false; 2];
         self.dropped = [0.0; 2];
     }
@@ -1252,7 +996,7 @@ impl ThermalString {
                     il = step(il);
                 }
             }
-            let temps = &self.temperature[self.margin_nodes..self.margin_nodes + n_b];
+            let temps = self.grid.under_bow(n_b);
             let k = NodeConsts {
                 f_b: f_b as NodeReal,
                 v_b: bow.velocity_m_per_s as NodeReal,
@@ -1303,9 +1047,13 @@ impl ThermalString {
         }
         // The grid idles once the bow is off and the contact has cooled to nothing.
         if on || self.thermal_active {
-            self.update_temperature();
+            self.grid.update(
+                self.wide_simd,
+                &self.nodes.v_delta[..n_b],
+                &self.nodes.force[..n_b],
+            );
             if !on {
-                self.thermal_active = self.temperature.iter().any(|t| *t != 0.0);
+                self.thermal_active = self.grid.any_warm();
             }
         }
         if on {
@@ -1385,143 +1133,11 @@ impl ThermalString {
         self.spec.z0_kg_per_s
     }
 
-    /// Eq. (1) by FTCS with the sub-steps the stability bound asks for: diffusion over
-    /// the whole grid (branch-free interior), then the friction source and convective loss
-    /// on the bow's nodes.
-    fn update_temperature(&mut self) {
-        #[cfg(target_arch = "x86_64")]
-        if self.wide_simd {
-            // SAFETY: `wide_simd` is true only where AVX2 was detected at run time.
-            unsafe { self.update_temperature_avx2() };
-            return;
-        }
-        self.update_temperature_body()
-    }
-
-    /// [`ThermalString::update_temperature`] compiled for AVX2 (bit-identical: no FMA).
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn update_temperature_avx2(&mut self) {
-        self.update_temperature_body()
-    }
-
-    #[inline(always)]
-    fn update_temperature_body(&mut self) {
-        let n_b = self.nodes_count;
-        let off = self.margin_nodes;
-        for _ in 0..self.substeps {
-            ftcs_step(
-                self.ftcs,
-                &self.temperature,
-                &mut self.temperature_next,
-                off,
-                &self.nodes.v_delta[..n_b],
-                &self.nodes.force[..n_b],
-            );
-            std::mem::swap(&mut self.temperature, &mut self.temperature_next);
-        }
-    }
-}
-
-/// The per-sub-step constants of eq. (1) (set with the configuration): the FTCS ratio
-/// `r = alpha h / dx^2`, the heating `h C_H / dx` and the cooling `h C_C`, `h` the sub-step.
-///
-/// The convective loss `h C_C |v| T` is explicit: once `h C_C |v|` passes `1 - 2 r`, a
-/// node's new temperature would take a negative weight of its old one (it would lose more
-/// heat than it holds, and beyond 2 the loss grows without bound: fast slips on a coarse
-/// grid, a few m/s at N_B 1). The loss factor is therefore capped at `max_cool = 1 - 2 r`,
-/// which keeps every weight of the update non-negative and their sum at most 1: the grid
-/// obeys the maximum principle (never below ambient, never above what the heating put
-/// in) at any slip velocity. Below the cap, which is every sample of ordinary playing,
-/// the update is unchanged.
-#[derive(Debug, Clone, Copy, Default)]
-struct FtcsConsts {
-    r: NodeReal,
-    heat: NodeReal,
-    cool: NodeReal,
-    max_cool: NodeReal,
-}
-
-/// [`flush_tiny`] (same threshold) for the grid's float type.
-#[inline(always)]
-fn flush_tiny_node(x: NodeReal) -> NodeReal {
-    if x.abs() < FLUSH_BELOW as NodeReal {
-        0.0
-    } else {
-        x
-    }
-}
-
-/// One FTCS sub-step from `t` into `next` (the grid and the bow's `n_b` nodes from `off`);
-/// slices as arguments, so the vectorised loops need no overlap checks.
-#[inline(always)]
-fn ftcs_step(
-    k: FtcsConsts,
-    t: &[NodeReal],
-    next: &mut [NodeReal],
-    off: usize,
-    vd: &[NodeReal],
-    force: &[NodeReal],
-) {
-    let FtcsConsts {
-        r,
-        heat,
-        cool,
-        max_cool,
-    } = k;
-    let n = t.len();
-    let next = &mut next[..n];
-    if n == 1 {
-        next[0] = flush_tiny_node(t[0] * (1.0 - 2.0 * r));
-    } else {
-        next[0] = flush_tiny_node(t[0] + r * (t[1] - 2.0 * t[0]));
-        // Tiny values are flushed to zero inside the loop (a select, which vectorises),
-        // so no later step computes with subnormals.
-        for (out, w) in next[1..n - 1].iter_mut().zip(t.windows(3)) {
-            *out = flush_tiny_node(w[1] + r * (w[0] - 2.0 * w[1] + w[2]));
-        }
-        next[n - 1] = flush_tiny_node(t[n - 1] + r * (t[n - 2] - 2.0 * t[n - 1]));
-    }
-    let n_b = vd.len();
-    let bow = &mut next[off..off + n_b];
-    let t_bow = &t[off..off + n_b];
-    for (((out, tj), vd), f) in bow.iter_mut().zip(t_bow).zip(vd).zip(&force[..n_b]) {
-        let v = vd.abs();
-        *out = flush_tiny_node(*out + heat * f.abs() * v - (cool * v).min(max_cool) * tj);
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// The capped convective loss (see [`FtcsConsts`]): at a slip far beyond the cap (here
-    /// `h C_C |v|` = 50) a hot node cools at most to ambient in one sub-step and never
-    /// goes negative or grows; below the cap the loss is the explicit `h C_C |v| T`.
-    #[test]
-    fn the_convective_loss_never_takes_a_node_below_ambient() {
-        let k = FtcsConsts {
-            r: 0.2,
-            heat: 0.0,
-            cool: 0.5,
-            max_cool: 0.6,
-        };
-        let t = [0.0, 10.0, 10.0, 10.0, 0.0];
-        let mut next = [0.0; 5];
-        for (v, want_middle) in [
-            // 0.5 * 0.1 = 0.05 below the cap: 10 + 0.2 * (10 - 20 + 10) - 0.05 * 10.
-            (0.1, 9.5),
-            // Capped at 0.6: 10 - 0.6 * 10 = 4 (uncapped: 10 - 50 * 10 = -490).
-            (100.0, 4.0),
-        ] {
-            ftcs_step(k, &t, &mut next, 1, &[v; 3], &[1.0; 3]);
-            assert!((next[2] - want_middle).abs() < 1e-5, "v {v}: {}", next[2]);
-            assert!(
-                next.iter().all(|x| *x >= 0.0 && *x <= 10.0),
-                "v {v}: {next:?}"
-            );
-        }
-    }
 
     #[test]
     fn reflections_of_psd_admittances_are_passive() {
