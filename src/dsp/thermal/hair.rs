@@ -218,7 +218,13 @@ fn solve_nodes_avx2(k: NodeConsts, s: NodeSlices<'_>, temps: &[NodeReal]) {
 }
 
 #[inline]
-pub(super) fn solve_nodes(wide_simd: bool, k: NodeConsts, nodes: &mut Nodes, temps: &[NodeReal], n_b: usize) {
+pub(super) fn solve_nodes(
+    wide_simd: bool,
+    k: NodeConsts,
+    nodes: &mut Nodes,
+    temps: &[NodeReal],
+    n_b: usize,
+) {
     let s = node_slices(nodes, n_b);
     let temps = &temps[..n_b];
     #[cfg(target_arch = "x86_64")]

@@ -35,9 +35,10 @@
 //! Values paper B does not publish are chosen here and justified in
 //! [`ThermalParams::default`] and [`HairParams::default`].
 //!
-//! **Parts.** `hair` holds the bow's nodes and their stick/slip solve (both planes),
-//! `grid` the thermal grid of eq. (1) and its FTCS update; this module joins them to the
-//! string's waves and terminations ([`ThermalString`]).
+//! **Parts.** `waves` holds the string without its bow (both polarisations' travelling
+//! waves, end filters and reflections, energy and sleep), `hair` the bow's nodes and their
+//! stick/slip solve (both planes), `grid` the thermal grid of eq. (1) and its FTCS update;
+//! this module joins them ([`ThermalString`]).
 //!
 //! | symbol | meaning | unit |
 //! |---|---|---|
@@ -50,12 +51,14 @@
 //! | `C_H` | heating per unit frictional power per length | K m/J |
 //! | `F_b` | bow force per unit length | N/m |
 
-use super::filters::{flush_tiny, Allpass1, OnePoleLoss};
+use super::filters::{Allpass1, OnePoleLoss};
 use grid::ThermalGrid;
 use hair::{solve_nodes, sum_lanes, NodeConsts, Nodes};
+use waves::Waves;
 
 mod grid;
 mod hair;
+mod waves;
 use std::f64::consts::PI;
 
 /// Largest `alpha dt / dx^2` used per thermal sub-step (the bound is 1/2).
@@ -336,15 +339,10 @@ pub struct ThermalString {
     width_m: f64,
     dx_m: f64,
     internal_rate_hz: f64,
-    /// Samples along the string (bridge at 0, nut at m - 1).
-    m: usize,
     /// Position index of the first (bridge-side) bow node.
     bow_start: usize,
-    /// Delay lines per polarisation: `[h, v]`, rings of a power-of-two length.
-    right: [Vec<f64>; 2],
-    left: [Vec<f64>; 2],
-    mask: usize,
-    t: usize,
+    /// The waves in both polarisations, their end filters and reflections.
+    waves: Waves,
     nodes: Nodes,
     /// Temperature grid: margin, bow nodes, margin.
     grid: ThermalGrid,
@@ -352,22 +350,8 @@ pub struct ThermalString {
     contact_active: bool,
     /// Whether any grid point is above ambient (else the FTCS update is skipped).
     thermal_active: bool,
-    loss: [OnePoleLoss; 2],
-    /// Thiran fractional delay at the nut, per polarisation (tuning).
-    fraction: [Allpass1; 2],
-    nut_reflection: [[f64; 2]; 2],
-    bridge_reflection: [[f64; 2]; 2],
-    /// Polarisations put to sleep ([`ThermalString::sleep_quiet_polarisations`]): their
-    /// lines and filters hold zeros and are not computed.
-    asleep: [bool; 2],
     /// Terminated by a modal bridge, not its own `bridge_admittance`.
     modal_bridge: bool,
-    /// Sum of the squared waves a sleeping polarisation was offered and dropped (at the
-    /// bridge and from the other polarisation at the nut), m^2/s^2.
-    dropped: [f64; 2],
-    /// Energy of dropped waves that wakes a sleeping polarisation, in the same units
-    /// (`threshold fs / Z`).
-    wake_sum: f64,
 }
 
 /// `R = -(I + Z Y)^-1 (I - Z Y)` for a real 2x2 `Y`.
@@ -508,7 +492,6 @@ impl ThermalString {
         let ring = ((max_rate_hz / lowest_hz / 2.0).ceil() as usize + 4).next_power_of_two();
         let dx_min = c / max_rate_hz;
         let grid_capacity = max_nodes + 2 * ((thermal.margin_m / dx_min).round() as usize + 1);
-        let zeros = |n: usize| vec![0.0; n];
         Ok(Self {
             wide_simd: super::detect_wide_simd(),
             consts: NodeConsts::default(),
@@ -522,25 +505,18 @@ impl ThermalString {
             width_m: 0.0,
             dx_m: dx_min,
             internal_rate_hz: max_rate_hz,
-            m: 0,
             bow_start: 0,
-            right: [zeros(ring), zeros(ring)],
-            left: [zeros(ring), zeros(ring)],
-            mask: ring - 1,
-            t: 0,
+            waves: Waves::new(
+                ring,
+                reflection(spec.z0_kg_per_s, spec.nut_admittance),
+                reflection(spec.z0_kg_per_s, spec.bridge_admittance),
+            ),
             nodes: Nodes::with_capacity(max_nodes),
             grid: ThermalGrid::with_capacity(grid_capacity),
             contact_active: true,
             thermal_active: true,
-            loss: [OnePoleLoss::default(); 2],
-            fraction: [Allpass1::new(0.0); 2],
             half_y: 0.5 / spec.z0_kg_per_s,
-            nut_reflection: reflection(spec.z0_kg_per_s, spec.nut_admittance),
-            bridge_reflection: reflection(spec.z0_kg_per_s, spec.bridge_admittance),
-            asleep: [false; 2],
             modal_bridge: false,
-            dropped: [0.0; 2],
-            wake_sum: f64::INFINITY,
         })
     }
 
@@ -581,7 +557,7 @@ impl ThermalString {
             0.0,
             self.termination_gain(),
         );
-        if m + 4 > self.mask {
+        if m + 4 > self.waves.mask() {
             return Err(ThermalConfigError::Capacity);
         }
         if m < MIN_BOW_NODES + BOW_CLEARANCE {
@@ -593,9 +569,7 @@ impl ThermalString {
         self.internal_rate_hz = fs;
         self.grid.set_layout(margin_nodes, substeps);
         self.set_nodes_under_bow(nodes.min(m - BOW_CLEARANCE));
-        self.m = m;
-        self.loss = [loss; 2];
-        self.fraction = [Allpass1::new(a); 2];
+        self.waves.set_loop(m, loss, a);
         self.consts = self.node_consts();
         self.grid
             .set_constants(&self.thermal, self.dx_m, self.internal_rate_hz);
@@ -611,7 +585,6 @@ impl ThermalString {
         self.nodes.resize(n);
         self.grid.cover(n);
     }
-
 
     /// The node solve's constants at the current rate and spacing (divisions done once
     /// per configuration, not per sample); the bow's force and velocity are filled in per
@@ -678,7 +651,7 @@ impl ThermalString {
             extra_delay,
             self.termination_gain(),
         );
-        if m + 4 > self.mask || m < MIN_BOW_NODES + BOW_CLEARANCE {
+        if m + 4 > self.waves.mask() || m < MIN_BOW_NODES + BOW_CLEARANCE {
             return false;
         }
         let fit = self.nodes_configured.min(m - BOW_CLEARANCE);
@@ -687,12 +660,7 @@ impl ThermalString {
         }
         self.spec.f0_hz = f0_hz;
         self.spec.length_m = self.c_m_per_s / (2.0 * f0_hz);
-        self.m = m;
-        for p in 0..2 {
-            self.loss[p].g = loss.g;
-            self.loss[p].p = loss.p;
-            self.fraction[p].a = a;
-        }
+        self.waves.retune(m, loss, a);
         true
     }
 
@@ -700,11 +668,11 @@ impl ThermalString {
     /// terminations: the nut's, and its own bridge's unless a modal bridge terminates it
     /// ([`ThermalString::use_modal_bridge`], whose loss is the body's, on top of `Q1`).
     fn termination_gain(&self) -> f64 {
-        let rn = self.nut_reflection;
+        let rn = self.waves.nut_reflection();
         if self.modal_bridge {
             return rn[0][0].abs();
         }
-        let rb = self.bridge_reflection;
+        let rb = self.waves.bridge_reflection();
         (rb[0][0] * rn[0][0] + rb[0][1] * rn[1][0]).abs()
     }
 
@@ -761,7 +729,7 @@ impl ThermalString {
 
     /// Integer part of the loop at the internal rate (the filters add the rest).
     pub fn loop_samples(&self) -> usize {
-        2 * self.m
+        2 * self.waves.len()
     }
 
     /// Temperatures of the bow nodes, K above ambient.
@@ -805,24 +773,8 @@ impl ThermalString {
 
     /// Energy of each polarisation's waves and end filters, `[h, v]`, J.
     fn wave_energies_j(&self) -> [f64; 2] {
-        let z = self.spec.z0_kg_per_s;
-        let fs = self.internal_rate_hz;
-        let mask = self.mask;
-        let mut out = [0.0; 2];
-        for (p, out) in out.iter_mut().enumerate() {
-            if self.asleep[p] {
-                continue;
-            }
-            let mut sum = 0.0;
-            for x in 0..self.m {
-                let a = self.right[p][x.wrapping_sub(self.t) & mask];
-                let b = self.left[p][self.t.wrapping_sub(self.m - 1 - x) & mask];
-                sum += a * a + b * b;
-            }
-            sum += self.loss[p].stored_energy() + self.fraction[p].stored_energy();
-            *out = z / fs * sum;
-        }
-        out
+        self.waves
+            .energies_j(self.spec.z0_kg_per_s, self.internal_rate_hz)
     }
 
     /// Energy the hair holds (horizontal spring, vertical mass and spring), J.
@@ -854,39 +806,25 @@ impl ThermalString {
         if self.contact_active {
             return;
         }
-        let energies = self.wave_energies_j();
-        self.wake_sum = 0.5 * threshold_j * self.internal_rate_hz / self.spec.z0_kg_per_s;
-        for (p, energy) in energies.iter().enumerate() {
-            if !self.asleep[p] && *energy < 0.5 * threshold_j {
-                self.right[p].fill(0.0);
-                self.left[p].fill(0.0);
-                self.loss[p].reset();
-                self.fraction[p].reset();
-                self.asleep[p] = true;
-                self.dropped[p] = 0.0;
-            }
-        }
+        self.waves
+            .sleep_quiet(threshold_j, self.spec.z0_kg_per_s, self.internal_rate_hz);
     }
 
     /// `[h, v]`: which polarisations sleep.
     pub fn asleep(&self) -> [bool; 2] {
-        self.asleep
+        self.waves.asleep()
     }
 
     /// Whether both polarisations sleep and the temperature grid has cooled (the string
     /// then costs only its ring index).
     #[inline(always)]
     pub fn is_asleep(&self) -> bool {
-        self.asleep[0] & self.asleep[1] & !self.thermal_active
+        let [h, v] = self.waves.asleep();
+        h & v & !self.thermal_active
     }
 
     pub fn reset(&mut self) {
-        for p in 0..2 {
-            self.right[p].fill(0.0);
-            self.left[p].fill(0.0);
-            self.loss[p].reset();
-            self.fraction[p].reset();
-        }
+        self.waves.reset();
         let n = &mut self.nodes;
         for v in [
             &mut n.hair_x,
@@ -901,8 +839,6 @@ impl ThermalString {
         }
         n.slipping.fill(false);
         self.grid.clear();
-        self.asleep = [false; 2];
-        self.dropped = [0.0; 2];
     }
 
     /// One sample at the internal rate with the string's own (2x2 admittance) bridge. A bow
@@ -923,10 +859,7 @@ impl ThermalString {
     /// The bow contact and thermal update of one sample (no terminations).
     #[inline(always)]
     pub fn tick_contact(&mut self, bow: ThermalBowControl) -> ThermalFrame {
-        let mask = self.mask;
-        let m = self.m;
-        let t = self.t;
-        let at = |delay: usize| t.wrapping_sub(delay) & mask;
+        let m = self.waves.len();
         let n_b = self.nodes_count;
         // Round half up (beta * m >= 0), without a libm call per sample.
         let centre = (bow.position_beta.clamp(0.01, 0.5) * m as f64 + 0.5) as usize;
@@ -936,18 +869,13 @@ impl ThermalString {
         let on = f_b > 0.0;
         if on {
             // A landing bow wakes the string (its sleeping lines hold zeros).
-            self.asleep = [false; 2];
+            self.waves.wake();
         }
         let mut frame = ThermalFrame::default();
         let mid = n_b / 2;
         let half_y = self.half_y;
 
-        // Consecutive nodes sit at consecutive ring indices in both lines (see the layout
-        // note in `finish_sample`): contiguous slices unless a ring wraps under the bow.
-        let step = |i: usize| (i + 1) & mask;
-        let ir0 = self.bow_start.wrapping_sub(t) & mask;
-        let il0 = at(m - 1 - self.bow_start);
-        let contiguous = ir0 + n_b <= mask + 1 && il0 + n_b <= mask + 1;
+        let span = self.waves.span(self.bow_start, n_b);
         let nodes = &mut self.nodes;
         if !on {
             if !self.contact_active {
@@ -972,30 +900,7 @@ impl ThermalString {
             self.contact_active = true;
             // Gather the incoming waves, solve every node (independent within a sample,
             // branch-free so it vectorises), scatter the outgoing waves.
-            if contiguous {
-                let (r0, r1) = (
-                    &self.right[0][ir0..ir0 + n_b],
-                    &self.right[1][ir0..ir0 + n_b],
-                );
-                let (l0, l1) = (&self.left[0][il0..il0 + n_b], &self.left[1][il0..il0 + n_b]);
-                for (((v, a), b), (vy, (c, d))) in nodes.vp[..n_b]
-                    .iter_mut()
-                    .zip(r0)
-                    .zip(l0)
-                    .zip(nodes.vp_y[..n_b].iter_mut().zip(r1.iter().zip(l1)))
-                {
-                    *v = (a + b) as NodeReal;
-                    *vy = (c + d) as NodeReal;
-                }
-            } else {
-                let (mut ir, mut il) = (ir0, il0);
-                for i in 0..n_b {
-                    nodes.vp[i] = (self.right[0][ir] + self.left[0][il]) as NodeReal;
-                    nodes.vp_y[i] = (self.right[1][ir] + self.left[1][il]) as NodeReal;
-                    ir = step(ir);
-                    il = step(il);
-                }
-            }
+            self.waves.gather(span, &mut nodes.vp, &mut nodes.vp_y);
             let temps = self.grid.under_bow(n_b);
             let k = NodeConsts {
                 f_b: f_b as NodeReal,
@@ -1008,31 +913,7 @@ impl ThermalString {
             for (slip, vd) in slip_s.iter_mut().zip(vd_s.iter()) {
                 *slip = *vd != 0.0;
             }
-            if contiguous {
-                let [r0, r1] = &mut self.right;
-                let [l0, l1] = &mut self.left;
-                for (forces, r, l) in [(&nodes.force, r0, l0), (&nodes.fy, r1, l1)] {
-                    let r = &mut r[ir0..ir0 + n_b];
-                    let l = &mut l[il0..il0 + n_b];
-                    for ((f, a), b) in forces[..n_b].iter().zip(r).zip(l) {
-                        let dv = f64::from(*f) * half_y;
-                        *a += dv;
-                        *b += dv;
-                    }
-                }
-            } else {
-                let (mut ir, mut il) = (ir0, il0);
-                for i in 0..n_b {
-                    let dv = f64::from(nodes.force[i]) * half_y;
-                    let dv_y = f64::from(nodes.fy[i]) * half_y;
-                    self.right[0][ir] += dv;
-                    self.left[0][il] += dv;
-                    self.right[1][ir] += dv_y;
-                    self.left[1][il] += dv_y;
-                    ir = step(ir);
-                    il = step(il);
-                }
-            }
+            self.waves.scatter(span, &nodes.force, &nodes.fy, half_y);
             frame.friction_force_n = sum_lanes(&nodes.force);
             frame.normal_force_n = sum_lanes(&nodes.normal);
             frame.slipping_nodes = nodes.slipping.iter().map(|s| *s as usize).sum();
@@ -1041,9 +922,7 @@ impl ThermalString {
             frame.hair_velocity_m_per_s = f64::from(nodes.hair_v[mid]);
         }
         if !on {
-            let x = self.bow_start + mid;
-            frame.string_velocity_m_per_s =
-                self.right[0][x.wrapping_sub(t) & mask] + self.left[0][at(m - 1 - x)];
+            frame.string_velocity_m_per_s = self.waves.velocity_h(self.bow_start + mid);
         }
         // The grid idles once the bow is off and the contact has cooled to nothing.
         if on || self.thermal_active {
@@ -1067,7 +946,7 @@ impl ThermalString {
         let z = self.spec.z0_kg_per_s;
         // Terminations: the string's own bridge reflection.
         let at_bridge = self.arriving_at_bridge();
-        let rb = self.bridge_reflection;
+        let rb = self.waves.bridge_reflection();
         let outgoing = [
             rb[0][0] * at_bridge[0] + rb[0][1] * at_bridge[1],
             rb[1][0] * at_bridge[0] + rb[1][1] * at_bridge[1],
@@ -1082,57 +961,19 @@ impl ThermalString {
     /// [`ThermalString::finish_sample`]; the bridge model answers with the outgoing waves.
     #[inline(always)]
     pub fn arriving_at_bridge(&mut self) -> [f64; 2] {
-        let i = self.t.wrapping_sub(self.m - 1) & self.mask;
-        let mut out = [0.0; 2];
-        for (p, out) in out.iter_mut().enumerate() {
-            if !self.asleep[p] {
-                *out = self.loss[p].tick(self.left[p][i]);
-            }
-        }
-        out
+        self.waves.arriving_at_bridge()
     }
 
     /// Ends the sample: writes the waves leaving the bridge, reflects at the nut, and
     /// advances time.
-    ///
-    /// Layout: the left-going wave at position `x` (samples from the bridge) and time `t`
-    /// is `left[(t - (m - 1 - x)) & mask]`, the right-going one `right[(x - t) & mask]`; the
-    /// waves never move in memory, and both indices grow with `x`, so the bow's nodes
-    /// read and write contiguous slices.
     #[inline(always)]
     pub fn finish_sample(&mut self, leaving_bridge: [f64; 2]) {
-        let j = (self.m - 1).wrapping_sub(self.t) & self.mask;
-        let mut at_nut = [0.0; 2];
-        for p in 0..2 {
-            if !self.asleep[p] {
-                at_nut[p] = self.fraction[p].tick(self.right[p][j]);
-            }
-        }
-        let rn = self.nut_reflection;
-        let next = (self.t + 1) & self.mask;
-        let bridge_end = 0usize.wrapping_sub(next) & self.mask;
-        for p in 0..2 {
-            let from_bridge = flush_tiny(leaving_bridge[p]);
-            let from_nut = flush_tiny(rn[p][0] * at_nut[0] + rn[p][1] * at_nut[1]);
-            if self.asleep[p] {
-                // Dropped (the lines stay zero) until the dropped waves add up to the
-                // wake threshold; this sample's waves then go in.
-                self.dropped[p] += from_bridge * from_bridge + from_nut * from_nut;
-                if self.dropped[p] < self.wake_sum {
-                    continue;
-                }
-                self.asleep[p] = false;
-            }
-            self.right[p][bridge_end] = from_bridge;
-            self.left[p][next] = from_nut;
-        }
-        self.t = next;
+        self.waves.finish_sample(leaving_bridge)
     }
 
     pub fn z0_kg_per_s(&self) -> f64 {
         self.spec.z0_kg_per_s
     }
-
 }
 
 #[cfg(test)]

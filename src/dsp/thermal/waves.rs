@@ -1,0 +1,307 @@
+//! The string of paper B without its bow: travelling velocity waves in both transverse
+//! polarisations (horizontal `h`, the bowing direction, and vertical `v`), one sample per
+//! node spacing, a loss filter and a Thiran fractional delay per polarisation for the
+//! tuning, real 2x2 reflections at the ends, its stored energy and sleep.
+//!
+//! Layout: the left-going wave at position `x` (samples from the bridge) and time `t` is
+//! `left[(t - (m - 1 - x)) & mask]`, the right-going one `right[(x - t) & mask]`; the
+//! waves never move in memory, and both indices grow with `x`, so the bow's nodes read and
+//! write contiguous slices ([`Waves::gather`], [`Waves::scatter`]).
+
+use super::NodeReal;
+use crate::dsp::filters::{flush_tiny, Allpass1, OnePoleLoss};
+
+/// Both polarisations' delay lines, end filters and reflections, and their sleep state.
+#[derive(Debug, Clone)]
+pub(super) struct Waves {
+    /// Delay lines per polarisation: `[h, v]`, rings of a power-of-two length.
+    right: [Vec<f64>; 2],
+    left: [Vec<f64>; 2],
+    mask: usize,
+    t: usize,
+    /// Samples along the string (bridge at 0, nut at m - 1).
+    m: usize,
+    loss: [OnePoleLoss; 2],
+    /// Thiran fractional delay at the nut, per polarisation (tuning).
+    fraction: [Allpass1; 2],
+    nut_reflection: [[f64; 2]; 2],
+    bridge_reflection: [[f64; 2]; 2],
+    /// Polarisations put to sleep ([`Waves::sleep_quiet`]): their lines and filters hold
+    /// zeros and are not computed.
+    asleep: [bool; 2],
+    /// Sum of the squared waves a sleeping polarisation was offered and dropped (at the
+    /// bridge and from the other polarisation at the nut), m^2/s^2.
+    dropped: [f64; 2],
+    /// Energy of dropped waves that wakes a sleeping polarisation, in the same units
+    /// (`threshold fs / Z`).
+    wake_sum: f64,
+}
+
+/// Where the bow's `n` nodes sit in the rings this sample.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Span {
+    right: usize,
+    left: usize,
+    n: usize,
+    /// Neither ring wraps under the bow: the nodes are contiguous slices.
+    contiguous: bool,
+}
+
+impl Waves {
+    /// Silent lines of `ring` samples (a power of two) with the ends' reflections.
+    pub(super) fn new(
+        ring: usize,
+        nut_reflection: [[f64; 2]; 2],
+        bridge_reflection: [[f64; 2]; 2],
+    ) -> Self {
+        debug_assert!(ring.is_power_of_two());
+        Self {
+            right: [vec![0.0; ring], vec![0.0; ring]],
+            left: [vec![0.0; ring], vec![0.0; ring]],
+            mask: ring - 1,
+            t: 0,
+            m: 0,
+            loss: [OnePoleLoss::default(); 2],
+            fraction: [Allpass1::new(0.0); 2],
+            nut_reflection,
+            bridge_reflection,
+            asleep: [false; 2],
+            dropped: [0.0; 2],
+            wake_sum: f64::INFINITY,
+        }
+    }
+
+    /// `ring - 1`: the longest half-loop is a few samples less.
+    pub(super) fn mask(&self) -> usize {
+        self.mask
+    }
+
+    /// Samples along the string.
+    pub(super) fn len(&self) -> usize {
+        self.m
+    }
+
+    /// A new loop (configuration): `m` samples, fresh loss and Thiran filters.
+    pub(super) fn set_loop(&mut self, m: usize, loss: OnePoleLoss, thiran: f64) {
+        self.m = m;
+        self.loss = [loss; 2];
+        self.fraction = [Allpass1::new(thiran); 2];
+    }
+
+    /// A new length (a stopped note): the filters' coefficients change, their states and
+    /// the waves stay where they are.
+    pub(super) fn retune(&mut self, m: usize, loss: OnePoleLoss, thiran: f64) {
+        self.m = m;
+        for p in 0..2 {
+            self.loss[p].g = loss.g;
+            self.loss[p].p = loss.p;
+            self.fraction[p].a = thiran;
+        }
+    }
+
+    pub(super) fn nut_reflection(&self) -> [[f64; 2]; 2] {
+        self.nut_reflection
+    }
+
+    pub(super) fn bridge_reflection(&self) -> [[f64; 2]; 2] {
+        self.bridge_reflection
+    }
+
+    /// The ring positions of `n` nodes from position `start` (samples from the bridge).
+    #[inline(always)]
+    pub(super) fn span(&self, start: usize, n: usize) -> Span {
+        let right = start.wrapping_sub(self.t) & self.mask;
+        let left = self.t.wrapping_sub(self.m - 1 - start) & self.mask;
+        Span {
+            right,
+            left,
+            n,
+            contiguous: right + n <= self.mask + 1 && left + n <= self.mask + 1,
+        }
+    }
+
+    /// The velocity the incoming waves give each node, `[h, v]` into `vp` and `vp_y`.
+    #[inline(always)]
+    pub(super) fn gather(&self, s: Span, vp: &mut [NodeReal], vp_y: &mut [NodeReal]) {
+        let n = s.n;
+        if s.contiguous {
+            let (r0, r1) = (
+                &self.right[0][s.right..s.right + n],
+                &self.right[1][s.right..s.right + n],
+            );
+            let (l0, l1) = (
+                &self.left[0][s.left..s.left + n],
+                &self.left[1][s.left..s.left + n],
+            );
+            for (((v, a), b), (vy, (c, d))) in vp[..n]
+                .iter_mut()
+                .zip(r0)
+                .zip(l0)
+                .zip(vp_y[..n].iter_mut().zip(r1.iter().zip(l1)))
+            {
+                *v = (a + b) as NodeReal;
+                *vy = (c + d) as NodeReal;
+            }
+        } else {
+            let (mut ir, mut il) = (s.right, s.left);
+            for i in 0..n {
+                vp[i] = (self.right[0][ir] + self.left[0][il]) as NodeReal;
+                vp_y[i] = (self.right[1][ir] + self.left[1][il]) as NodeReal;
+                ir = (ir + 1) & self.mask;
+                il = (il + 1) & self.mask;
+            }
+        }
+    }
+
+    /// Adds each node's force to both travelling waves leaving it: `F / 2Z` each way
+    /// (`half_y = 1 / 2Z`), horizontal `force`, vertical `force_y`.
+    #[inline(always)]
+    pub(super) fn scatter(
+        &mut self,
+        s: Span,
+        force: &[NodeReal],
+        force_y: &[NodeReal],
+        half_y: f64,
+    ) {
+        let n = s.n;
+        if s.contiguous {
+            let [r0, r1] = &mut self.right;
+            let [l0, l1] = &mut self.left;
+            for (forces, r, l) in [(force, r0, l0), (force_y, r1, l1)] {
+                let r = &mut r[s.right..s.right + n];
+                let l = &mut l[s.left..s.left + n];
+                for ((f, a), b) in forces[..n].iter().zip(r).zip(l) {
+                    let dv = f64::from(*f) * half_y;
+                    *a += dv;
+                    *b += dv;
+                }
+            }
+        } else {
+            let (mut ir, mut il) = (s.right, s.left);
+            for i in 0..n {
+                let dv = f64::from(force[i]) * half_y;
+                let dv_y = f64::from(force_y[i]) * half_y;
+                self.right[0][ir] += dv;
+                self.left[0][il] += dv;
+                self.right[1][ir] += dv_y;
+                self.left[1][il] += dv_y;
+                ir = (ir + 1) & self.mask;
+                il = (il + 1) & self.mask;
+            }
+        }
+    }
+
+    /// The horizontal velocity at position `x` (no bow there).
+    #[inline(always)]
+    pub(super) fn velocity_h(&self, x: usize) -> f64 {
+        self.right[0][x.wrapping_sub(self.t) & self.mask]
+            + self.left[0][self.t.wrapping_sub(self.m - 1 - x) & self.mask]
+    }
+
+    /// The `[h, v]` velocity waves arriving at the bridge this sample (after the loss
+    /// filter). Once per sample, before [`Waves::finish_sample`].
+    #[inline(always)]
+    pub(super) fn arriving_at_bridge(&mut self) -> [f64; 2] {
+        let i = self.t.wrapping_sub(self.m - 1) & self.mask;
+        let mut out = [0.0; 2];
+        for (p, out) in out.iter_mut().enumerate() {
+            if !self.asleep[p] {
+                *out = self.loss[p].tick(self.left[p][i]);
+            }
+        }
+        out
+    }
+
+    /// Ends the sample: writes the waves leaving the bridge, reflects at the nut, and
+    /// advances time.
+    #[inline(always)]
+    pub(super) fn finish_sample(&mut self, leaving_bridge: [f64; 2]) {
+        let j = (self.m - 1).wrapping_sub(self.t) & self.mask;
+        let mut at_nut = [0.0; 2];
+        for p in 0..2 {
+            if !self.asleep[p] {
+                at_nut[p] = self.fraction[p].tick(self.right[p][j]);
+            }
+        }
+        let rn = self.nut_reflection;
+        let next = (self.t + 1) & self.mask;
+        let bridge_end = 0usize.wrapping_sub(next) & self.mask;
+        for p in 0..2 {
+            let from_bridge = flush_tiny(leaving_bridge[p]);
+            let from_nut = flush_tiny(rn[p][0] * at_nut[0] + rn[p][1] * at_nut[1]);
+            if self.asleep[p] {
+                // Dropped (the lines stay zero) until the dropped waves add up to the
+                // wake threshold; this sample's waves then go in.
+                self.dropped[p] += from_bridge * from_bridge + from_nut * from_nut;
+                if self.dropped[p] < self.wake_sum {
+                    continue;
+                }
+                self.asleep[p] = false;
+            }
+            self.right[p][bridge_end] = from_bridge;
+            self.left[p][next] = from_nut;
+        }
+        self.t = next;
+    }
+
+    /// Energy of each polarisation's waves and end filters, `[h, v]`, J, on a string of
+    /// impedance `z` at rate `fs`.
+    pub(super) fn energies_j(&self, z: f64, fs: f64) -> [f64; 2] {
+        let mask = self.mask;
+        let mut out = [0.0; 2];
+        for (p, out) in out.iter_mut().enumerate() {
+            if self.asleep[p] {
+                continue;
+            }
+            let mut sum = 0.0;
+            for x in 0..self.m {
+                let a = self.right[p][x.wrapping_sub(self.t) & mask];
+                let b = self.left[p][self.t.wrapping_sub(self.m - 1 - x) & mask];
+                sum += a * a + b * b;
+            }
+            sum += self.loss[p].stored_energy() + self.fraction[p].stored_energy();
+            *out = z / fs * sum;
+        }
+        out
+    }
+
+    /// Puts each polarisation whose waves hold less than `threshold_j / 2` to sleep (see
+    /// [`super::ThermalString::sleep_quiet_polarisations`]).
+    pub(super) fn sleep_quiet(&mut self, threshold_j: f64, z: f64, fs: f64) {
+        let energies = self.energies_j(z, fs);
+        self.wake_sum = 0.5 * threshold_j * fs / z;
+        for (p, energy) in energies.iter().enumerate() {
+            if !self.asleep[p] && *energy < 0.5 * threshold_j {
+                self.right[p].fill(0.0);
+                self.left[p].fill(0.0);
+                self.loss[p].reset();
+                self.fraction[p].reset();
+                self.asleep[p] = true;
+                self.dropped[p] = 0.0;
+            }
+        }
+    }
+
+    /// `[h, v]`: which polarisations sleep.
+    pub(super) fn asleep(&self) -> [bool; 2] {
+        self.asleep
+    }
+
+    /// Both polarisations awake (a landing bow).
+    #[inline(always)]
+    pub(super) fn wake(&mut self) {
+        self.asleep = [false; 2];
+    }
+
+    /// Silence: zero waves and filter states, both polarisations awake.
+    pub(super) fn reset(&mut self) {
+        for p in 0..2 {
+            self.right[p].fill(0.0);
+            self.left[p].fill(0.0);
+            self.loss[p].reset();
+            self.fraction[p].reset();
+        }
+        self.asleep = [false; 2];
+        self.dropped = [0.0; 2];
+    }
+}
