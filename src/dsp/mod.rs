@@ -1,12 +1,14 @@
 //! The DSP core. It never imports the plugin framework: it takes plain settings in SI
 //! units. Parts: friction contacts ([`friction`]), resonators ([`waveguide`]), the body
-//! ([`body`]), the instrument that wires them to notes and a bow ([`instrument`]); paper B's
+//! ([`body`]) on one delay line ([`delay`]), the instrument that wires them to notes and a
+//! bow ([`instrument`]); paper B's
 //! finite-width thermal bow ([`thermal`]) and its four-string instrument at the modal bridge
 //! ([`thermal_instrument`]).
 
 pub mod body;
 pub mod bridge;
 pub mod bridge_data;
+pub mod delay;
 pub mod engine;
 pub mod filters;
 pub mod fingering;

@@ -45,6 +45,7 @@
 //! assert!(out.bridge_force_n.is_finite());
 //! ```
 
+use super::delay::{split_loop, DelayLine};
 use super::filters::{Allpass1, OnePoleLoss};
 use super::friction::{BowInput, FrictionContact, LoadLine};
 use std::f64::consts::PI;
@@ -96,9 +97,15 @@ pub struct StringOutput {
 pub struct WaveguideString {
     spec: StringSpec,
     sample_rate_hz: f64,
-    /// right-going (towards the nut) and left-going waves, indexed by time (see `tick`)
-    right: Vec<f64>,
-    left: Vec<f64>,
+    /// right-going (towards the nut) and left-going waves, indexed by time (see `tick`):
+    /// rings of a power-of-two length, so an index wraps with a mask, not a division
+    right: DelayLine,
+    left: DelayLine,
+    /// `ring length - 1`
+    mask: usize,
+    /// The longest half-loop plus the margins the tuning keeps (what the string was
+    /// allocated for; the ring may be longer)
+    capacity: usize,
     t: usize,
     m: usize,
     bow_index: usize,
@@ -168,11 +175,14 @@ impl WaveguideString {
     /// sample rate. Call from a non-real-time context.
     pub fn new(spec: StringSpec, sample_rate_hz: f64, lowest_hz: f64) -> Self {
         let capacity = (sample_rate_hz / lowest_hz / 2.0).ceil() as usize + 4;
+        let right = DelayLine::new(capacity);
         let mut s = Self {
             spec,
             sample_rate_hz,
-            right: vec![0.0; capacity],
-            left: vec![0.0; capacity],
+            mask: right.mask(),
+            left: DelayLine::new(capacity),
+            right,
+            capacity,
             t: 0,
             m: 2,
             bow_index: 0,
@@ -232,7 +242,7 @@ impl WaveguideString {
         let fs = self.sample_rate_hz;
         self.fundamental_hz = f1_hz;
         let n = fs / f1_hz;
-        let capacity_ok = (n / 2.0) < (self.right.len() - 2) as f64;
+        let capacity_ok = (n / 2.0) < (self.capacity - 2) as f64;
         if !(n >= MIN_LOOP_SAMPLES && capacity_ok) {
             self.playable = false;
             self.reset();
@@ -288,7 +298,7 @@ impl WaveguideString {
             .sum();
         // 2 M + d = remainder, with the Thiran delay d in [0.5, 2.5)
         let remainder = n - self.loss.phase_delay(w1) - dispersion_delay;
-        let m = (((remainder - 0.5) / 2.0).floor() as usize).clamp(2, self.right.len() - 2);
+        let m = split_loop(remainder).0.clamp(2, self.capacity - 2);
         let d = remainder - 2.0 * m as f64;
         if !(0.5..2.5).contains(&d) {
             // Outside the capacity or the filter budget: refuse rather than mistune.
@@ -384,11 +394,11 @@ impl WaveguideString {
     /// bow lifted every sample moves `at_nut^2` into the filters and `reflected^2` out, and
     /// they hold at most the difference, so this total never grows, sample by sample.
     pub fn energy_j(&self) -> f64 {
-        let cap = self.right.len();
+        let mask = self.mask;
         let waves: f64 = (0..self.m)
             .map(|x| {
-                let a = self.right[(self.t + cap - x) % cap];
-                let b = self.left[(self.t + cap - (self.m - 1 - x)) % cap];
+                let a = self.right[self.t.wrapping_sub(x) & mask];
+                let b = self.left[self.t.wrapping_sub(self.m - 1 - x) & mask];
                 a * a + b * b
             })
             .sum();
@@ -411,9 +421,9 @@ impl WaveguideString {
         if !self.playable {
             return StringOutput::default();
         }
-        let cap = self.right.len();
+        let mask = self.mask;
         let m = self.m;
-        let at = |delay: usize| (self.t + cap - delay) % cap;
+        let at = |delay: usize| self.t.wrapping_sub(delay) & mask;
         let z0 = self.spec.z0_kg_per_s;
         let admittance = 0.5 / z0;
 
@@ -441,7 +451,7 @@ impl WaveguideString {
         }
         reflected = -self.loss.tick(reflected);
 
-        self.t = (self.t + 1) % cap;
+        self.t = (self.t + 1) & mask;
         self.right[self.t] = flush(-at_bridge);
         self.left[self.t] = flush(reflected);
 

@@ -51,6 +51,7 @@
 //! | `C_H` | heating per unit frictional power per length | K m/J |
 //! | `F_b` | bow force per unit length | N/m |
 
+use super::delay::split_loop;
 use super::filters::{Allpass1, OnePoleLoss};
 use grid::ThermalGrid;
 use hair::{solve_nodes, sum_lanes, NodeConsts, Nodes};
@@ -415,8 +416,8 @@ fn loop_tuning(
     let g2 = ((-PI * (w2 / w1) / (0.5 * q1)).exp() / t).min(g1);
     let loss = OnePoleLoss::fit(w1, g1, w2, g2);
     let remainder = fs / f0 - loss.phase_delay(w1) - extra_delay;
-    let m = ((remainder - 0.5) / 2.0).floor().max(0.0) as usize;
-    let a = Allpass1::coefficient_for_delay(remainder - 2.0 * m as f64, w1);
+    let (m, d) = split_loop(remainder);
+    let a = Allpass1::coefficient_for_delay(d, w1);
     (loss, m, a)
 }
 
@@ -489,7 +490,7 @@ impl ThermalString {
             return Err(format!("invalid lowest frequency {lowest_hz}"));
         }
         let c = 2.0 * spec.length_m * spec.f0_hz;
-        let ring = ((max_rate_hz / lowest_hz / 2.0).ceil() as usize + 4).next_power_of_two();
+        let ring = (max_rate_hz / lowest_hz / 2.0).ceil() as usize + 4;
         let dx_min = c / max_rate_hz;
         let grid_capacity = max_nodes + 2 * ((thermal.margin_m / dx_min).round() as usize + 1);
         Ok(Self {

@@ -9,14 +9,15 @@
 //! write contiguous slices ([`Waves::gather`], [`Waves::scatter`]).
 
 use super::NodeReal;
+use crate::dsp::delay::DelayLine;
 use crate::dsp::filters::{flush_tiny, Allpass1, OnePoleLoss};
 
 /// Both polarisations' delay lines, end filters and reflections, and their sleep state.
 #[derive(Debug, Clone)]
 pub(super) struct Waves {
     /// Delay lines per polarisation: `[h, v]`, rings of a power-of-two length.
-    right: [Vec<f64>; 2],
-    left: [Vec<f64>; 2],
+    right: [DelayLine; 2],
+    left: [DelayLine; 2],
     mask: usize,
     t: usize,
     /// Samples along the string (bridge at 0, nut at m - 1).
@@ -48,17 +49,17 @@ pub(super) struct Span {
 }
 
 impl Waves {
-    /// Silent lines of `ring` samples (a power of two) with the ends' reflections.
+    /// Silent lines of at least `ring` samples with the ends' reflections.
     pub(super) fn new(
         ring: usize,
         nut_reflection: [[f64; 2]; 2],
         bridge_reflection: [[f64; 2]; 2],
     ) -> Self {
-        debug_assert!(ring.is_power_of_two());
+        let line = DelayLine::new(ring);
         Self {
-            right: [vec![0.0; ring], vec![0.0; ring]],
-            left: [vec![0.0; ring], vec![0.0; ring]],
-            mask: ring - 1,
+            mask: line.mask(),
+            right: [line.clone(), line.clone()],
+            left: [line.clone(), line],
             t: 0,
             m: 0,
             loss: [OnePoleLoss::default(); 2],
