@@ -101,8 +101,6 @@ pub struct WaveguideString {
     /// rings of a power-of-two length, so an index wraps with a mask, not a division
     right: DelayLine,
     left: DelayLine,
-    /// `ring length - 1`
-    mask: usize,
     /// The longest half-loop plus the margins the tuning keeps (what the string was
     /// allocated for; the ring may be longer)
     capacity: usize,
@@ -175,13 +173,11 @@ impl WaveguideString {
     /// sample rate. Call from a non-real-time context.
     pub fn new(spec: StringSpec, sample_rate_hz: f64, lowest_hz: f64) -> Self {
         let capacity = (sample_rate_hz / lowest_hz / 2.0).ceil() as usize + 4;
-        let right = DelayLine::new(capacity);
         let mut s = Self {
             spec,
             sample_rate_hz,
-            mask: right.mask(),
+            right: DelayLine::new(capacity),
             left: DelayLine::new(capacity),
-            right,
             capacity,
             t: 0,
             m: 2,
@@ -394,11 +390,10 @@ impl WaveguideString {
     /// bow lifted every sample moves `at_nut^2` into the filters and `reflected^2` out, and
     /// they hold at most the difference, so this total never grows, sample by sample.
     pub fn energy_j(&self) -> f64 {
-        let mask = self.mask;
         let waves: f64 = (0..self.m)
             .map(|x| {
-                let a = self.right[self.t.wrapping_sub(x) & mask];
-                let b = self.left[self.t.wrapping_sub(self.m - 1 - x) & mask];
+                let a = self.right[self.right.back(self.t, x)];
+                let b = self.left[self.left.back(self.t, self.m - 1 - x)];
                 a * a + b * b
             })
             .sum();
@@ -421,7 +416,7 @@ impl WaveguideString {
         if !self.playable {
             return StringOutput::default();
         }
-        let mask = self.mask;
+        let mask = self.right.mask();
         let m = self.m;
         let at = |delay: usize| self.t.wrapping_sub(delay) & mask;
         let z0 = self.spec.z0_kg_per_s;

@@ -18,7 +18,6 @@ pub(super) struct Waves {
     /// Delay lines per polarisation: `[h, v]`, rings of a power-of-two length.
     right: [DelayLine; 2],
     left: [DelayLine; 2],
-    mask: usize,
     t: usize,
     /// Samples along the string (bridge at 0, nut at m - 1).
     m: usize,
@@ -57,7 +56,6 @@ impl Waves {
     ) -> Self {
         let line = DelayLine::new(ring);
         Self {
-            mask: line.mask(),
             right: [line.clone(), line.clone()],
             left: [line.clone(), line],
             t: 0,
@@ -73,8 +71,9 @@ impl Waves {
     }
 
     /// `ring - 1`: the longest half-loop is a few samples less.
+    #[inline(always)]
     pub(super) fn mask(&self) -> usize {
-        self.mask
+        self.right[0].mask()
     }
 
     /// Samples along the string.
@@ -111,13 +110,13 @@ impl Waves {
     /// The ring positions of `n` nodes from position `start` (samples from the bridge).
     #[inline(always)]
     pub(super) fn span(&self, start: usize, n: usize) -> Span {
-        let right = start.wrapping_sub(self.t) & self.mask;
-        let left = self.t.wrapping_sub(self.m - 1 - start) & self.mask;
+        let right = start.wrapping_sub(self.t) & self.mask();
+        let left = self.left[0].back(self.t, self.m - 1 - start);
         Span {
             right,
             left,
             n,
-            contiguous: right + n <= self.mask + 1 && left + n <= self.mask + 1,
+            contiguous: right + n <= self.mask() + 1 && left + n <= self.mask() + 1,
         }
     }
 
@@ -148,8 +147,8 @@ impl Waves {
             for i in 0..n {
                 vp[i] = (self.right[0][ir] + self.left[0][il]) as NodeReal;
                 vp_y[i] = (self.right[1][ir] + self.left[1][il]) as NodeReal;
-                ir = (ir + 1) & self.mask;
-                il = (il + 1) & self.mask;
+                ir = (ir + 1) & self.mask();
+                il = (il + 1) & self.mask();
             }
         }
     }
@@ -186,8 +185,8 @@ impl Waves {
                 self.left[0][il] += dv;
                 self.right[1][ir] += dv_y;
                 self.left[1][il] += dv_y;
-                ir = (ir + 1) & self.mask;
-                il = (il + 1) & self.mask;
+                ir = (ir + 1) & self.mask();
+                il = (il + 1) & self.mask();
             }
         }
     }
@@ -195,15 +194,15 @@ impl Waves {
     /// The horizontal velocity at position `x` (no bow there).
     #[inline(always)]
     pub(super) fn velocity_h(&self, x: usize) -> f64 {
-        self.right[0][x.wrapping_sub(self.t) & self.mask]
-            + self.left[0][self.t.wrapping_sub(self.m - 1 - x) & self.mask]
+        self.right[0][x.wrapping_sub(self.t) & self.mask()]
+            + self.left[0][self.left[0].back(self.t, self.m - 1 - x)]
     }
 
     /// The `[h, v]` velocity waves arriving at the bridge this sample (after the loss
     /// filter). Once per sample, before [`Waves::finish_sample`].
     #[inline(always)]
     pub(super) fn arriving_at_bridge(&mut self) -> [f64; 2] {
-        let i = self.t.wrapping_sub(self.m - 1) & self.mask;
+        let i = self.left[0].back(self.t, self.m - 1);
         let mut out = [0.0; 2];
         for (p, out) in out.iter_mut().enumerate() {
             if !self.asleep[p] {
@@ -217,7 +216,7 @@ impl Waves {
     /// advances time.
     #[inline(always)]
     pub(super) fn finish_sample(&mut self, leaving_bridge: [f64; 2]) {
-        let j = (self.m - 1).wrapping_sub(self.t) & self.mask;
+        let j = (self.m - 1).wrapping_sub(self.t) & self.mask();
         let mut at_nut = [0.0; 2];
         for p in 0..2 {
             if !self.asleep[p] {
@@ -225,8 +224,8 @@ impl Waves {
             }
         }
         let rn = self.nut_reflection;
-        let next = (self.t + 1) & self.mask;
-        let bridge_end = 0usize.wrapping_sub(next) & self.mask;
+        let next = (self.t + 1) & self.mask();
+        let bridge_end = 0usize.wrapping_sub(next) & self.mask();
         for p in 0..2 {
             let from_bridge = flush_tiny(leaving_bridge[p]);
             let from_nut = flush_tiny(rn[p][0] * at_nut[0] + rn[p][1] * at_nut[1]);
@@ -248,7 +247,7 @@ impl Waves {
     /// Energy of each polarisation's waves and end filters, `[h, v]`, J, on a string of
     /// impedance `z` at rate `fs`.
     pub(super) fn energies_j(&self, z: f64, fs: f64) -> [f64; 2] {
-        let mask = self.mask;
+        let mask = self.mask();
         let mut out = [0.0; 2];
         for (p, out) in out.iter_mut().enumerate() {
             if self.asleep[p] {
@@ -257,7 +256,7 @@ impl Waves {
             let mut sum = 0.0;
             for x in 0..self.m {
                 let a = self.right[p][x.wrapping_sub(self.t) & mask];
-                let b = self.left[p][self.t.wrapping_sub(self.m - 1 - x) & mask];
+                let b = self.left[p][self.left[p].back(self.t, self.m - 1 - x)];
                 sum += a * a + b * b;
             }
             sum += self.loss[p].stored_energy() + self.fraction[p].stored_energy();
