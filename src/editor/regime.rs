@@ -7,7 +7,8 @@
 //!
 //! **How.** A sample slips where the string moves away from the bow:
 //! `|v_s - v_b| > SLIP_FRACTION_OF_BOW * |v_b|`. A slip starts where a sticking sample is
-//! followed by a slipping one. Motion is periodic with `n` slips per period when, for every
+//! followed by a slipping one, and counts if the run of slipping samples reaches
+//! `SLIP_PEAK_OF_BOW * |v_b|` (shallower runs are ripples, not slips). Motion is periodic with `n` slips per period when, for every
 //! slip onset `t_i`, the onset `n` slips later, `t_(i+n)`, comes one period later: all the
 //! spans `t_(i+n) - t_i` agree to [`PERIOD_JITTER`] and their median lies within
 //! [`PERIOD_RANGE`] of the note's period. The smallest such `n` is the number of slips per
@@ -43,6 +44,12 @@ use crate::dsp::instrument::INTERNAL_RATE_HZ;
 /// the bristle laws and the thermal bow's compliant hair; a Helmholtz slip moves the string
 /// at `v_b / beta >= 2 v_b` against the bow. Half the bow velocity lies between the two.
 pub const SLIP_FRACTION_OF_BOW: f32 = 0.5;
+/// A run of slipping samples counts as a slip only if its relative velocity reaches this
+/// multiple of the bow velocity somewhere. A Helmholtz slip reaches `v_b (1 - beta) / beta`,
+/// 9 `v_b` at beta 0.1; a finite-width bow's precursor (the string dipping for a few
+/// samples while the corner crosses the bow, paper B's partial slipping) and a bristle
+/// law's creep stay below `v_b`.
+pub const SLIP_PEAK_OF_BOW: f32 = 1.0;
 /// Velocities below this count as rest, m/s: 60 dB below the ~1 m/s slip of a default
 /// note, and above the ripple the model leaves on a resting string.
 pub const MOTION_FLOOR_M_PER_S: f32 = 1e-3;
@@ -115,12 +122,29 @@ pub fn classify_regime(samples: &[ContactSample], sample_rate: f32, f0_hz: f32) 
     if samples.iter().all(slipping) {
         return Some(Regime::Sliding);
     }
-    let onsets: Vec<usize> = samples
-        .windows(2)
-        .enumerate()
-        .filter(|(_, w)| !slipping(&w[0]) && slipping(&w[1]))
-        .map(|(i, _)| i + 1)
-        .collect();
+    // A slip is a run of slipping samples whose relative velocity reaches
+    // SLIP_PEAK_OF_BOW times the bow's somewhere; shallower runs are ripples.
+    let deep = |s: &ContactSample| {
+        s.relative_velocity.abs() > (SLIP_PEAK_OF_BOW * bow(s).abs()).max(MOTION_FLOOR_M_PER_S)
+    };
+    // The run under way: where it started (None before the first sticking sample: a slip
+    // already under way at the window's start has no onset) and whether it went deep.
+    let mut onsets: Vec<usize> = Vec::new();
+    let mut run: Option<(Option<usize>, bool)> = Some((None, false));
+    for (i, s) in samples.iter().enumerate() {
+        run = match (run, slipping(s)) {
+            (None, true) => Some((Some(i), deep(s))),
+            (Some((start, reached)), true) => Some((start, reached || deep(s))),
+            (Some((Some(start), true)), false) => {
+                onsets.push(start);
+                None
+            }
+            (_, false) => None,
+        };
+    }
+    if let Some((Some(start), true)) = run {
+        onsets.push(start);
+    }
     Some(
         (1..=MAX_SLIPS_PER_PERIOD)
             .find(|&n| repeats_every_period(&onsets, n, period, sample_rate))

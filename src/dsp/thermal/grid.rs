@@ -1,5 +1,7 @@
 //! Paper B's thermal grid (eq. 1): the temperature of the string under and around the
-//! bow, `dT/dt = alpha d2T/dx2 - C_C T |v_D| + C_H |f v_D|`, by forward Euler in time and
+//! bow, `dT/dt = alpha d2T/dx2 - C_C T |v_D| + C_H |f v_D|`, here with two terms paper B
+//! does not have (both off when their parameters are zero, see [`ThermalParams`]): a bulk
+//! cooling `- T / tau_b` and the heating referred to a reference load. By forward Euler in time and
 //! centred differences in space (FTCS), on nodes `dx` apart covering the bow plus a margin
 //! each side, `T = 0` beyond. Stable only if `alpha dt / dx^2 < 1/2` (eq. 2): the
 //! configuration sub-steps the update (`ceil(r / 0.45)` steps of `dt / n`), so it never
@@ -32,6 +34,12 @@ pub(super) struct ThermalGrid {
     /// FTCS sub-steps per sample.
     substeps: usize,
     consts: FtcsConsts,
+    /// The heating constant at paper B's eq. (1) as written, before the load scaling.
+    heat_per_load: NodeReal,
+    /// Heating referred to this load per metre, N/m (0: heating by the load).
+    reference_load: f64,
+    /// The load the current heating constant was scaled for, N/m.
+    load: f64,
 }
 
 impl ThermalGrid {
@@ -43,6 +51,9 @@ impl ThermalGrid {
             margin: 0,
             substeps: 1,
             consts: FtcsConsts::default(),
+            heat_per_load: 0.0,
+            reference_load: 0.0,
+            load: 0.0,
         }
     }
 
@@ -78,12 +89,34 @@ impl ThermalGrid {
     pub(super) fn set_constants(&mut self, p: &ThermalParams, dx: f64, fs: f64) {
         let h = 1.0 / fs / self.substeps as f64;
         let r = p.diffusivity_m2_per_s * h / (dx * dx);
+        // The bulk loss's exact decay over one sub-step, capped so that no grid point
+        // takes a negative weight of its old temperature (see [`FtcsConsts`]).
+        let bulk = (-(-h * p.bulk_cooling_per_s).exp_m1()).min((1.0 - 2.0 * r).max(0.0));
+        self.heat_per_load = (h * p.c_h_kelvin_m_per_j / dx) as NodeReal;
+        self.reference_load = p.heating_reference_load_n_per_m;
+        self.load = 0.0;
         self.consts = FtcsConsts {
             r: r as NodeReal,
-            heat: (h * p.c_h_kelvin_m_per_j / dx) as NodeReal,
+            heat: self.heat_per_load,
             cool: (h * p.c_c_per_m) as NodeReal,
-            max_cool: (1.0 - 2.0 * r).max(0.0) as NodeReal,
+            bulk: bulk as NodeReal,
+            max_cool: (1.0 - 2.0 * r - bulk).max(0.0) as NodeReal,
         };
+    }
+
+    /// Refers the heating to the bow's load per metre `load` (N/m, positive), when the
+    /// parameters ask for it ([`ThermalParams::heating_reference_load_n_per_m`]): the
+    /// source becomes `C_H (p_ref / p) |f v_D|`, so the heat per unit of real contact
+    /// area does not grow with the load. The ratio is capped at [`MAX_LOAD_RATIO`] so a
+    /// bow barely touching cannot scale the constant out of range. Divides only when the
+    /// load changes.
+    #[inline(always)]
+    pub(super) fn set_load(&mut self, load: f64) {
+        if self.reference_load > 0.0 && load != self.load {
+            self.load = load;
+            let ratio = (self.reference_load / load).min(MAX_LOAD_RATIO);
+            self.consts.heat = (f64::from(self.heat_per_load) * ratio) as NodeReal;
+        }
     }
 
     /// The whole grid, K above ambient.
@@ -145,13 +178,19 @@ impl ThermalGrid {
     }
 }
 
+/// Largest factor by which [`ThermalGrid::set_load`] raises the heating (a load 1000
+/// times below the reference: 0.3 N/m, 3 mN over a 1 cm bow, where friction is nothing).
+pub(super) const MAX_LOAD_RATIO: f64 = 1000.0;
+
 /// The per-sub-step constants of eq. (1) (set with the configuration): the FTCS ratio
-/// `r = alpha h / dx^2`, the heating `h C_H / dx` and the cooling `h C_C`, `h` the sub-step.
+/// `r = alpha h / dx^2`, the heating `h C_H / dx`, the cooling `h C_C` and the bulk
+/// cooling `h / tau_b`, `h` the sub-step.
 ///
-/// The convective loss `h C_C |v| T` is explicit: once `h C_C |v|` passes `1 - 2 r`, a
-/// node's new temperature would take a negative weight of its old one (it would lose more
-/// heat than it holds, and beyond 2 the loss grows without bound: fast slips on a coarse
-/// grid, a few m/s at N_B 1). The loss factor is therefore capped at `max_cool = 1 - 2 r`,
+/// The losses `h C_C |v| T` and `h T / tau_b` are explicit: once `h C_C |v| + h / tau_b`
+/// passes `1 - 2 r`, a node's new temperature would take a negative weight of its old one
+/// (it would lose more heat than it holds, and beyond 2 the loss grows without bound: fast
+/// slips on a coarse grid, a few m/s at N_B 1). The convective factor is therefore capped
+/// at `max_cool = 1 - 2 r - h / tau_b`,
 /// which keeps every weight of the update non-negative and their sum at most 1: the grid
 /// obeys the maximum principle (never below ambient, never above what the heating put
 /// in) at any slip velocity. Below the cap, which is every sample of ordinary playing,
@@ -161,6 +200,7 @@ pub(super) struct FtcsConsts {
     pub(super) r: NodeReal,
     pub(super) heat: NodeReal,
     pub(super) cool: NodeReal,
+    pub(super) bulk: NodeReal,
     pub(super) max_cool: NodeReal,
 }
 
@@ -189,20 +229,21 @@ fn ftcs_step(
         r,
         heat,
         cool,
+        bulk,
         max_cool,
     } = k;
     let n = t.len();
     let next = &mut next[..n];
     if n == 1 {
-        next[0] = flush_tiny_node(t[0] * (1.0 - 2.0 * r));
+        next[0] = flush_tiny_node(t[0] * (1.0 - 2.0 * r) - bulk * t[0]);
     } else {
-        next[0] = flush_tiny_node(t[0] + r * (t[1] - 2.0 * t[0]));
+        next[0] = flush_tiny_node(t[0] + r * (t[1] - 2.0 * t[0]) - bulk * t[0]);
         // Tiny values are flushed to zero inside the loop (a select, which vectorises),
         // so no later step computes with subnormals.
         for (out, w) in next[1..n - 1].iter_mut().zip(t.windows(3)) {
-            *out = flush_tiny_node(w[1] + r * (w[0] - 2.0 * w[1] + w[2]));
+            *out = flush_tiny_node(w[1] + r * (w[0] - 2.0 * w[1] + w[2]) - bulk * w[1]);
         }
-        next[n - 1] = flush_tiny_node(t[n - 1] + r * (t[n - 2] - 2.0 * t[n - 1]));
+        next[n - 1] = flush_tiny_node(t[n - 1] + r * (t[n - 2] - 2.0 * t[n - 1]) - bulk * t[n - 1]);
     }
     let n_b = vd.len();
     let bow = &mut next[off..off + n_b];
@@ -226,6 +267,7 @@ mod tests {
             r: 0.2,
             heat: 0.0,
             cool: 0.5,
+            bulk: 0.0,
             max_cool: 0.6,
         };
         let t = [0.0, 10.0, 10.0, 10.0, 0.0];
