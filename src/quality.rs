@@ -17,9 +17,9 @@
 //!
 //! | preset | Newton tolerance | thermal N_B | measured (docs/precision.md) |
 //! |---|---|---|---|
-//! | draft | 1e-2 m/s | 6 | cello D, elasto-plastic: attack waveform -10 dB against 1e-13, 1.7x faster than 1e-10; thermal Fig. 6 bow at beta 0.1: f0 -0.11 cents, harmonics 0.8 dB, attack -13 dB, 52x real time |
-//! | good | 1e-4 m/s | 10 | -49 dB (elasto-plastic), -84 dB (LuGre); thermal: f0 -0.19 cents, harmonics 0.4 dB, attack -11 dB, 32x |
-//! | reference | 1e-10 m/s | 60 | below -260 dB; thermal: f0 +0.02 cents, harmonics 0.2 dB, attack -12 dB, 6.2x |
+//! | draft | 1e-2 m/s | 6 | cello D, elasto-plastic: attack waveform -10 dB against 1e-13, 1.7x faster than 1e-10; thermal Fig. 6 bow at beta 0.1: f0 +0.29 cents, harmonics 2.9 dB, attack -16 dB, 41x real time |
+//! | good | 1e-4 m/s | 10 | -49 dB (elasto-plastic), -84 dB (LuGre); thermal: f0 +0.03 cents, harmonics 0.3 dB, attack -17 dB, 27x |
+//! | reference | 1e-10 m/s | 60 | below -260 dB; thermal: f0 +0.01 cents, harmonics 0.3 dB, attack -35 dB, 5.1x |
 //! | auto | 1e-4 m/s | per note: [`auto_nodes`] | good's error at every note and bow position |
 //!
 //! `auto` keeps good's error target where the error grows: a slip lasts `beta / f0`

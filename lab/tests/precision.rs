@@ -21,22 +21,9 @@ fn quick() -> &'static (Plan, Report) {
     })
 }
 
-/// Paper B's string refines space and time together with its node count. Its attack
-/// takes most of a second to settle since the bulk cooling came in (the quick plan's one
-/// second leaves N_B 12 no nearer N_B 24 than N_B 6 is, in pitch or waveform), so this
-/// renders the quick plan's thermal scenario for 3 s, the full plan's length, and
-/// measures the steady second half. Measured there: the harmonics' error falls from N_B
-/// 6 to 12 (1.02 to 0.83 dB); the pitch is within 0.1 cents of the reference at both
-/// (0.035 and 0.095 cents), so it does not order them; the attack's waveform does not
-/// converge at these counts (0.18 and 0.44 of the reference's RMS: the landing bow picks
-/// between nearby slip patterns), which docs/precision.md reports.
 #[test]
-fn thermal_steady_errors_fall_as_the_node_count_doubles() {
-    let mut plan = Plan::quick();
-    plan.groups.retain(|g| g.model == "thermal");
-    plan.seconds = 3.0;
-    plan.timing_runs = 1;
-    let report = compute(&plan, |_| {}).expect("the thermal scenario renders");
+fn thermal_errors_fall_as_the_node_count_doubles() {
+    let (_, report) = quick();
     let series: Vec<_> = report
         .convergence
         .iter()
@@ -44,22 +31,9 @@ fn thermal_steady_errors_fall_as_the_node_count_doubles() {
         .collect();
     // N_B 6, 12 and the N_B 24 reference.
     assert_eq!(series.len(), 3);
-    let f0 = |k: usize| series[k].errors.f0_cents.unwrap().abs();
-    let harmonics = |k: usize| series[k].errors.harmonics_db.unwrap();
     let wave = |k: usize| series[k].errors.waveform_relative.unwrap();
-    println!(
-        "N_B 6 -> 12: pitch {:.3} -> {:.3} cents, harmonics {:.2} -> {:.2} dB, attack waveform {:.2e} -> {:.2e}",
-        f0(0),
-        f0(1),
-        harmonics(0),
-        harmonics(1),
-        wave(0),
-        wave(1)
-    );
-    assert!(harmonics(1) < harmonics(0));
-    // Half a cent: a tenth of the smallest pitch difference heard on sustained tones
-    // (about 5 cents), and five times what both counts measure today.
-    assert!(f0(0) < 0.5 && f0(1) < 0.5);
+    println!("thermal waveform error {:.2e} -> {:.2e}", wave(0), wave(1));
+    assert!(wave(1) < wave(0));
 }
 
 #[test]
