@@ -158,6 +158,32 @@ impl ThermalParams {
         self.mu_cold + (self.mu_hot - self.mu_cold) * u
     }
 
+    /// The temperature at which a contact sliding steadily at `speed` (m/s) under a
+    /// friction force of `friction_per_m` (N per metre of bow) on a load of `load_per_m`
+    /// (N/m) loses heat as fast as it gains it, K above ambient (eq. 1 without
+    /// diffusion): `C_H' |f| v / (C_C v + 1 / tau_b)`, with `C_H' = C_H p_ref / p` when the
+    /// heating is referred to a load. Below it a sliding node warms, unless diffusion
+    /// carries more away. Paper B's constants: `C_H |f| / C_C` at every speed.
+    pub fn sliding_equilibrium_kelvin(
+        &self,
+        friction_per_m: f64,
+        load_per_m: f64,
+        speed: f64,
+    ) -> f64 {
+        let heating = if self.heating_reference_load_n_per_m > 0.0 && load_per_m > 0.0 {
+            self.c_h_kelvin_m_per_j * self.heating_reference_load_n_per_m / load_per_m
+        } else {
+            self.c_h_kelvin_m_per_j
+        };
+        let v = speed.abs();
+        let loss = self.c_c_per_m * v + self.bulk_cooling_per_s;
+        if loss > 0.0 {
+            heating * friction_per_m.abs() * v / loss
+        } else {
+            f64::INFINITY
+        }
+    }
+
     pub fn validate(&self) -> Result<(), String> {
         let all = [
             self.mu_cold,
