@@ -603,13 +603,18 @@ pub fn summary(plan: &Plan, results: &[(Cell, Measured)]) -> String {
             let sh = Shares::of(results, model, rate);
             let _ = writeln!(
                 s,
-                "| {} | {} | {:.0} % ({}/{}) | {:+.1} | {:.0} % ({}/{}) | {:.0} % ({}/{}) |",
+                "| {} | {} | {:.0} % ({}/{}) | {} | {:.0} % ({}/{}) | {:.0} % ({}/{}) |",
                 model.name(),
                 rate / 1000.0,
                 percent(sh.nominal_in_tune, sh.nominal_cells),
                 sh.nominal_in_tune,
                 sh.nominal_cells,
-                sh.nominal_median_cents,
+                // No nominal cell in Helmholtz motion: no median.
+                if sh.nominal_median_cents.is_finite() {
+                    format!("{:+.1}", sh.nominal_median_cents)
+                } else {
+                    "-".into()
+                },
                 percent(sh.window_in_tune, sh.window_cells),
                 sh.window_in_tune,
                 sh.window_cells,
