@@ -458,15 +458,11 @@ mod tests {
         // Stick-slip: over 0.2 s (29 periods) every node spends part of the time in each.
         assert!(slip.iter().all(|f| *f > 0.0 && *f < 1.0), "{slip:?}");
         // Friction warms the bow, but less than continuous sliding would: its equilibrium
-        // is C_H mu p v / (C_C v + 1 / tau_b) < C_H mu p / C_C (thermal module), with mu
-        // at most mu_cold and p the reference load (heating per contact area).
+        // (ThermalParams::sliding_equilibrium_kelvin) with mu at most mu_cold, at a speed
+        // (1 km/s) above any slip, where it is highest.
         let th = ThermalParams::default();
-        let load = if th.heating_reference_load_n_per_m > 0.0 {
-            th.heating_reference_load_n_per_m
-        } else {
-            bow.force_n / settings.width_m
-        };
-        let sliding_eq = th.c_h_kelvin_m_per_j * th.mu_cold * load / th.c_c_per_m;
+        let load = bow.force_n / settings.width_m;
+        let sliding_eq = th.sliding_equilibrium_kelvin(th.mu_cold * load, load, 1e3);
         assert!(
             temperature
                 .iter()

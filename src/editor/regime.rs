@@ -8,8 +8,9 @@
 //! **How.** A sample slips where the string moves away from the bow:
 //! `|v_s - v_b| > SLIP_FRACTION_OF_BOW * |v_b|`. A slip starts where a sticking sample is
 //! followed by a slipping one, and counts if the run of slipping samples reaches
-//! `SLIP_PEAK_OF_BOW * |v_b|` (shallower runs are ripples, not slips). Motion is periodic with `n` slips per period when, for every
-//! slip onset `t_i`, the onset `n` slips later, `t_(i+n)`, comes one period later: all the
+//! `SLIP_PEAK_OF_BOW * |v_b|` (shallower runs are ripples, not slips). Motion is
+//! periodic with `n` slips per period when, for every slip onset `t_i`, the onset `n`
+//! slips later, `t_(i+n)`, comes one period later: all the
 //! spans `t_(i+n) - t_i` agree to [`PERIOD_JITTER`] and their median lies within
 //! [`PERIOD_RANGE`] of the note's period. The smallest such `n` is the number of slips per
 //! period (1: Raman's Helmholtz motion); if none fits, the slips are irregular: raucous.
@@ -127,24 +128,13 @@ pub fn classify_regime(samples: &[ContactSample], sample_rate: f32, f0_hz: f32) 
     let deep = |s: &ContactSample| {
         s.relative_velocity.abs() > (SLIP_PEAK_OF_BOW * bow(s).abs()).max(MOTION_FLOOR_M_PER_S)
     };
-    // The run under way: where it started (None before the first sticking sample: a slip
-    // already under way at the window's start has no onset) and whether it went deep.
-    let mut onsets: Vec<usize> = Vec::new();
-    let mut run: Option<(Option<usize>, bool)> = Some((None, false));
-    for (i, s) in samples.iter().enumerate() {
-        run = match (run, slipping(s)) {
-            (None, true) => Some((Some(i), deep(s))),
-            (Some((start, reached)), true) => Some((start, reached || deep(s))),
-            (Some((Some(start), true)), false) => {
-                onsets.push(start);
-                None
-            }
-            (_, false) => None,
-        };
-    }
-    if let Some((Some(start), true)) = run {
-        onsets.push(start);
-    }
+    let onsets: Vec<usize> = samples
+        .windows(2)
+        .enumerate()
+        .filter(|(_, w)| !slipping(&w[0]) && slipping(&w[1]))
+        .map(|(i, _)| i + 1)
+        .filter(|&i| samples[i..].iter().take_while(|s| slipping(s)).any(deep))
+        .collect();
     Some(
         (1..=MAX_SLIPS_PER_PERIOD)
             .find(|&n| repeats_every_period(&onsets, n, period, sample_rate))

@@ -1,8 +1,9 @@
 //! Paper B's thermal grid (eq. 1): the temperature of the string under and around the
 //! bow, `dT/dt = alpha d2T/dx2 - C_C T |v_D| + C_H |f v_D|`, here with two terms paper B
-//! does not have (both off when their parameters are zero, see [`ThermalParams`]): a bulk
-//! cooling `- T / tau_b` and the heating referred to a reference load. By forward Euler in time and
-//! centred differences in space (FTCS), on nodes `dx` apart covering the bow plus a margin
+//! does not have (both off when their parameters are zero, see [`ThermalParams`]): a
+//! bulk cooling `- T / tau_b` and the heating referred to a reference load. By forward
+//! Euler in time and centred differences in space (FTCS), on nodes `dx` apart covering
+//! the bow plus a margin
 //! each side, `T = 0` beyond. Stable only if `alpha dt / dx^2 < 1/2` (eq. 2): the
 //! configuration sub-steps the update (`ceil(r / 0.45)` steps of `dt / n`), so it never
 //! runs unstable.
@@ -36,8 +37,8 @@ pub(super) struct ThermalGrid {
     consts: FtcsConsts,
     /// The heating constant at paper B's eq. (1) as written, before the load scaling.
     heat_per_load: NodeReal,
-    /// Heating referred to this load per metre, N/m (0: heating by the load).
-    reference_load: f64,
+    /// Whether the heating is referred to a load (see [`ThermalParams::heating_scale`]).
+    scales_with_load: bool,
     /// The load the current heating constant was scaled for, N/m.
     load: f64,
 }
@@ -52,7 +53,7 @@ impl ThermalGrid {
             substeps: 1,
             consts: FtcsConsts::default(),
             heat_per_load: 0.0,
-            reference_load: 0.0,
+            scales_with_load: false,
             load: 0.0,
         }
     }
@@ -93,7 +94,7 @@ impl ThermalGrid {
         // takes a negative weight of its old temperature (see [`FtcsConsts`]).
         let bulk = (-(-h * p.bulk_cooling_per_s).exp_m1()).min((1.0 - 2.0 * r).max(0.0));
         self.heat_per_load = (h * p.c_h_kelvin_m_per_j / dx) as NodeReal;
-        self.reference_load = p.heating_reference_load_n_per_m;
+        self.scales_with_load = p.heating_reference_load_n_per_m > 0.0;
         self.load = 0.0;
         self.consts = FtcsConsts {
             r: r as NodeReal,
@@ -104,18 +105,15 @@ impl ThermalGrid {
         };
     }
 
-    /// Refers the heating to the bow's load per metre `load` (N/m, positive), when the
-    /// parameters ask for it ([`ThermalParams::heating_reference_load_n_per_m`]): the
-    /// source becomes `C_H (p_ref / p) |f v_D|`, so the heat per unit of real contact
-    /// area does not grow with the load. The ratio is capped at [`MAX_LOAD_RATIO`] so a
-    /// bow barely touching cannot scale the constant out of range. Divides only when the
-    /// load changes.
+    /// Refers the heating to the bow's load per metre `load` (N/m, positive) when the
+    /// parameters ask for it: the heating constant times [`ThermalParams::heating_scale`],
+    /// so the heat per unit of real contact area does not grow with the load. Divides only
+    /// when the load changes; a compare when the heating is not referred to a load.
     #[inline(always)]
-    pub(super) fn set_load(&mut self, load: f64) {
-        if self.reference_load > 0.0 && load != self.load {
+    pub(super) fn set_load(&mut self, p: &ThermalParams, load: f64) {
+        if self.scales_with_load && load != self.load {
             self.load = load;
-            let ratio = (self.reference_load / load).min(MAX_LOAD_RATIO);
-            self.consts.heat = (f64::from(self.heat_per_load) * ratio) as NodeReal;
+            self.consts.heat = (f64::from(self.heat_per_load) * p.heating_scale(load)) as NodeReal;
         }
     }
 
@@ -177,10 +175,6 @@ impl ThermalGrid {
         }
     }
 }
-
-/// Largest factor by which [`ThermalGrid::set_load`] raises the heating (a load 1000
-/// times below the reference: 0.3 N/m, 3 mN over a 1 cm bow, where friction is nothing).
-pub(super) const MAX_LOAD_RATIO: f64 = 1000.0;
 
 /// The per-sub-step constants of eq. (1) (set with the configuration): the FTCS ratio
 /// `r = alpha h / dx^2`, the heating `h C_H / dx`, the cooling `h C_C` and the bulk

@@ -77,6 +77,11 @@ pub const MIN_BOW_NODES: usize = 1;
 /// Samples of string the bow leaves free: one at the bridge, the rest toward the nut.
 pub const BOW_CLEARANCE: usize = 4;
 
+/// Largest factor by which [`ThermalParams::heating_scale`] raises the heating (a load
+/// 1000 times below the reference: 0.3 N/m, 3 mN over a 1 cm bow, where friction is
+/// nothing).
+pub const MAX_LOAD_RATIO: f64 = 1000.0;
+
 /// Temperature-dependent friction and heat (see the module doc).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ThermalParams {
@@ -170,17 +175,27 @@ impl ThermalParams {
         load_per_m: f64,
         speed: f64,
     ) -> f64 {
-        let heating = if self.heating_reference_load_n_per_m > 0.0 && load_per_m > 0.0 {
-            self.c_h_kelvin_m_per_j * self.heating_reference_load_n_per_m / load_per_m
-        } else {
-            self.c_h_kelvin_m_per_j
-        };
+        let heating = self.c_h_kelvin_m_per_j * self.heating_scale(load_per_m);
         let v = speed.abs();
         let loss = self.c_c_per_m * v + self.bulk_cooling_per_s;
         if loss > 0.0 {
             heating * friction_per_m.abs() * v / loss
         } else {
             f64::INFINITY
+        }
+    }
+
+    /// What the heating `C_H` is multiplied by at a load of `load_per_m` (N/m): 1 as
+    /// paper B writes eq. (1), or `p_ref / p` when the heating is referred to a load
+    /// ([`ThermalParams::heating_reference_load_n_per_m`]), capped at
+    /// [`MAX_LOAD_RATIO`] so a bow barely touching cannot scale it out of range.
+    #[inline]
+    pub fn heating_scale(&self, load_per_m: f64) -> f64 {
+        let p_ref = self.heating_reference_load_n_per_m;
+        if p_ref > 0.0 && load_per_m > 0.0 {
+            (p_ref / load_per_m).min(MAX_LOAD_RATIO)
+        } else {
+            1.0
         }
     }
 
@@ -939,7 +954,8 @@ impl ThermalString {
         if on {
             // A landing bow wakes the string (its sleeping lines hold zeros).
             self.waves.wake();
-            self.grid.set_load(bow.force_per_m * self.narrowing);
+            self.grid
+                .set_load(&self.thermal, bow.force_per_m * self.narrowing);
         }
         let mut frame = ThermalFrame::default();
         let mid = n_b / 2;
