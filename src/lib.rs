@@ -234,17 +234,16 @@ impl Plugin for Colophony {
                 self.handle_event(event);
                 next_event = context.next_event();
             }
+            // Up to the next event nothing lands: one run.
+            let end = next_event.map_or(samples, |e| {
+                (e.timing() as usize).clamp(sample + 1, samples)
+            });
             if !live && self.settled() {
-                // Up to the next event the bow and gain hold: one run.
-                let end = next_event.map_or(samples, |e| {
-                    (e.timing() as usize).clamp(sample + 1, samples)
-                });
                 self.play_run(channels, sample, end);
-                sample = end;
             } else {
-                self.play_sample(channels, sample, live);
-                sample += 1;
+                self.play_moving(channels, sample, end, live);
             }
+            sample = end;
         }
         // Events at or after the block's end (none should be) are still applied.
         while let Some(event) = next_event {
@@ -268,21 +267,10 @@ impl Colophony {
             || p.gain.smoothed.is_smoothing())
     }
 
-    /// The next sample's bow and output gain from the (smoothed) parameters.
-    fn next_controls(&self) -> (BowControl, f64) {
-        let p = &self.params;
-        let bow = BowControl {
-            velocity_m_per_s: p.bow_velocity.smoothed.next() as f64,
-            force_n: p.bow_force.smoothed.next() as f64,
-            position_beta: p.bow_position.smoothed.next() as f64,
-        };
-        (bow, util::db_to_gain(p.gain.smoothed.next()) as f64)
-    }
-
     /// Samples `from..to` with the parameters settled and no event between: the performer
     /// renders them as a block ([`Performer::tick_block`]), the same samples as ticking.
     fn play_run(&mut self, channels: &mut [&mut [f32]], from: usize, to: usize) {
-        let (bow, gain) = self.next_controls();
+        let (bow, gain) = next_controls(&self.params);
         let mut chunk = [0.0f64; 64];
         let mut at = from;
         while at < to {
@@ -295,24 +283,47 @@ impl Colophony {
         }
     }
 
-    /// One sample, feeding the editor's live views while they listen.
-    fn play_sample(&mut self, channels: &mut [&mut [f32]], sample: usize, live: bool) {
-        let (bow, gain) = self.next_controls();
-        let frame = self.performer.tick(bow);
-        if live {
-            let played = self.performer.bow();
-            let contact = editor::live::ContactSample::new(&frame, &played);
-            self.editor_link.scope.push(contact);
-            if let Some(string) = self.performer.probed_thermal_string() {
-                self.node_probe.add_from(
-                    string.node_temperatures(),
-                    string.slipping(),
-                    &self.editor_link,
-                );
-            }
-        }
-        write_frame(channels, sample, frame.audio * gain);
+    /// Samples `from..to` with no event between while a parameter smooths or the editor's
+    /// live views listen: the bow moves sample by sample ([`Performer::tick_run`]), and
+    /// the live views get every sample.
+    fn play_moving(&mut self, channels: &mut [&mut [f32]], from: usize, to: usize, live: bool) {
+        let Self {
+            params,
+            performer,
+            editor_link,
+            node_probe,
+            ..
+        } = self;
+        performer.tick_run(
+            to - from,
+            || next_controls(params),
+            |k, gain, frame, played, performer| {
+                if live {
+                    let contact = editor::live::ContactSample::new(frame, played);
+                    editor_link.scope.push(contact);
+                    if let Some(string) = performer.probed_thermal_string() {
+                        node_probe.add_from(
+                            string.node_temperatures(),
+                            string.slipping(),
+                            editor_link,
+                        );
+                    }
+                }
+                write_frame(channels, from + k, frame.audio * gain);
+            },
+        );
     }
+}
+
+/// The next sample's bow and output gain from the (smoothed) parameters.
+#[inline]
+fn next_controls(p: &ColophonyParams) -> (BowControl, f64) {
+    let bow = BowControl {
+        velocity_m_per_s: p.bow_velocity.smoothed.next() as f64,
+        force_n: p.bow_force.smoothed.next() as f64,
+        position_beta: p.bow_position.smoothed.next() as f64,
+    };
+    (bow, util::db_to_gain(p.gain.smoothed.next()) as f64)
 }
 
 /// One output sample on every channel: subnormals flushed, the safety limiter applied.

@@ -1089,6 +1089,62 @@ impl Performer {
         }
     }
 
+    /// `n` samples with no event between, the bow given sample by sample by `next` (a
+    /// host's smoothed parameters) with a value `C` of the caller's riding along (its
+    /// gain, say); `sink(k, c, frame, played, self)` takes sample `k` with the bow as
+    /// played. The same samples as `n` calls of [`Performer::tick`], but once the gesture
+    /// is steady and only the waveguide strings sound (which no sample of an event-free run
+    /// can change), the rest of the run loops over the strings alone with the checks
+    /// hoisted: the performance layer's per-sample work is then the two or three factors
+    /// on the bow (issue 18's cost budget, for the plugin's per-sample path: automation
+    /// moving, or a live view open).
+    #[inline]
+    pub fn tick_run<C>(
+        &mut self,
+        n: usize,
+        mut next: impl FnMut() -> (BowControl, C),
+        mut sink: impl FnMut(usize, C, &Frame, &BowControl, &Self),
+    ) {
+        let mut k = 0;
+        while k < n {
+            if !self.others_awake {
+                if let Some((v, f, away)) = self.steady {
+                    let mut played = self.bow_now;
+                    if away == 1.0 {
+                        for k in k..n {
+                            let (bow, c) = next();
+                            played = BowControl {
+                                velocity_m_per_s: bow.velocity_m_per_s * v,
+                                force_n: bow.force_n * f,
+                                ..bow
+                            };
+                            let frame = self.instrument.tick(played);
+                            sink(k, c, &frame, &played, self);
+                        }
+                    } else {
+                        for k in k..n {
+                            let (bow, c) = next();
+                            played = BowControl {
+                                velocity_m_per_s: bow.velocity_m_per_s * v,
+                                force_n: bow.force_n * f,
+                                position_beta: (bow.position_beta * away)
+                                    .clamp(MIN_NOTE_BETA, MAX_NOTE_BETA),
+                            };
+                            let frame = self.instrument.tick(played);
+                            sink(k, c, &frame, &played, self);
+                        }
+                    }
+                    self.bow_now = played;
+                    return;
+                }
+            }
+            let (bow, c) = next();
+            let frame = self.tick_general(bow);
+            sink(k, c, &frame, &self.bow_now, self);
+            k += 1;
+        }
+    }
+
     /// The waveguide strings (for tools and tests: energy, solver statistics, and the
     /// renderer's bristle, torsion and intonation settings).
     pub fn strings(&self) -> &Instrument {
@@ -1759,6 +1815,82 @@ mod tests {
                 at += n;
             }
             assert_eq!(got, want, "blocks of {block}");
+        }
+    }
+
+    #[test]
+    fn a_run_with_the_bow_moving_gives_the_same_frames_as_ticking_it() {
+        // As the plugin while automation moves: the bow changes every sample (a slow
+        // force and position sweep, so the gesture's position factor is not 1 after the
+        // ff controller), through an attack, a controller, a second note, a rubbed source
+        // ringing on after a switch, with runs of every size from 1 to 700.
+        let bow_at = |at: usize| {
+            let t = at as f64 / FS;
+            BowControl {
+                velocity_m_per_s: 0.1 + 0.02 * (3.0 * t).sin(),
+                force_n: 0.8 + 0.3 * (2.0 * t).sin(),
+                position_beta: 0.1 + 0.02 * (5.0 * t).sin(),
+            }
+        };
+        let events = |p: &mut Performer, at: usize| match at {
+            0 => p.note_on(50, 0.8),
+            20_000 => p.set_controller(11, 1.0),
+            30_000 => p.note_on(57, 0.4),
+            35_000 => p.configure(&Setup {
+                rubbed: Some(RubbedPreset::ALL[0]),
+                ..Setup::default()
+            }),
+            40_000 => p.note_off(50),
+            _ => {}
+        };
+        let marks = [0, 20_000, 30_000, 35_000, 40_000, 48_000];
+        let mut ticked = cello();
+        let mut want = Vec::new();
+        for at in 0..48_000 {
+            events(&mut ticked, at);
+            let f = ticked.tick(bow_at(at));
+            let b = ticked.bow();
+            want.push(
+                [
+                    f.audio,
+                    f.bow_point_velocity_m_per_s,
+                    b.force_n,
+                    b.position_beta,
+                ]
+                .map(f64::to_bits),
+            );
+        }
+        for run in [1, 7, 64, 511, 700] {
+            let mut p = cello();
+            let mut got = Vec::new();
+            let mut at = 0;
+            while at < 48_000 {
+                events(&mut p, at);
+                let next = marks.iter().copied().find(|&m| m > at).unwrap_or(48_000);
+                let n = run.min(next - at);
+                let mut k_next = at;
+                p.tick_run(
+                    n,
+                    || {
+                        k_next += 1;
+                        (bow_at(k_next - 1), k_next - 1)
+                    },
+                    |k, sample, f, b, _| {
+                        assert_eq!(sample, at + k, "the caller's value rides with its sample");
+                        got.push(
+                            [
+                                f.audio,
+                                f.bow_point_velocity_m_per_s,
+                                b.force_n,
+                                b.position_beta,
+                            ]
+                            .map(f64::to_bits),
+                        );
+                    },
+                );
+                at += n;
+            }
+            assert_eq!(got, want, "runs of {run}");
         }
     }
 

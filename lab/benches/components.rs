@@ -2,8 +2,9 @@
 //! `-- --quick` for a fast pass): one friction solve per law on the cello D load line, one
 //! waveguide string sample, one thermal string sample at N_B 10 and 60, and one modal
 //! bridge junction solve (four strings, the shipped 14-mode cello bridge), and one sample
-//! of the cello bowing D3 bare and through the performer (the performance layer's cost is
-//! their difference). Whole-model costs against precision are `colophony bench precision`.
+//! of the cello bowing D3 bare and through the performer, one sample at a time, as a block
+//! and as a run with the bow given per sample (the performance layer's cost is their
+//! difference). Whole-model costs against precision are `colophony bench precision`.
 
 use colophony::dsp::bridge::{solve_junction, ModalBridge};
 use colophony::dsp::friction::bristle::{BristleFriction, BristleLaw, BristleParams};
@@ -130,6 +131,29 @@ fn performer_tick(c: &mut Criterion) {
     group.bench_function("through the performer", |b| {
         b.iter(|| {
             performer.tick_block(black_box(bow), &mut block);
+            black_box(block[511])
+        })
+    });
+    group.finish();
+    // As the plugin plays while automation moves or a live view listens: the bow handed
+    // over sample by sample, the strings' own loop against the performer's run.
+    let mut group = c.benchmark_group("cello D3 bowed, a run of 512 with the bow per sample");
+    let played = performer.bow();
+    group.bench_function("instrument", |b| {
+        b.iter(|| {
+            for sample in block.iter_mut() {
+                *sample = bare.tick(black_box(played)).audio;
+            }
+            black_box(block[511])
+        })
+    });
+    group.bench_function("through the performer", |b| {
+        b.iter(|| {
+            performer.tick_run(
+                block.len(),
+                || (black_box(bow), ()),
+                |k, (), frame, _, _| block[k] = frame.audio,
+            );
             black_box(block[511])
         })
     });

@@ -184,8 +184,9 @@ pub fn perform(
             out.resize(out.len() + block, 0.0);
             quiet += block as u64;
         } else {
-            for i in 0..block as u64 {
-                let now = done + i;
+            let end = done + block as u64;
+            let mut now = done;
+            while now < end {
                 while next < events.len() && events[next].sample <= now {
                     let c = events[next].channel;
                     match events[next].event {
@@ -206,10 +207,20 @@ pub fn perform(
                     }
                     next += 1;
                 }
-                let frame = performer.tick(how.bow);
-                let y = safety_limit(flush_tiny(frame.audio * how.gain)) as f32;
-                quiet = if y.abs() < QUIET_LEVEL { quiet + 1 } else { 0 };
-                out.push(y);
+                // Up to the next event (or the block's end) nothing lands: one run.
+                let run_end = events
+                    .get(next)
+                    .map_or(end, |e| e.sample.clamp(now + 1, end));
+                performer.tick_run(
+                    (run_end - now) as usize,
+                    || (how.bow, ()),
+                    |_, (), frame, _, _| {
+                        let y = safety_limit(flush_tiny(frame.audio * how.gain)) as f32;
+                        quiet = if y.abs() < QUIET_LEVEL { quiet + 1 } else { 0 };
+                        out.push(y);
+                    },
+                );
+                now = run_end;
             }
         }
         done += block as u64;
