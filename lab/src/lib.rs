@@ -18,3 +18,4 @@ pub mod playing_space;
 pub mod playing_space_figure;
 pub mod precision;
 pub mod render;
+pub mod thermal_constants;

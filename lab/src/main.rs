@@ -111,7 +111,8 @@ enum Command {
     /// `precision --out DIR [--quick]` writes the work-precision benchmark (errors against
     /// refined references beside the cost, and the STK and Faust peers) to DIR; `peers
     /// [--seconds S] [--out DIR]` times whole processes rendering cello D3 against STK's
-    /// Bowed (needs libstk-dev and g++).
+    /// Bowed (needs libstk-dev and g++); `thermal-constants` bows paper B's contact with
+    /// candidate constant sets on probe notes across the window.
     Bench {
         what: String,
         /// Output directory (precision).
@@ -395,8 +396,9 @@ fn main() -> ExitCode {
                     }),
                 None => Err("bench intonation needs --out FILE (the shipped one: assets/intonation.csv)".into()),
             },
+            "thermal-constants" => colophony_lab::thermal_constants::run(),
             other => Err(format!(
-                "unknown bench '{other}': choose friction, table1, scenes, precision, playing-space or intonation"
+                "unknown bench '{other}': choose friction, table1, scenes, peers, precision, playing-space, intonation or thermal-constants"
             )),
         }),
         Command::Presets => {

@@ -161,6 +161,8 @@ pub struct Cell {
     pub intonation: Option<&'static IntonationTable>,
     /// The bristle laws' time discretisation (the plugin's: the trapezoid).
     pub integrator: BristleIntegrator,
+    /// The thermal contact's constants (the plugin's: [`ThermalParams::default`]).
+    pub thermal: ThermalParams,
 }
 
 impl Cell {
@@ -227,6 +229,7 @@ impl Cell {
             string,
             intonation: Some(intonation::shipped()),
             integrator: BristleIntegrator::Trapezoid,
+            thermal: ThermalParams::default(),
         }
     }
 
@@ -292,8 +295,13 @@ pub fn render_cell(cell: &Cell) -> Result<(Vec<f64>, Vec<ContactSample>), String
                 nodes: GOOD_NODES,
                 width_m: 0.01,
             };
-            let mut engine =
-                ThermalInstrument::new(cell.kind, &bridge.modes, cell.rate_hz, settings)?;
+            let mut engine = ThermalInstrument::with_contact(
+                cell.kind,
+                &bridge.modes,
+                cell.rate_hz,
+                settings,
+                cell.thermal,
+            )?;
             engine.set_intonation(cell.intonation);
             engine.set_preferred_string(cell.string);
             engine.note_on(cell.note);

@@ -225,6 +225,26 @@ impl ThermalInstrument {
         host_rate_hz: f64,
         settings: ThermalSettings,
     ) -> Result<Self, String> {
+        Self::with_contact(
+            kind,
+            bridge,
+            host_rate_hz,
+            settings,
+            ThermalParams::default(),
+        )
+    }
+
+    /// [`ThermalInstrument::new`] with the thermal contact's constants `thermal` instead
+    /// of [`ThermalParams::default`] (the tools compare candidate sets:
+    /// `colophony bench thermal-constants`).
+    pub fn with_contact(
+        kind: InstrumentKind,
+        bridge: &[BridgeMode],
+        host_rate_hz: f64,
+        settings: ThermalSettings,
+        thermal: ThermalParams,
+    ) -> Result<Self, String> {
+        thermal.validate()?;
         if !(host_rate_hz.is_finite() && host_rate_hz > 0.0) {
             return Err(format!("invalid sample rate {host_rate_hz}"));
         }
@@ -244,7 +264,7 @@ impl ThermalInstrument {
                 };
                 ThermalString::with_capacity(
                     spec,
-                    ThermalParams::default(),
+                    thermal,
                     HairParams::default(),
                     ThermalCapacity {
                         max_nodes: MAX_NODES,
