@@ -41,8 +41,9 @@ pub const PROBES: [(InstrumentKind, u8); 13] = [
 /// Fractions of `F_max` bowed besides the default 1 N.
 pub const FRACTIONS: [f64; 4] = [1.0 / 16.0, 1.0 / 8.0, 0.25, 0.5];
 
-/// The candidate sets: paper B's eq. (1) as written (the default), the bulk-cooled set,
-/// and faster-cooling sets with the heating per contact area (docs/playing-space.md).
+/// The candidate sets: paper B's eq. (1) as written, the bulk-cooled set, and
+/// faster-cooling sets with the heating per contact area, the default among them
+/// (docs/playing-space.md).
 pub fn candidates() -> Vec<(&'static str, ThermalParams)> {
     let fast = |tau_b_s: f64, c_c: f64, c_h: f64, mu_hot: f64| ThermalParams {
         c_c_per_m: c_c,
@@ -50,10 +51,10 @@ pub fn candidates() -> Vec<(&'static str, ThermalParams)> {
         bulk_cooling_per_s: 1.0 / tau_b_s,
         heating_reference_load_n_per_m: 300.0,
         mu_hot,
-        ..ThermalParams::default()
+        ..ThermalParams::paper_b_eq1()
     };
     vec![
-        ("eq. 1 (default)", ThermalParams::default()),
+        ("eq. 1 as written", ThermalParams::paper_b_eq1()),
         ("bulk-cooled 0.3 ms", bulk_cooled()),
         ("33 us, 15000, 4500", fast(33e-6, 15000.0, 4500.0, 0.3)),
         (
@@ -61,8 +62,8 @@ pub fn candidates() -> Vec<(&'static str, ThermalParams)> {
             fast(1.0 / 60_000.0, 15000.0, 9000.0, 0.3),
         ),
         (
-            "33 us, 15000, 4500, mu_hot 0.5",
-            fast(33e-6, 15000.0, 4500.0, 0.5),
+            "33 us, 15000, 4500, mu_hot 0.5 (the default)",
+            ThermalParams::default(),
         ),
         (
             "17 us, 15000, 9000, mu_hot 0.55",

@@ -119,17 +119,20 @@ fn temperature_rises_while_slipping_and_diffuses_while_sticking() {
     let grid = |s: &ThermalString| -> Vec<f64> {
         s.temperature_grid().iter().map(|x| f64::from(*x)).collect()
     };
-    let (mut slips, mut heated, mut sticks, mut diffusive) = (0, 0, 0, 0);
+    // Whole-width slips far from the sliding equilibrium: (below it, warmed), (above it,
+    // cooled).
+    let (mut below, mut heated, mut above, mut cooled) = (0, 0, 0, 0);
+    let (mut sticks, mut diffusive) = (0, 0);
     let th = ThermalParams::default();
     let dx = s.width_m() / s.nodes() as f64;
-    for _ in 0..(0.1 * fs) as usize {
+    for _ in 0..(0.3 * fs) as usize {
         let before = mean(s.node_temperatures());
         let grid_before = grid(&s);
         s.tick(FIG6_BOW);
         let slipping = s.slipping();
-        // The coolest equilibrium of the sliding nodes at this sample's speeds and
-        // forces (ThermalParams::sliding_equilibrium_kelvin, eq. 1 without diffusion).
-        let equilibrium = s
+        // The sliding nodes' equilibria at this sample's speeds and forces
+        // (ThermalParams::sliding_equilibrium_kelvin, eq. 1 without diffusion).
+        let equilibria: Vec<f64> = s
             .node_forces()
             .iter()
             .zip(s.node_sliding_velocities())
@@ -140,13 +143,21 @@ fn temperature_rises_while_slipping_and_diffuses_while_sticking() {
                     f64::from(*v),
                 )
             })
-            .fold(f64::INFINITY, f64::min);
-        // Half of it: diffusion also carries heat out through the bow's edges.
-        if slipping.iter().all(|x| *x) && before < 0.5 * equilibrium {
-            // The whole width slides and the contact is well below its sliding
-            // equilibrium: friction heating outweighs the losses and diffusion.
-            slips += 1;
-            heated += (mean(s.node_temperatures()) > before) as usize;
+            .collect();
+        let coolest = equilibria.iter().cloned().fold(f64::INFINITY, f64::min);
+        let hottest = equilibria.iter().cloned().fold(0.0, f64::max);
+        if slipping.iter().all(|x| *x) {
+            let after = mean(s.node_temperatures());
+            // Eq. (1) relaxes a sliding contact toward its equilibrium. A factor of two
+            // each side: diffusion also carries heat out through the bow's edges, and
+            // the equilibria move with each sample's speeds.
+            if before < 0.5 * coolest {
+                below += 1;
+                heated += (after > before) as usize;
+            } else if before > 2.0 * hottest {
+                above += 1;
+                cooled += (after < before) as usize;
+            }
         }
         if slipping.iter().all(|x| !*x) {
             // No node slips: eq. (1) is pure diffusion, which never creates a new maximum
@@ -165,8 +176,11 @@ fn temperature_rises_while_slipping_and_diffuses_while_sticking() {
                 (max_after <= max_before + ulp && sum_after <= sum_before + n * ulp) as usize;
         }
     }
-    println!("whole-width slips below half the sliding equilibrium that heated the bow: {heated}/{slips}; all-stick samples obeying diffusion: {diffusive}/{sticks}");
-    assert!(slips > 100 && heated == slips);
+    println!("whole-width slips well below the sliding equilibrium that warmed: {heated}/{below}; well above it that cooled: {cooled}/{above}; all-stick samples obeying diffusion: {diffusive}/{sticks}");
+    // The default contact cools in 33 us, so a slip spends only its first samples far
+    // from equilibrium: about one such sample per period of the 65 Hz string (about 20
+    // over the 0.3 s).
+    assert!(below + above > 10 && heated == below && cooled == above);
     assert!(sticks > 100 && diffusive == sticks);
 }
 
@@ -420,10 +434,13 @@ fn the_thermal_instrument_rings_in_tune_and_flattens_with_bow_force() {
         // the polarisations is not in the tuning. 5 cents: about the smallest pitch
         // difference players notice on sustained tones.
         assert!(free.abs() < 5.0, "MIDI {note}: free decay {free:+.2} cents");
-        // Bowing only flattens (the capture is delayed under force), never sharpens by more
-        // than the free string's error.
+        // Bowing flattens toward F_max (the capture is delayed under force) and sharpens
+        // by at most a few cents elsewhere: Helmholtz motion locks the stiff string's
+        // stretched partials into one harmonic series a little above its first partial
+        // (the point laws sound 2 to 14 cents above it, docs/playing-space.md). Bound: the
+        // 5 cents players notice, as above.
         assert!(
-            bowed < free + 1.0,
+            bowed < free + 5.0,
             "MIDI {note}: bowed {bowed:+.2}, free {free:+.2}"
         );
         if note == 43 {

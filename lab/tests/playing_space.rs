@@ -150,25 +150,40 @@ fn bowed_at_nominal_the_point_laws_centre_on_equal_temperament() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
-/// The thermal model bowed at the plugin's defaults (1 N) in Helmholtz motion sounds in
-/// tune: before the intonation table its notes were 17 cents flat (median).
+/// The thermal model bowed at nominal (the plugin's defaults, 1 N, and the middle of each
+/// note's window) in Helmholtz motion sounds in tune: with paper B's eq. (1) as written
+/// its notes were 17 cents flat at the defaults (median) and the middle slid. Both nominal
+/// bowings stick with the default constants since 2026-11-25, and the intonation table is
+/// fitted to the mean of the two; the defaults alone sit a few cents flat (printed) where
+/// 1 N is near a thin string's `F_max` (the violin's E string: 1.15 N).
 #[test]
-fn the_thermal_model_bowed_at_its_defaults_is_in_tune_where_it_is_helmholtz() {
+fn the_thermal_model_bowed_at_nominal_is_in_tune_where_it_is_helmholtz() {
     let results = nominal_results();
-    let mut cents: Vec<f64> = results
-        .iter()
-        .filter(|(c, m)| {
-            c.model == Model::Thermal
-                && c.bowing == Bowing::Defaults
-                && m.regime == Some(Regime::Helmholtz)
-        })
-        .map(|(_, m)| m.cents)
-        .collect();
-    cents.sort_by(f64::total_cmp);
-    println!("thermal, defaults, Helmholtz: {cents:?}");
+    let helmholtz_cents = |defaults_only: bool| {
+        let mut cents: Vec<f64> = results
+            .iter()
+            .filter(|(c, m)| {
+                c.model == Model::Thermal
+                    && (!defaults_only || c.bowing == Bowing::Defaults)
+                    && m.regime == Some(Regime::Helmholtz)
+            })
+            .map(|(_, m)| m.cents)
+            .collect();
+        cents.sort_by(f64::total_cmp);
+        cents
+    };
+    let defaults = helmholtz_cents(true);
+    let cents = helmholtz_cents(false);
+    println!(
+        "thermal, nominal, Helmholtz: {} cells, median {:+.1} cents (defaults only: {} cells, median {:+.1})",
+        cents.len(),
+        cents.get(cents.len() / 2).copied().unwrap_or(f64::NAN),
+        defaults.len(),
+        defaults.get(defaults.len() / 2).copied().unwrap_or(f64::NAN)
+    );
     assert!(
         !cents.is_empty(),
-        "no thermal note at its defaults is in Helmholtz motion"
+        "no thermal note at nominal bowing is in Helmholtz motion"
     );
     let median = cents[cents.len() / 2];
     // 3 cents: issue 16's nominal target.

@@ -20,10 +20,10 @@
 //! stable only if `alpha dt / dx^2 < 1/2` (eq. 2). Every change of the grid checks it and
 //! sub-steps the update (`ceil(r / 0.45)` steps of `dt / n`), so it never runs unstable.
 //! `mu(T)` is piecewise linear: `mu_cold` below `T_cold`, `mu_hot` above `T_hot`. Two
-//! terms paper B does not have can be turned on (both off by default): a bulk cooling
-//! `- T / tau_b` and the heating referred to a reference load, `C_H (p_ref / p) |f v_D|`;
-//! without them steady sliding is stable at every force and speed (see
-//! [`ThermalParams::default`] and [`bulk_cooled`]).
+//! terms paper B does not have are on by default: a bulk cooling `- T / tau_b` and the
+//! heating referred to a reference load, `C_H (p_ref / p) |f v_D|`; without them (paper
+//! B's eq. 1 as written, [`ThermalParams::paper_b_eq1`]) steady sliding is stable at every
+//! force and speed (see [`ThermalParams::default`] and [`bulk_cooled`]).
 //!
 //! **Vertical plane, per node** (eqs. 9-10): a lumped junction loaded by the hair's vertical
 //! admittance, a mass on a parallel spring-dashpot discretised by the trapezoid rule. The
@@ -104,26 +104,59 @@ pub struct ThermalParams {
 }
 
 impl Default for ThermalParams {
-    /// Paper B publishes none of these (docs/parameters.md §1.3: [NF]); chosen so that:
-    /// - the equilibrium temperature of steady sliding, `T_eq = C_H f / C_C`, is
-    ///   `250 * 0.4 * 300 / 2000 = 15 K` at paper B's 300 N/m, inside the 10-25 K swing
-    ///   reported for rosin (van Walstijn et al., docs/parameters.md §1.3), and independent of
-    ///   the sliding speed;
-    /// - a slip of ~1 ms at ~0.5 m/s relaxes toward it (`C_C |v| ~ 1000 /s`);
-    /// - diffusion cools the contact within about a period of a low string: with
-    ///   `alpha = 4e-3 m^2/s` over the 1.4 cm grid, `tau = L^2 / (pi^2 alpha) ~ 5 ms`. This is
-    ///   an equivalent diffusivity (heat also leaves into the string core and the air,
-    ///   which eq. 1 does not model), far above steel's 1.2e-5;
-    /// - `mu` falls from 0.8 when cool to 0.3 when hot (the spread of measured static and
-    ///   sliding rosin friction), over 2-14 K.
+    /// Paper B publishes none of these (docs/parameters.md §1.3: [NF]). Chosen by
+    /// measurement (`colophony bench thermal-constants`, docs/playing-space.md, "Choosing
+    /// the thermal constants") so that the contact sticks across each string's Schelleng
+    /// window, the plugin's default 1 N lies inside every string's window, paper B's own
+    /// checks hold (Figure 6, the window test, the hair, `lab/tests/paper_b.rs`), and the
+    /// pitch falls with the force by cents below `F_max / 2`:
+    /// - **bulk cooling in 33 us** (`- T / tau_b`, heat leaving the contact into the
+    ///   string's core and the rosin layer). A contact that keeps its heat for
+    ///   milliseconds, as eq. (1) alone does, slides steadily at every force (its sliding
+    ///   equilibrium does not depend on the speed) and, where it sticks, flattens by a
+    ///   semitone; cooling rates of 1e4-1e5 /s while sliding are the order of the
+    ///   secondary source in docs/parameters.md §1.3;
+    /// - **heating per unit of real contact area**, referred to paper B's 300 N/m (rosin
+    ///   junctions yield plastically, so the real contact area grows with the load: Smith
+    ///   and Woodhouse 2000), so the contact's temperature does not grow with the force;
+    /// - `C_C` 15000 /m and `C_H` 4500 K m/J: the sliding equilibrium
+    ///   `T_eq(v) = C_H mu p_ref v / (C_C v + 1 / tau_b)` is about 2.5 K at 0.1 m/s,
+    ///   11 K at 0.5 m/s and 18 K at 1 m/s (taking mu 0.6), so the steady sliding
+    ///   friction falls with speed across the 2-14 K of `mu(T)`, a thermal counterpart of
+    ///   the hyperbolic law;
+    /// - `mu` falls from 0.8 when cool to 0.5 when hot: the 0.3 drop puts the violin's E
+    ///   string's `F_max` at 1.15 N (beta 0.1, 0.1 m/s), above the default force (a 0.5 drop
+    ///   gave 0.69 N); 0.55 and above break paper B's Figure 6;
+    /// - diffusion over the grid as before: `alpha = 4e-3 m^2/s` (an equivalent
+    ///   diffusivity) spreads heat across the 1.4 cm grid in about 5 ms.
     ///
-    /// The bulk cooling and the heating per contact area are off (eq. 1 as paper B writes
-    /// it). With them on (`bulk_cooling_per_s` 1 / 0.3 ms, the heating referred to
-    /// 300 N/m, `C_C` 5000 /m, `C_H` 1500 K m/J) the string sticks across most of its
-    /// window instead of sliding, but its bowed pitch falls by tens of cents with the
-    /// force on stopped notes (docs/playing-space.md, "Why the thermal model slides"), so
-    /// they are parameters to try, not the default.
+    /// Paper B's eq. (1) as written (no bulk cooling, heating by the load, `mu` 0.8 to
+    /// 0.3, `C_C` 2000, `C_H` 250): [`ThermalParams::paper_b_eq1`].
     fn default() -> Self {
+        Self {
+            mu_cold: 0.8,
+            mu_hot: 0.5,
+            t_cold_kelvin: 2.0,
+            t_hot_kelvin: 14.0,
+            diffusivity_m2_per_s: 4e-3,
+            c_c_per_m: 15000.0,
+            c_h_kelvin_m_per_j: 4500.0,
+            bulk_cooling_per_s: 1.0 / 33e-6,
+            heating_reference_load_n_per_m: 300.0,
+            margin_m: 2e-3,
+        }
+    }
+}
+
+impl ThermalParams {
+    /// Paper B's eq. (1) as written, with the constants Colophony used by default until
+    /// 2026-11-25: no bulk cooling, heating by the load; the equilibrium temperature of
+    /// steady sliding, `T_eq = C_H f / C_C`, is `250 * 0.4 * 300 / 2000 = 15 K` at paper B's
+    /// 300 N/m (inside the 10-25 K swing reported for rosin) at every sliding speed; a
+    /// slip of ~1 ms at ~0.5 m/s relaxes toward it (`C_C |v| ~ 1000 /s`); `mu` 0.8 to 0.3
+    /// over 2-14 K. It slides steadily across most of the window (docs/playing-space.md,
+    /// "Why the thermal model slides").
+    pub fn paper_b_eq1() -> Self {
         Self {
             mu_cold: 0.8,
             mu_hot: 0.3,
@@ -141,7 +174,7 @@ impl Default for ThermalParams {
 
 /// The thermal constants of the bulk-cooled contact (docs/playing-space.md, "Why the
 /// thermal model slides"): bulk cooling in 0.3 ms, heating per unit of contact area at
-/// 300 N/m, `C_C` 5000 /m, `C_H` 1500 K m/J, the rest as [`ThermalParams::default`].
+/// 300 N/m, `C_C` 5000 /m, `C_H` 1500 K m/J, the rest as [`ThermalParams::paper_b_eq1`].
 /// Measured: it sticks in most of the window's upper two thirds, and flattens steeply
 /// with the force.
 pub fn bulk_cooled() -> ThermalParams {
@@ -150,7 +183,7 @@ pub fn bulk_cooled() -> ThermalParams {
         c_h_kelvin_m_per_j: 1500.0,
         bulk_cooling_per_s: 1.0 / 3e-4,
         heating_reference_load_n_per_m: 300.0,
-        ..ThermalParams::default()
+        ..ThermalParams::paper_b_eq1()
     }
 }
 
@@ -1087,9 +1120,14 @@ mod tests {
     fn the_avx2_string_gives_the_same_bits_as_the_portable_one() {
         // Paper B's Figure 6 bow on 60 nodes for 0.1 s, then lifted while the grid
         // cools: every path of the node solve and the FTCS update, in both builds, with
-        // the default constants and with the bulk-cooled ones (lifted for 0.5 ms there:
-        // its 0.3 ms leaves the grid warm).
-        for (params, lifted_s) in [(ThermalParams::default(), 0.05), (bulk_cooled(), 5e-4)] {
+        // paper B's eq. (1) as written, the bulk-cooled constants (lifted for 0.5 ms
+        // there: its 0.3 ms leaves the grid warm) and the default ones (33 us: lifted for
+        // 50 us).
+        for (params, lifted_s) in [
+            (ThermalParams::paper_b_eq1(), 0.05),
+            (bulk_cooled(), 5e-4),
+            (ThermalParams::default(), 5e-5),
+        ] {
             let make = |wide_simd: bool| {
                 let mut s = ThermalString::new(
                     ThermalStringSpec::cello_c(),
