@@ -513,7 +513,7 @@ impl Performer {
     /// by the velocity); one that lands while another is held is legato (the stroke goes
     /// on; on the same string the finger moves and the bow stays on). A legato note below
     /// [`PORTAMENTO_BELOW_VELOCITY`], or any with CC65 down, glides the finger over the
-    /// setup's glide time (the waveguide strings; the thermal model moves it at once).
+    /// setup's glide time.
     pub fn note_on(&mut self, note: u8, velocity: f32) {
         self.note_on_channel(0, note, velocity);
     }
@@ -541,8 +541,8 @@ impl Performer {
         }
     }
 
-    /// The note reaches the source (no new stroke); with `glide` (seconds), the waveguide
-    /// strings slide the finger there.
+    /// The note reaches the source (no new stroke); with `glide` (seconds), the strings
+    /// (waveguide or thermal) slide the finger there.
     fn land(&mut self, note: u8, glide: Option<f64>) {
         // A bow lands: whatever tail was estimated no longer holds.
         self.tail = None;
@@ -567,7 +567,11 @@ impl Performer {
                 if let Some(engine) = self.thermal.get_mut(k) {
                     // A new node count fades the instrument out and lands the note after.
                     engine.set_settings(settings);
-                    if let Some(string) = engine.note_on(note) {
+                    let landed = match glide {
+                        Some(seconds) => engine.note_on_gliding(note, seconds),
+                        None => engine.note_on(note),
+                    };
+                    if let Some(string) = landed {
                         self.held[key] = true;
                         self.last_note = Some(note);
                         self.notes[key].string = Some(string as u8);
@@ -1989,6 +1993,54 @@ mod tests {
         // moves each place on the string by a few cents, and steps are 1.3 ms).
         assert!((half - 150.0).abs() < 20.0, "{half}");
         assert!((at(0.25) - firm[firm.len() - 1]).abs() < 0.01);
+    }
+
+    #[test]
+    fn a_soft_legato_note_glides_the_thermal_finger_too() {
+        // Paper B's thermal cello: D3 bowed, then F3 legato and soft on the same string;
+        // the string's tuning (cents above D3) every 64 samples.
+        let string = InstrumentKind::Cello.string_for_note(50).unwrap();
+        let setup = Setup {
+            point_law: None,
+            ..Setup::default()
+        };
+        let mut p = Performer::new(InstrumentKind::Cello);
+        p.activate(&setup, FS).unwrap();
+        p.configure(&setup);
+        let bow = BowControl::default();
+        let tuned = |p: &Performer| {
+            p.thermal(InstrumentKind::Cello)
+                .unwrap()
+                .string(string)
+                .fundamental_hz()
+        };
+        p.note_on(50, 0.8);
+        for _ in 0..(0.2 * FS) as usize {
+            p.tick(bow);
+        }
+        let d3 = tuned(&p);
+        p.note_on(53, 0.3);
+        p.note_off(50);
+        let (mut cents, mut audio) = (Vec::new(), Vec::new());
+        for i in 0..(0.25 * FS) as usize {
+            audio.push(p.tick(bow).audio);
+            if i % 64 == 0 {
+                cents.push(1200.0 * (tuned(&p) / d3).log2());
+            }
+        }
+        // The bow stays on through the glide: every 10 ms of it sounds.
+        assert!(audio.chunks(480).all(|c| crate::analysis::rms(c) > 1e-3));
+        let at = |t: f64| cents[(t * FS / 64.0) as usize];
+        // Rises monotonically from D3 to F3 over the glide time, then stays.
+        assert!(cents.windows(2).all(|w| w[1] >= w[0] - 1e-9));
+        assert!(at(0.0) < 20.0, "{}", at(0.0));
+        // Halfway in time, halfway in semitones (within 20 cents: the intonation table
+        // moves each place on the string by a few cents, and steps are 1.3 ms).
+        let half = at(0.5 * GLIDE_S_DEFAULT);
+        assert!((half - 150.0).abs() < 20.0, "{half}");
+        let end = cents[cents.len() - 1];
+        assert!((end - 300.0).abs() < 15.0, "{end}");
+        assert!((at(0.2) - end).abs() < 0.01);
     }
 
     #[test]

@@ -21,6 +21,11 @@ use super::thermal_instrument::ThermalInstrument;
 pub trait Engine {
     /// Lands the bow for `note`; the string (or object) it went to, `None` if ignored.
     fn note_on(&mut self, note: u8) -> Option<usize>;
+    /// As [`Engine::note_on`], but a note landing on a string already bowed glides the
+    /// finger there over `glide_s` seconds (portamento); engines without fingers land it.
+    fn note_on_gliding(&mut self, note: u8, _glide_s: f64) -> Option<usize> {
+        self.note_on(note)
+    }
     /// Lifts the bow from `note`.
     fn note_off(&mut self, note: u8);
     fn all_notes_off(&mut self);
@@ -59,6 +64,9 @@ macro_rules! string_engine {
         impl Engine for $t {
             fn note_on(&mut self, note: u8) -> Option<usize> {
                 <$t>::note_on(self, note)
+            }
+            fn note_on_gliding(&mut self, note: u8, glide_s: f64) -> Option<usize> {
+                <$t>::note_on_gliding(self, note, glide_s)
             }
             fn note_off(&mut self, note: u8) {
                 <$t>::note_off(self, note)

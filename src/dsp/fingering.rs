@@ -63,6 +63,8 @@ pub struct Fingering {
     expressions: [NoteExpression; STRINGS],
     /// A finger glide under way: semitones still to go to the note (0: none).
     glides: [f64; STRINGS],
+    /// Semitones a glide moves per step ([`Fingering::advance_glides`]).
+    glide_steps: [f64; STRINGS],
     /// The string the player asks notes to go to (0 = lowest), `None` for the usual choice.
     preferred_string: Option<usize>,
     bend_semitones: f64,
@@ -83,6 +85,7 @@ impl Fingering {
             notes: [None; STRINGS],
             expressions: [NoteExpression::NEUTRAL; STRINGS],
             glides: [0.0; STRINGS],
+            glide_steps: [0.0; STRINGS],
             preferred_string: None,
             bend_semitones: 0.0,
             reference_semitones: 0.0,
@@ -124,10 +127,12 @@ impl Fingering {
     }
 
     /// `string`'s note becomes `note` with the finger `glide` semitones away from it,
-    /// keeping the note's expression (a legato glide).
-    pub fn glide_to(&mut self, string: usize, note: u8, glide: f64) {
+    /// keeping the note's expression (a legato glide), to arrive in `steps` calls of
+    /// [`Fingering::advance_glides`] (at least one).
+    pub fn glide_to(&mut self, string: usize, note: u8, glide: f64, steps: f64) {
         self.notes[string] = Some(note);
         self.glides[string] = glide;
+        self.glide_steps[string] = glide.abs() / steps.max(1.0);
     }
 
     /// The note on `string`, if any.
@@ -140,15 +145,29 @@ impl Fingering {
         self.glides[string]
     }
 
-    /// Moves `string`'s glide `step` semitones toward 0; returns whether it still glides.
-    pub fn advance_glide(&mut self, string: usize, step: f64) -> bool {
-        let g = &mut self.glides[string];
-        *g = if *g > 0.0 {
-            (*g - step).max(0.0)
-        } else {
-            (*g + step).min(0.0)
-        };
-        *g != 0.0
+    /// Moves every gliding finger one step toward its note. Returns the pitch (Hz) each
+    /// string that moved and holds a note should now be tuned to, and whether any finger
+    /// still glides.
+    pub fn advance_glides(&mut self) -> ([Option<f64>; STRINGS], bool) {
+        let mut retune = [None; STRINGS];
+        let mut any = false;
+        for i in 0..STRINGS {
+            let g = self.glides[i];
+            if g == 0.0 {
+                continue;
+            }
+            let step = self.glide_steps[i];
+            self.glides[i] = if g > 0.0 {
+                (g - step).max(0.0)
+            } else {
+                (g + step).min(0.0)
+            };
+            any |= self.glides[i] != 0.0;
+            if self.notes[i].is_some() {
+                retune[i] = Some(self.tuned_hz(i));
+            }
+        }
+        (retune, any)
     }
 
     /// `string`'s note expression.

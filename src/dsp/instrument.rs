@@ -309,8 +309,6 @@ struct StringVoice {
     contact: AnyFriction,
     bow: BowEnvelope,
     awake: bool,
-    /// A finger glide's change per retune, semitones ([`Fingering::glide`] is what is left).
-    glide_step: f64,
     /// Whether the note's expression is not neutral (one test per sample instead of three).
     expressive: bool,
 }
@@ -404,7 +402,6 @@ impl Instrument {
             .expect("the built-in bristle parameters are valid"),
             bow: BowEnvelope::default(),
             awake: false,
-            glide_step: 0.0,
             expressive: false,
         });
         Self {
@@ -547,8 +544,7 @@ impl Instrument {
         };
         let distance = from - note as f64;
         let steps = (glide_s * self.sample_rate_hz / GLIDE_EVERY as f64).max(1.0);
-        self.fingering.glide_to(index, note, distance);
-        self.voices[index].glide_step = distance.abs() / steps;
+        self.fingering.glide_to(index, note, distance, steps);
         self.probed = index;
         self.gliding = distance != 0.0;
         self.glide_countdown = 0;
@@ -559,15 +555,10 @@ impl Instrument {
 
     /// Moves every gliding finger one step toward its note.
     fn advance_glides(&mut self) {
-        let mut any = false;
-        for i in 0..STRINGS {
-            if self.fingering.glide(i) == 0.0 {
-                continue;
-            }
-            any |= self.fingering.advance_glide(i, self.voices[i].glide_step);
-            if self.fingering.note(i).is_some() {
-                let hz = self.fingering.tuned_hz(i);
-                self.voices[i].string.bend_to(hz);
+        let (retune, any) = self.fingering.advance_glides();
+        for (voice, hz) in self.voices.iter_mut().zip(retune) {
+            if let Some(hz) = hz {
+                voice.string.bend_to(hz);
             }
         }
         self.gliding = any;
