@@ -10,7 +10,7 @@
 //! `H_m(z) R_m` with `R_m = G_m K / D`, `a1 = 2 (w^2 - K^2) / D`, `a2 = (K^2 - 2 pi b K + w^2) / D`.
 //! Modes at or above Nyquist are dropped.
 //!
-//! [`StringsOnBridge`] couples several strings (both polarisations) through it: every
+//! [`solve_junction`] couples several strings (both polarisations) through it: every
 //! string end moves with the bridge, `v_B = Y F_total`. `H_m` passes its input straight
 //! through (`b0 = 1`), so the loop is delay free; it is solved exactly each sample as a
 //! 2x2 linear system: with `v_in,i` the wave arriving on string `i` (impedance `Z_i`),
@@ -23,6 +23,19 @@
 //! | `f_m`, `b_m` | mode frequency, half-power bandwidth | Hz |
 //! | `R_m` | modal gain (`[[hh, hv], [hv, vv]]`) | s/kg |
 //! | `v_B` | bridge velocity `[h, v]` | m/s |
+//!
+//! ```
+//! use colophony::dsp::bridge::{BridgeMode, ModalBridge};
+//! // One mode coupling the two planes (a PSD gain): the bridge's admittance has a PSD
+//! // real part at every frequency, so it never gives energy back to the strings.
+//! let mode = BridgeMode { freq_hz: 2200.0, bandwidth_hz: 150.0, gain: [[2.0, 0.5], [0.5, 1.0]] };
+//! let bridge = ModalBridge::new(&[mode], 48_000.0).unwrap();
+//! for f in [100.0, 2200.0, 10_000.0] {
+//!     let y = bridge.response(f);
+//!     let (hh, hv, vv) = (y[0][0].0, y[0][1].0, y[1][1].0);
+//!     assert!(hh >= 0.0 && vv >= 0.0 && hh * vv - hv * hv >= -1e-18);
+//! }
+//! ```
 
 use super::filters::{flush_tiny, FLUSH_BELOW};
 use std::f64::consts::PI;

@@ -3,6 +3,24 @@
 //!
 //! Every loop filter exposes its phase delay in samples at a normalised angular
 //! frequency `w` (rad/sample), so the string can account for it in the loop length.
+//!
+//! ```
+//! use colophony::dsp::filters::{Allpass1, OnePoleLoss};
+//! use std::f64::consts::PI;
+//! let w = |f: f64| 2.0 * PI * f / 48_000.0;
+//! // Thiran's fractional delay of 0.3 samples: its phase delay at low frequency is 0.3.
+//! let a = (1.0 - 0.3) / (1.0 + 0.3);
+//! assert!((Allpass1::phase_delay(a, w(20.0)) - 0.3).abs() < 1e-6);
+//! // A loss filter losing 1 % per trip at 100 Hz and 10 % at 1 kHz: a 100 Hz sine
+//! // through it comes out at 0.99 of its amplitude.
+//! let mut loss = OnePoleLoss::fit(w(100.0), 0.99, w(1000.0), 0.9);
+//! let peak = (0..48_000)
+//!     .map(|n| loss.tick((w(100.0) * n as f64).sin()))
+//!     .skip(24_000)
+//!     .fold(0.0f64, |m, y| m.max(y.abs()));
+//! assert!((peak - 0.99).abs() < 1e-3);
+//! let _ = Allpass1::new(a).tick(1.0);
+//! ```
 
 use std::f64::consts::PI;
 

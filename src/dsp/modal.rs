@@ -18,6 +18,23 @@
 //! | `Q` | quality factor (`r = 2 pi f m / Q`) | 1 |
 //! | `m` | modal mass | kg |
 //! | `w` | mode shape at the contact | 1 |
+//!
+//! ```
+//! use colophony::dsp::modal::{ModalObject, ModeSpec};
+//! let mode = ModeSpec { freq_hz: 660.0, q: 1000.0, mass_kg: 0.01, weight: 1.0 };
+//! let mut glass = ModalObject::new(&[mode], 48_000.0).unwrap();
+//! // A 1 N push for one sample (the trapezoid spreads it over two), then the glass
+//! // rings freely and loses energy.
+//! let tick = |glass: &mut ModalObject, force_n: f64| {
+//!     glass.begin(force_n);
+//!     glass.finish(0.0);
+//! };
+//! tick(&mut glass, 1.0);
+//! tick(&mut glass, 0.0);
+//! let struck = glass.energy_j();
+//! (0..4_800).for_each(|_| tick(&mut glass, 0.0));
+//! assert!(struck > 0.0 && glass.energy_j() < struck);
+//! ```
 
 use super::filters::flush_tiny;
 use super::friction::{BowInput, FrictionContact, LoadLine};

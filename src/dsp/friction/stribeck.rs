@@ -15,6 +15,18 @@
 //! |---|---|---|---|
 //! | `mu_s`, `mu_d` | static and dynamic coefficients | 1 | paper A: 0.4, 0.2 |
 //! | `v_s` | Stribeck velocity | m/s | paper A: 0.1 |
+//!
+//! ```
+//! use colophony::dsp::friction::stribeck::StribeckFriction;
+//! use colophony::dsp::friction::{BowInput, FrictionContact, LoadLine};
+//! let mut contact = StribeckFriction::default();
+//! let bow = BowInput { velocity_m_per_s: 0.1, normal_force_n: 1.0 };
+//! // The string would move 1 m/s against the bow: it slides, and the friction lies
+//! // between mu_d F_N and mu_s F_N, along the bow's motion.
+//! let load = LoadLine { free_velocity_m_per_s: -1.0, admittance_s_per_kg: 0.1 };
+//! let f = contact.solve(load, bow);
+//! assert!(f >= contact.mu_d * 1.0 && f <= contact.mu_s * 1.0);
+//! ```
 
 use super::{BowInput, FrictionContact, LoadLine};
 

@@ -56,6 +56,27 @@
 //! | `tau_b` | bulk cooling time | s |
 //! | `p_ref` | load per metre the heating is referred to | N/m |
 //! | `F_b` | bow force per unit length | N/m |
+//!
+//! ```
+//! use colophony::dsp::thermal::{
+//!     HairParams, ThermalBowControl, ThermalParams, ThermalString, ThermalStringSpec,
+//! };
+//! // Paper B's Figure 6 bow on the cello's open C, 10 hair nodes over 1 cm.
+//! let mut string = ThermalString::new(
+//!     ThermalStringSpec::cello_c(),
+//!     10,
+//!     0.01,
+//!     ThermalParams::default(),
+//!     HairParams::default(),
+//! )
+//! .unwrap();
+//! let bow = ThermalBowControl { velocity_m_per_s: 0.15, force_per_m: 300.0, position_beta: 0.07 };
+//! let fs = string.internal_rate_hz();
+//! let peak = (0..(0.1 * fs) as usize)
+//!     .map(|_| string.tick(bow).bridge_force_n.abs())
+//!     .fold(0.0, f64::max);
+//! assert!(peak > 0.0);
+//! ```
 
 use super::delay::split_loop;
 use super::filters::{Allpass1, OnePoleLoss};
