@@ -17,9 +17,9 @@
 //!
 //! | preset | Newton tolerance | thermal N_B | measured (docs/precision.md) |
 //! |---|---|---|---|
-//! | draft | 1e-2 m/s | 6 | cello D, elasto-plastic: attack waveform -10 dB against 1e-13, 1.7x faster than 1e-10; thermal Fig. 6 bow at beta 0.1: f0 +0.29 cents, harmonics 2.9 dB, attack -16 dB, 41x real time |
-//! | good | 1e-4 m/s | 10 | -49 dB (elasto-plastic), -84 dB (LuGre); thermal: f0 +0.03 cents, harmonics 0.3 dB, attack -17 dB, 27x |
-//! | reference | 1e-10 m/s | 60 | below -260 dB; thermal: f0 +0.01 cents, harmonics 0.3 dB, attack -35 dB, 5.1x |
+//! | draft | 1e-2 m/s | 6 | cello D, elasto-plastic: attack waveform -10 dB against 1e-13, 1.7x faster than 1e-10; thermal Fig. 6 bow at beta 0.1: f0 -0.6 cents, harmonics 0.4 dB, attack -13 dB, 40x real time (at Figure 6's beta 0.07 it double-slips) |
+//! | good | 1e-4 m/s | 10 | -49 dB (elasto-plastic), -84 dB (LuGre); thermal: f0 -0.2 to -0.4 cents, harmonics 0.2-0.5 dB, attack -16 dB, 26x |
+//! | reference | 1e-10 m/s | 60 | below -260 dB; thermal: f0 -0.02 to -0.04 cents, harmonics 0.02-0.06 dB, attack -31 dB, 5.0x |
 //! | auto | 1e-4 m/s | per note: [`auto_nodes`] | good's error at every note and bow position |
 //!
 //! `auto` keeps good's error target where the error grows: a slip lasts `beta / f0`
