@@ -252,7 +252,7 @@ pub struct Plan {
 const RATES_HZ: [f64; 6] = [22_050.0, 44_100.0, 48_000.0, 96_000.0, 192_000.0, 384_000.0];
 const REFERENCE_RATE_HZ: f64 = 768_000.0;
 const TOLERANCES_M_PER_S: [f64; 5] = [1e-2, 1e-4, 1e-6, 1e-8, 1e-10];
-const NODES: [usize; 8] = [3, 6, 10, 15, 20, 30, 40, 60];
+const NODES: [usize; 9] = [3, 6, 8, 10, 15, 20, 30, 40, 60];
 /// The waveguide's filter-order series: dispersion allpass sections at 48 kHz (the default
 /// is [`colophony::dsp::waveguide::DEFAULT_DISPERSION_STAGES`], the references use
 /// [`MAX_DISPERSION_STAGES`]).
