@@ -1307,6 +1307,21 @@ mod tests {
 
     const FS: f64 = 48_000.0;
 
+    /// `(start, length)` of the spans of at most `size` samples that cover
+    /// `0..marks.last()` without crossing a mark (an event's sample).
+    fn spans(marks: &[usize], size: usize) -> Vec<(usize, usize)> {
+        let end = marks.last().copied().unwrap_or(0);
+        let mut v = Vec::new();
+        let mut at = 0;
+        while at < end {
+            let next = marks.iter().copied().find(|&m| m > at).unwrap_or(end);
+            let n = size.min(next - at);
+            v.push((at, n));
+            at += n;
+        }
+        v
+    }
+
     fn cello() -> Performer {
         let setup = Setup::default();
         let mut p = Performer::new(InstrumentKind::Cello);
@@ -1808,15 +1823,11 @@ mod tests {
         for block in [1, 7, 64, 511, 700] {
             let mut p = cello();
             let mut got = Vec::new();
-            let mut at = 0;
-            while at < 48_000 {
+            for (at, n) in spans(&marks, block) {
                 events(&mut p, at);
-                let next = marks.iter().copied().find(|&m| m > at).unwrap_or(48_000);
-                let n = block.min(next - at);
                 let mut out = vec![0.0; n];
                 p.tick_block(bow, &mut out);
                 got.extend(out.iter().map(|x| x.to_bits()));
-                at += n;
             }
             assert_eq!(got, want, "blocks of {block}");
         }
@@ -1867,11 +1878,8 @@ mod tests {
         for run in [1, 7, 64, 511, 700] {
             let mut p = cello();
             let mut got = Vec::new();
-            let mut at = 0;
-            while at < 48_000 {
+            for (at, n) in spans(&marks, run) {
                 events(&mut p, at);
-                let next = marks.iter().copied().find(|&m| m > at).unwrap_or(48_000);
-                let n = run.min(next - at);
                 let mut k_next = at;
                 p.tick_run(
                     n,
@@ -1892,7 +1900,6 @@ mod tests {
                         );
                     },
                 );
-                at += n;
             }
             assert_eq!(got, want, "runs of {run}");
         }
