@@ -54,6 +54,9 @@ impl BowEnvelope {
     }
 }
 
+/// Ticks between two retunes of a gliding finger (1.3 ms at 48 kHz).
+pub const GLIDE_EVERY: u32 = 64;
+
 /// Notes, fingers and tuning of the four strings (see the module doc).
 #[derive(Debug, Clone)]
 pub struct Fingering {
@@ -63,8 +66,11 @@ pub struct Fingering {
     expressions: [NoteExpression; STRINGS],
     /// A finger glide under way: semitones still to go to the note (0: none).
     glides: [f64; STRINGS],
-    /// Semitones a glide moves per step ([`Fingering::advance_glides`]).
+    /// Semitones a glide moves per step ([`Fingering::glide_tick`]).
     glide_steps: [f64; STRINGS],
+    /// Whether a finger glides, and the ticks to its next step.
+    gliding: bool,
+    glide_countdown: u32,
     /// The string the player asks notes to go to (0 = lowest), `None` for the usual choice.
     preferred_string: Option<usize>,
     bend_semitones: f64,
@@ -86,6 +92,8 @@ impl Fingering {
             expressions: [NoteExpression::NEUTRAL; STRINGS],
             glides: [0.0; STRINGS],
             glide_steps: [0.0; STRINGS],
+            gliding: false,
+            glide_countdown: 0,
             preferred_string: None,
             bend_semitones: 0.0,
             reference_semitones: 0.0,
@@ -105,6 +113,7 @@ impl Fingering {
     pub fn release_all(&mut self) {
         self.notes = [None; STRINGS];
         self.glides = [0.0; STRINGS];
+        self.gliding = false;
     }
 
     /// The string a new note goes to ([`InstrumentKind::string_for_note_on`], with the
@@ -127,12 +136,34 @@ impl Fingering {
     }
 
     /// `string`'s note becomes `note` with the finger `glide` semitones away from it,
-    /// keeping the note's expression (a legato glide), to arrive in `steps` calls of
-    /// [`Fingering::advance_glides`] (at least one).
-    pub fn glide_to(&mut self, string: usize, note: u8, glide: f64, steps: f64) {
+    /// keeping the note's expression (a legato glide), to arrive after `glide_s` seconds of
+    /// [`Fingering::glide_tick`] called at `rate_hz` (linearly in semitones, a step every
+    /// [`GLIDE_EVERY`] ticks).
+    pub fn glide_to(&mut self, string: usize, note: u8, glide: f64, glide_s: f64, rate_hz: f64) {
+        let steps = (glide_s * rate_hz / GLIDE_EVERY as f64).max(1.0);
         self.notes[string] = Some(note);
         self.glides[string] = glide;
-        self.glide_steps[string] = glide.abs() / steps.max(1.0);
+        self.glide_steps[string] = glide.abs() / steps;
+        self.gliding = glide != 0.0;
+        self.glide_countdown = 0;
+    }
+
+    /// One tick of the instrument (a sample at the rate given to
+    /// [`Fingering::glide_to`]): every [`GLIDE_EVERY`] ticks while a finger glides, moves
+    /// every gliding finger one step and returns the pitch (Hz) each string that moved and
+    /// holds a note should now be tuned to.
+    #[inline]
+    pub fn glide_tick(&mut self) -> Option<[Option<f64>; STRINGS]> {
+        if !self.gliding {
+            return None;
+        }
+        let due = self.glide_countdown == 0;
+        let retune = due.then(|| {
+            self.glide_countdown = GLIDE_EVERY;
+            self.advance_glides()
+        });
+        self.glide_countdown -= 1;
+        retune
     }
 
     /// The note on `string`, if any.
@@ -146,9 +177,8 @@ impl Fingering {
     }
 
     /// Moves every gliding finger one step toward its note. Returns the pitch (Hz) each
-    /// string that moved and holds a note should now be tuned to, and whether any finger
-    /// still glides.
-    pub fn advance_glides(&mut self) -> ([Option<f64>; STRINGS], bool) {
+    /// string that moved and holds a note should now be tuned to.
+    fn advance_glides(&mut self) -> [Option<f64>; STRINGS] {
         let mut retune = [None; STRINGS];
         let mut any = false;
         for i in 0..STRINGS {
@@ -167,7 +197,8 @@ impl Fingering {
                 retune[i] = Some(self.tuned_hz(i));
             }
         }
-        (retune, any)
+        self.gliding = any;
+        retune
     }
 
     /// `string`'s note expression.
@@ -206,6 +237,7 @@ impl Fingering {
         for i in 0..STRINGS {
             self.clear_string(i);
         }
+        self.gliding = false;
     }
 
     /// The reference pitch's offset from A4 = 440 Hz, semitones.

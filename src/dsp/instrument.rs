@@ -313,9 +313,6 @@ struct StringVoice {
     expressive: bool,
 }
 
-/// Samples between two retunes of a gliding finger (1.3 ms at 48 kHz).
-const GLIDE_EVERY: u32 = 64;
-
 #[derive(Debug, Clone)]
 pub struct Instrument {
     kind: InstrumentKind,
@@ -336,9 +333,6 @@ pub struct Instrument {
     /// Each instrument's body in place of the generic one ([`Instrument::set_body`]):
     /// modes and their count, per [`InstrumentKind::ALL`] index.
     custom_bodies: [Option<([BodyMode; MAX_BODY_MODES], usize)>; 3],
-    /// Whether a finger glides, and the samples to its next step.
-    gliding: bool,
-    glide_countdown: u32,
     probed: usize,
     ramp_step: f64,
     output_scale: f64,
@@ -411,8 +405,6 @@ impl Instrument {
             resampler: None,
             last: Frame::default(),
             voices,
-            gliding: false,
-            glide_countdown: 0,
             fingering: Fingering::new(
                 kind,
                 Some(intonation::model_index(FrictionModel::Hyperbolic.name())),
@@ -506,7 +498,6 @@ impl Instrument {
             voice.awake = false;
         }
         self.fingering.release_all();
-        self.gliding = false;
         self.body.reset();
         if let Some(r) = &mut self.resampler {
             r.reset();
@@ -531,7 +522,7 @@ impl Instrument {
 
     /// A legato note that slides the finger (portamento): on a string already bowed with
     /// another note, the stopping point glides from that note's place to this one over
-    /// `glide_s` seconds (linearly in semitones, retuned every [`GLIDE_EVERY`] samples);
+    /// `glide_s` seconds (linearly in semitones, retuned every [`GLIDE_EVERY`](super::fingering::GLIDE_EVERY) samples);
     /// otherwise, or with `glide_s` not positive, as [`Instrument::note_on`].
     pub fn note_on_gliding(&mut self, note: u8, glide_s: f64) -> Option<usize> {
         let index = self.fingering.string_for_note_on(note)?;
@@ -543,25 +534,12 @@ impl Instrument {
             _ => return self.note_on(note),
         };
         let distance = from - note as f64;
-        let steps = (glide_s * self.sample_rate_hz / GLIDE_EVERY as f64).max(1.0);
-        self.fingering.glide_to(index, note, distance, steps);
+        self.fingering
+            .glide_to(index, note, distance, glide_s, self.sample_rate_hz);
         self.probed = index;
-        self.gliding = distance != 0.0;
-        self.glide_countdown = 0;
         let hz = self.fingering.tuned_hz(index);
         self.voices[index].string.bend_to(hz);
         Some(index)
-    }
-
-    /// Moves every gliding finger one step toward its note.
-    fn advance_glides(&mut self) {
-        let (retune, any) = self.fingering.advance_glides();
-        for (voice, hz) in self.voices.iter_mut().zip(retune) {
-            if let Some(hz) = hz {
-                voice.string.bend_to(hz);
-            }
-        }
-        self.gliding = any;
     }
 
     /// Lifts the bow from the string playing `note`, if any.
@@ -759,12 +737,12 @@ impl Instrument {
         let mut frame = Frame::default();
         let skipping = self.skipping;
         self.body_asleep = false;
-        if self.gliding {
-            if self.glide_countdown == 0 {
-                self.glide_countdown = GLIDE_EVERY;
-                self.advance_glides();
+        if let Some(retune) = self.fingering.glide_tick() {
+            for (voice, hz) in self.voices.iter_mut().zip(retune) {
+                if let Some(hz) = hz {
+                    voice.string.bend_to(hz);
+                }
             }
-            self.glide_countdown -= 1;
         }
         for (i, voice) in self.voices.iter_mut().enumerate() {
             if !voice.awake && skipping {

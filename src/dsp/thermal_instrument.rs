@@ -215,14 +215,7 @@ pub struct ThermalInstrument {
     recoveries: u64,
     /// The rate [`ThermalInstrument::tick`] is called at, Hz.
     host_rate_hz: f64,
-    /// Whether a finger glides, and the host samples to its next step.
-    gliding: bool,
-    glide_countdown: u32,
 }
-
-/// Host samples between two retunes of a gliding finger (1.3 ms at 48 kHz), as the
-/// waveguide instrument's.
-const GLIDE_EVERY: u32 = 64;
 
 impl ThermalInstrument {
     /// Allocates for every setting within the limits ([`MAX_NODES`], [`MIN_WIDTH_M`]) and
@@ -321,8 +314,6 @@ impl ThermalInstrument {
             wide_simd: super::detect_wide_simd(),
             recoveries: 0,
             host_rate_hz,
-            gliding: false,
-            glide_countdown: 0,
         };
         instrument
             .apply_settings(settings)
@@ -466,7 +457,7 @@ impl ThermalInstrument {
 
     /// As [`ThermalInstrument::note_on`], but where the note's string is bowed with
     /// another note the stopping point glides from that note's place to this one over
-    /// `glide_s` seconds (linearly in semitones, retuned every [`GLIDE_EVERY`] host
+    /// `glide_s` seconds (linearly in semitones, retuned every [`GLIDE_EVERY`](super::fingering::GLIDE_EVERY) host
     /// samples), as the waveguide instrument's finger does; otherwise, or with `glide_s`
     /// not positive, as [`ThermalInstrument::note_on`].
     pub fn note_on_gliding(&mut self, note: u8, glide_s: f64) -> Option<usize> {
@@ -484,29 +475,14 @@ impl ThermalInstrument {
             _ => return self.note_on(note),
         };
         let distance = from - note as f64;
-        let steps = (glide_s * self.host_rate_hz / GLIDE_EVERY as f64).max(1.0);
-        self.fingering.glide_to(index, note, distance, steps);
+        self.fingering
+            .glide_to(index, note, distance, glide_s, self.host_rate_hz);
         self.core.probed = index;
-        self.gliding = distance != 0.0;
-        self.glide_countdown = 0;
         let f0 = self.fingering.tuned_hz(index);
         if !self.tune(index, f0) {
             self.bows[index].bowed = false;
         }
         Some(index)
-    }
-
-    /// Moves every gliding finger one step toward its note.
-    fn advance_glides(&mut self) {
-        let (retune, any) = self.fingering.advance_glides();
-        for (i, hz) in retune.into_iter().enumerate() {
-            if let Some(f0) = hz {
-                if !self.tune(i, f0) {
-                    self.bows[i].bowed = false;
-                }
-            }
-        }
-        self.gliding = any;
     }
 
     /// Lifts the bow from the string playing `note`, if any.
@@ -586,7 +562,6 @@ impl ThermalInstrument {
         self.resampler.reset();
         self.bows = [BowEnvelope::default(); STRINGS];
         self.fingering.clear();
-        self.gliding = false;
         self.core.probe = (0.0, 0.0);
         self.awake = false;
     }
@@ -681,12 +656,14 @@ impl ThermalInstrument {
                 return Frame::default();
             }
         }
-        if self.gliding {
-            if self.glide_countdown == 0 {
-                self.glide_countdown = GLIDE_EVERY;
-                self.advance_glides();
+        if let Some(retune) = self.fingering.glide_tick() {
+            for (i, hz) in retune.into_iter().enumerate() {
+                if let Some(f0) = hz {
+                    if !self.tune(i, f0) {
+                        self.bows[i].bowed = false;
+                    }
+                }
             }
-            self.glide_countdown -= 1;
         }
         let force_per_m = bow.force_n.max(0.0) / self.contact_width_m;
         for (i, (envelope, control)) in self
