@@ -826,14 +826,6 @@ impl Instrument {
         }
     }
 
-    /// Lets the bow hair yield (the default) or ties the contact rigidly to the bow
-    /// ([`WaveguideString::set_bow_hair`]).
-    pub fn set_bow_hair(&mut self, enabled: bool) {
-        for voice in &mut self.voices {
-            voice.string.set_bow_hair(enabled);
-        }
-    }
-
     /// Replaces the bristle parameters of every string (validated; real-time safe).
     pub fn set_bristle_params(&mut self, params: BristleParams) -> Result<(), String> {
         for voice in &mut self.voices {
