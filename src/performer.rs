@@ -1323,10 +1323,14 @@ mod tests {
     }
 
     fn cello() -> Performer {
-        let setup = Setup::default();
+        cello_with(&Setup::default())
+    }
+
+    /// A cello performer activated at `FS` and configured with `setup`.
+    fn cello_with(setup: &Setup) -> Performer {
         let mut p = Performer::new(InstrumentKind::Cello);
-        p.activate(&setup, FS).unwrap();
-        p.configure(&setup);
+        p.activate(setup, FS).unwrap();
+        p.configure(setup);
         p
     }
 
@@ -1482,9 +1486,7 @@ mod tests {
             dynamics_guard: false,
             ..Setup::default()
         };
-        let mut p = Performer::new(InstrumentKind::Cello);
-        p.activate(&setup, FS).unwrap();
-        p.configure(&setup);
+        let mut p = cello_with(&setup);
         p.set_controller(11, 0.25);
         p.note_on(50, 0.8);
         let bow = BowControl::default();
@@ -2011,9 +2013,7 @@ mod tests {
             point_law: None,
             ..Setup::default()
         };
-        let mut p = Performer::new(InstrumentKind::Cello);
-        p.activate(&setup, FS).unwrap();
-        p.configure(&setup);
+        let mut p = cello_with(&setup);
         let bow = BowControl::default();
         let tuned = |p: &Performer| {
             p.thermal(InstrumentKind::Cello)
@@ -2059,9 +2059,7 @@ mod tests {
                 preferred_string: Some(string),
                 ..Setup::default()
             };
-            let mut p = Performer::new(InstrumentKind::Cello);
-            p.activate(&setup, FS).unwrap();
-            p.configure(&setup);
+            let mut p = cello_with(&setup);
             p.note_on(note, 0.8);
             p.strings().string(string).fundamental_hz()
         };
