@@ -15,6 +15,7 @@
 //! | `quality` | Quality | - | draft, good, reference, auto, custom | good |
 //! | `reference_pitch` | Reference Pitch | Hz (A4) | 415 .. 466 | 440 |
 //! | `dynamics_guard` | Dynamics Guard | - | off, on (the dynamics keep the bow in Schelleng's window) | on |
+//! | `string_weight` | String Weight | - | off, on (each string bowed with the force times its impedance over 0.25 kg/s) | on |
 
 use crate::dsp::friction::FrictionModel;
 use crate::dsp::instrument::InstrumentKind;
@@ -242,6 +243,9 @@ pub struct ColophonyParams {
     pub vibrato_rate: FloatParam,
     #[id = "dynamics_guard"]
     pub dynamics_guard: BoolParam,
+    /// The point-bow strings weighted by their impedance ([`crate::performer::Setup`]).
+    #[id = "string_weight"]
+    pub string_weight: BoolParam,
     /// The editor window's size, saved with the plugin state (not a parameter).
     #[persist = "editor-state"]
     pub editor_state: crate::editor_state::EditorState,
@@ -391,6 +395,8 @@ impl Default for ColophonyParams {
             .with_value_to_string(formatters::v2s_f32_rounded(2)),
             // Read once per block.
             dynamics_guard: BoolParam::new("Dynamics Guard", true),
+            // Read once per block.
+            string_weight: BoolParam::new("String Weight", true),
             editor_state: Default::default(),
             user_bridges: Default::default(),
             state_version: crate::presets::StateVersion,
@@ -430,6 +436,7 @@ impl ColophonyParams {
             glide_s: self.glide_time_ms.value() as f64 * 1e-3,
             vibrato_rate_hz: self.vibrato_rate.value() as f64,
             dynamics_guard: self.dynamics_guard.value(),
+            string_weight: self.string_weight.value(),
         }
     }
 

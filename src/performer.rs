@@ -163,6 +163,11 @@ pub struct Setup {
     /// Schelleng's window. Off, they scale the velocity alone: a soft dynamic under the
     /// parameters' force presses a slow bow too hard (raucous).
     pub dynamics_guard: bool,
+    /// The strings weighted (on by default): the point-bow strings are bowed with the
+    /// force times their impedance over [`crate::dsp::instrument::WEIGHT_REFERENCE_Z0`],
+    /// so one force keeps its place in every string's window. Off, every string gets the
+    /// force as set. Paper B's thermal model and the rubbed objects take the force as set.
+    pub string_weight: bool,
 }
 
 impl Default for Setup {
@@ -182,6 +187,7 @@ impl Default for Setup {
             glide_s: GLIDE_S_DEFAULT,
             vibrato_rate_hz: VIBRATO_RATE_HZ,
             dynamics_guard: true,
+            string_weight: true,
         }
     }
 }
@@ -476,6 +482,7 @@ impl Performer {
             self.instrument.set_friction_model(friction);
             self.rubbed.set_friction_model(friction);
         }
+        self.instrument.set_string_weighting(setup.string_weight);
         self.instrument
             .set_newton_tolerance(setup.newton_tolerance_m_per_s);
         self.rubbed

@@ -33,7 +33,7 @@
 //! let preset = presets::find("cello-legato").unwrap();
 //! let params = ColophonyParams::default();
 //! preset.apply_to(&params).unwrap();
-//! assert_eq!(params.bow_force.value(), 1.5);
+//! assert_eq!(params.bow_force.value(), 0.59);
 //! ```
 
 use crate::params::ColophonyParams;
@@ -45,7 +45,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// The version of the plugin state this build writes.
-pub const STATE_VERSION: u32 = 1;
+pub const STATE_VERSION: u32 = 2;
 /// The persisted field that holds it.
 pub const STATE_VERSION_FIELD: &str = "state-version";
 
@@ -433,6 +433,8 @@ pub fn find(what: &str) -> Result<Preset, String> {
 /// Brings a saved plugin state up to [`STATE_VERSION`] before its values are loaded (the
 /// plugin's `filter_state`):
 /// - version 0 -> 1: no parameter was renamed or re-ranged; the version is recorded.
+/// - version 1 -> 2: String Weight (new, on by default) is set off where the state does
+///   not hold it, so a project saved before it plays as it did.
 /// - any version: a float that is not finite (a damaged file) is dropped, so the
 ///   parameter keeps its value instead of becoming NaN; a number outside its
 ///   parameter's range is brought to the range's end.
@@ -468,6 +470,12 @@ pub fn migrate_state(state: &mut PluginState) {
         }
     }
     let version = state_version(state);
+    if version < 2 {
+        state
+            .params
+            .entry("string_weight".into())
+            .or_insert(ParamValue::Bool(false));
+    }
     if version < STATE_VERSION {
         state
             .fields

@@ -360,9 +360,12 @@ fn the_schelleng_numbers_follow_the_note_the_audio_thread_reports() {
     let mut f = fixture();
     let link = f.link.clone();
     let mut h = harness(&mut f.editor);
-    // No note yet: cello D (Z0 0.506 kg/s); F_max at 0.1 m/s and beta 0.1 is 5.06 N.
+    // No note yet: cello D (Z0 0.506 kg/s); F_max at 0.1 m/s and beta 0.1 is 5.06 N on
+    // the string, which String Weight (on) bows with 0.506 / 0.2 = 2.53 times the force
+    // parameter: the window shows the parameter's 2.000 N.
     assert_shows(&h, "0.506 kg/s");
-    assert_shows(&h, "5.060 N");
+    assert_shows(&h, "2.000 N");
+    assert_shows(&h, "x 2.53 (the force below is the parameter's)");
     assert_shows(&h, "D3 (no note yet), 146.8 Hz");
     // The strings took G2 (the G string, Z0 0.833 kg/s).
     link.set_note(Some(43));

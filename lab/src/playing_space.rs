@@ -5,7 +5,9 @@
 //! **Cells.** For each model (the four point laws on the waveguide instrument, paper B's
 //! thermal instrument with its modal bridge), instrument, note (from the lowest open string
 //! to two octaves above the highest) and host rate, the note is bowed with:
-//! - `defaults`: the plugin's default bow (0.1 m/s, 1 N, beta 0.1);
+//! - `defaults`: the plugin's default bow (0.1 m/s, 1 N, beta 0.1), on the point laws'
+//!   strings times the string's weight as the plugin plays it (String Weight on:
+//!   [`InstrumentKind::string_weight`]);
 //! - `middle`: beta 0.1 and the geometric middle `sqrt(F_min F_max)` of the note's window;
 //! - the grid: beta 0.05, 0.08, 0.12, 0.18, each at `2 F_min`, `sqrt(F_min F_max)` and
 //!   `F_max / 2`.
@@ -207,7 +209,11 @@ impl Cell {
         }
         let (f_min, f_max) = (window.min_force_n(v), window.max_force_n(v));
         let force = match bowing {
-            Bowing::Defaults => 1.0,
+            // The plugin weights the point-bow strings by default; not the thermal model.
+            Bowing::Defaults => match model {
+                Model::Point(_) => kind.string_weight(index),
+                Model::Thermal => 1.0,
+            },
             Bowing::Middle | Bowing::Centre(_) => (f_min * f_max).sqrt(),
             Bowing::TwiceMin(_) => 2.0 * f_min,
             Bowing::HalfMax(_) => 0.5 * f_max,

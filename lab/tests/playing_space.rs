@@ -250,3 +250,39 @@ fn inside_the_window_every_model_is_in_helmholtz_motion() {
         wrong.join("\n")
     );
 }
+
+/// Weighted strings (docs/playing-space.md, "Weighted strings"): at the plugin's defaults
+/// the cello's G and D strings, bowed with 1 N times their impedance over 0.2 kg/s (4.2 and
+/// 2.5 N), settle into Helmholtz motion by 0.3 s on most semitones, where 1 N on each
+/// (`F_max / 8` and `F_max / 5`) leaves them slipping several times a period. Measured on
+/// this build: 11 of 14 weighted against none unweighted (hyperbolic, 48 kHz). The bounds
+/// ask for the size of that, with room for the chaotic attacks to flip a few notes either
+/// way: at least half weighted, and at least four more than unweighted.
+#[test]
+fn weighted_strings_settle_the_cellos_middle_strings_at_the_defaults() {
+    let kind = InstrumentKind::Cello;
+    let model = Model::Point(colophony::dsp::friction::FrictionModel::Hyperbolic);
+    let mut weighted = Vec::new();
+    let mut bare = Vec::new();
+    for note in 43..=56u8 {
+        let cell = Cell::new(model, kind, note, 48_000.0, Bowing::Defaults, 0.6);
+        assert!(cell.bow.force_n > 2.0, "the defaults cell is weighted");
+        weighted.push(cell);
+        bare.push(Cell {
+            bow: colophony::dsp::instrument::BowControl {
+                force_n: 1.0,
+                ..cell.bow
+            },
+            ..cell
+        });
+    }
+    let count = |cells: &[Cell]| {
+        measure_all(cells)
+            .iter()
+            .filter(|(_, m)| m.helmholtz)
+            .count()
+    };
+    let (w, b) = (count(&weighted), count(&bare));
+    println!("Helmholtz by 0.3 s: weighted {w} of 14, 1 N on every string {b} of 14");
+    assert!(w >= 7 && w >= b + 4, "weighted {w}, unweighted {b} of 14");
+}

@@ -159,6 +159,16 @@ impl InstrumentKind {
         })
     }
 
+    /// What the bow force is multiplied by on string `index` when the strings are weighted
+    /// ([`Instrument::set_string_weighting`]): the string's impedance over
+    /// [`WEIGHT_REFERENCE_Z0`]. Schelleng's limits are both proportional to `Z0` (with the
+    /// dashpot bridge `R = 2 Q1 Z0 / pi`, docs/parameters.md), so one force parameter then
+    /// keeps the same place in every string's window, as a player leans into the heavy
+    /// strings.
+    pub fn string_weight(self, index: usize) -> f64 {
+        self.strings()[index.min(STRINGS - 1)].z0_kg_per_s / WEIGHT_REFERENCE_Z0
+    }
+
     /// Output scale: bridge force to a sample value, so that a default note of any
     /// instrument peaks near -12 dBFS.
     pub fn output_scale_per_n(self) -> f64 {
@@ -297,6 +307,14 @@ impl NoteExpression {
 
 /// The widest per-note bend, semitones: MPE's default member-channel range.
 pub const MAX_NOTE_BEND_SEMITONES: f64 = 48.0;
+/// The impedance of the string the force parameter is the force on when the strings are
+/// weighted, kg/s: about the violin's A string (0.203), so the default 1 N is 1 N there.
+/// Chosen by measurement (docs/playing-space.md, "Weighted strings"): from 0.5 down to
+/// 0.15 kg/s, the lower the reference (the more force on every string), the more notes
+/// settle into Helmholtz motion at the defaults; 0.2 doubles them against no weighting
+/// while keeping the violin's strings near the forces players use (0.9-1.8 N).
+pub const WEIGHT_REFERENCE_Z0: f64 = 0.2;
+
 /// The most a note's pressure may multiply its string's bow force.
 pub const MAX_NOTE_FORCE_SCALE: f64 = 4.0;
 /// A note's own bow position stays within the Bow Position parameter's range.
@@ -311,6 +329,8 @@ struct StringVoice {
     awake: bool,
     /// Whether the note's expression is not neutral (one test per sample instead of three).
     expressive: bool,
+    /// The bow force's factor on this string: 1, or [`InstrumentKind::string_weight`].
+    weight: f64,
 }
 
 #[derive(Debug, Clone)]
@@ -342,6 +362,8 @@ pub struct Instrument {
     body_asleep: bool,
     /// Times the non-finite guard in [`Instrument::tick`] reset the instrument.
     recoveries: u64,
+    /// Whether the bow force is weighted per string ([`Instrument::set_string_weighting`]).
+    weighted: bool,
 }
 
 impl Instrument {
@@ -397,6 +419,7 @@ impl Instrument {
             bow: BowEnvelope::default(),
             awake: false,
             expressive: false,
+            weight: 1.0,
         });
         Self {
             kind,
@@ -417,6 +440,31 @@ impl Instrument {
             skipping: true,
             body_asleep: true,
             recoveries: 0,
+            weighted: false,
+        }
+    }
+
+    /// Weights the bow force per string (on: string `i` is bowed with the force times
+    /// [`InstrumentKind::string_weight`]`(i)`; off, the default: every string gets the
+    /// force as given, the bare model the tools measure). The performer turns it on for
+    /// the player (the String Weight parameter). Real-time safe.
+    pub fn set_string_weighting(&mut self, on: bool) {
+        self.weighted = on;
+        self.update_weights();
+    }
+
+    /// Whether the bow force is weighted per string.
+    pub fn string_weighting(&self) -> bool {
+        self.weighted
+    }
+
+    fn update_weights(&mut self) {
+        for (i, voice) in self.voices.iter_mut().enumerate() {
+            voice.weight = if self.weighted {
+                self.kind.string_weight(i)
+            } else {
+                1.0
+            };
         }
     }
 
@@ -455,6 +503,7 @@ impl Instrument {
         }
         self.body = self.body_of(kind);
         self.output_scale = kind.output_scale_per_n();
+        self.update_weights();
     }
 
     /// Plays `kind`'s body as `modes` (at most [`MAX_BODY_MODES`]; a fitted bridge's
@@ -750,11 +799,11 @@ impl Instrument {
             }
             let bow_gain = voice.bow.advance(self.ramp_step);
             let (force, beta) = if !voice.expressive {
-                (bow.force_n, bow.position_beta)
+                (bow.force_n * voice.weight, bow.position_beta)
             } else {
                 let e = self.fingering.expression(i);
                 (
-                    bow.force_n * e.force_scale,
+                    bow.force_n * voice.weight * e.force_scale,
                     (bow.position_beta * e.position_scale).clamp(MIN_NOTE_BETA, MAX_NOTE_BETA),
                 )
             };
@@ -992,5 +1041,41 @@ mod tests {
         assert_eq!(cello.note_on(57), Some(1));
         cello.set_preferred_string(None);
         assert_eq!(cello.note_on(57), Some(3));
+    }
+
+    /// Weighted, each string is bowed with the force times its weight: a weighted note at
+    /// 1 N renders the same bits as the bare string at the weight in newtons, on every
+    /// string, and switching the instrument keeps the weighting (the violin's weights).
+    #[test]
+    fn a_weighted_string_is_bowed_with_the_force_times_its_impedance_ratio() {
+        let render = |kind: InstrumentKind, note: u8, weighted: bool, force_n: f64| {
+            let mut i = Instrument::new(InstrumentKind::Cello, 48_000.0);
+            i.set_string_weighting(weighted);
+            i.set_kind(kind);
+            i.note_on(note);
+            let bow = BowControl {
+                force_n,
+                ..BowControl::default()
+            };
+            (0..4800)
+                .map(|_| i.tick(bow).audio.to_bits())
+                .collect::<Vec<_>>()
+        };
+        for kind in [InstrumentKind::Cello, InstrumentKind::Violin] {
+            for (s, note) in kind.open_notes().into_iter().enumerate() {
+                let w = kind.string_weight(s);
+                // Z0 / 0.2 kg/s: between 0.87 (violin E) and 9.6 (cello C).
+                assert!((0.8..10.0).contains(&w), "{kind:?} string {s}: {w}");
+                assert_eq!(
+                    render(kind, note, true, 1.0),
+                    render(kind, note, false, w),
+                    "{kind:?} string {s}"
+                );
+                assert_ne!(
+                    render(kind, note, true, 1.0),
+                    render(kind, note, false, 1.0)
+                );
+            }
+        }
     }
 }

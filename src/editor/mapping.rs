@@ -166,6 +166,17 @@ impl SchellengWindow {
         }
     }
 
+    /// The window in units of the force parameter when the string is bowed with `weight`
+    /// times it ([`crate::dsp::instrument::InstrumentKind::string_weight`]): both limits
+    /// divided by `weight` (Z0 and R divided by it).
+    pub fn seen_through_weight(self, weight: f64) -> Self {
+        Self {
+            z0_kg_per_s: self.z0_kg_per_s / weight,
+            bridge_r_kg_per_s: self.bridge_r_kg_per_s / weight,
+            ..self
+        }
+    }
+
     /// Maximum bow force for Helmholtz motion, N: `2 Z0 |v_b| / (beta (mu_s - mu_d))`.
     pub fn max_force_n(&self, v_b: f64) -> f64 {
         2.0 * self.z0_kg_per_s * v_b.abs() / (self.beta * (self.mu_s - self.mu_d))

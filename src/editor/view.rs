@@ -164,6 +164,11 @@ impl EditorUi {
                 ..window
             });
         }
+        // Weighted strings: the window in the force parameter's units (the string is
+        // bowed with the parameter times its weight).
+        if self.params.string_weight.value() {
+            return Some(window.seen_through_weight(kind.string_weight(string)));
+        }
         Some(window)
     }
 
@@ -401,7 +406,11 @@ impl EditorUi {
         ui.label(RichText::new("Schelleng window").strong());
         let kind: InstrumentKind = p.instrument.value().into();
         let note = self.window_note(kind);
-        let open = kind.open_notes()[self.window_string(kind, note)];
+        let string = self.window_string(kind, note);
+        let open = kind.open_notes()[string];
+        // The string's own impedance and bridge resistance; the limits below are in the
+        // force parameter's units, divided by the string's weight where it is weighted.
+        let weight = w.z0_kg_per_s.recip() * kind.strings()[string].z0_kg_per_s;
         let heard = if self.link.note().is_some() {
             "last note"
         } else {
@@ -425,11 +434,21 @@ impl EditorUi {
                 ui.label(format!("{} string", pitch_class(open)));
                 ui.end_row();
                 ui.label("Z0");
-                ui.label(format!("{:.3} kg/s", w.z0_kg_per_s));
+                ui.label(format!("{:.3} kg/s", w.z0_kg_per_s * weight));
                 ui.end_row();
                 ui.label("Bridge R");
-                ui.label(format!("{:.0} kg/s (2 Q1 Z0 / pi)", w.bridge_r_kg_per_s));
+                ui.label(format!(
+                    "{:.0} kg/s (2 Q1 Z0 / pi)",
+                    w.bridge_r_kg_per_s * weight
+                ));
                 ui.end_row();
+                if (weight - 1.0).abs() > 1e-9 {
+                    ui.label("String weight");
+                    ui.label(format!(
+                        "x {weight:.2} (the force below is the parameter's)"
+                    ));
+                    ui.end_row();
+                }
                 ui.label("mu_s, mu_d");
                 ui.label(format!("{:.2}, {:.2}", w.mu_s, w.mu_d));
                 ui.end_row();
