@@ -1487,8 +1487,10 @@ mod tests {
     fn without_the_window_guard_a_soft_dynamic_under_a_heavy_bow_turns_raucous() {
         // Expression 0.25 is 22.5 dB down: with the guard the force follows the velocity
         // (Helmholtz, the test below); without it a bow 13x slower under the full 1 N
-        // presses about three times Schelleng's F_max for cello D3 and loses the single
-        // slip per period.
+        // presses about three times Schelleng's F_max for cello D3 and loses Helmholtz
+        // motion: either more than one slip per period, or (with the bow hair yielding,
+        // which at this slow bow takes up much of the force's swing) one short slip whose
+        // slip fraction is far from beta (Raman: it equals beta; the map's 15 %).
         let setup = Setup {
             dynamics_guard: false,
             ..Setup::default()
@@ -1511,8 +1513,19 @@ mod tests {
         assert_eq!(played.position_beta, 0.1, "no drift without the guard");
         let f0 = midi_to_hz(50.0);
         let window = 8 * (FS / f0) as usize;
-        let regime = classify_regime(&probe[n - window..], FS as f32, f0 as f32);
-        assert_ne!(regime, Some(Regime::Helmholtz));
+        let tail = &probe[n - window..];
+        let regime = classify_regime(tail, FS as f32, f0 as f32);
+        let v: Vec<f64> = tail.iter().map(|s| s.string_velocity as f64).collect();
+        let v_b = played.velocity_m_per_s;
+        let stats = crate::analysis::slip_stats(&v, v_b, FS, f0, 0.05 * v_b);
+        let beta = played.position_beta;
+        let helmholtz =
+            regime == Some(Regime::Helmholtz) && (stats.slip_fraction - beta).abs() <= 0.15 * beta;
+        println!(
+            "{regime:?}, slip fraction {:.3} (beta {beta})",
+            stats.slip_fraction
+        );
+        assert!(!helmholtz, "{regime:?}, {stats:?}");
     }
 
     #[test]

@@ -74,8 +74,10 @@ pub fn serafin_fig7(out: &Path) -> Result<String, String> {
         sample_rate_hz: fs,
         friction: FrictionModel::ElastoPlastic,
         bristle: BristleParams::waveguide_string(),
-        // Paper A's string is purely transverse, tuned by its free decay.
+        // Paper A's string is purely transverse, bowed by a rigid point, tuned by its free
+        // decay.
         torsion: false,
+        bow_hair: false,
         intonation: false,
         ..RenderSettings::default()
     };

@@ -34,6 +34,9 @@ pub struct RenderSettings {
     /// Whether the bow feels the string's torsion (the plugin's string; off for paper A's
     /// purely transverse string).
     pub torsion: bool,
+    /// Whether the bow hair yields in the bowing direction (the plugin's bow; off for paper
+    /// A's rigid point contact).
+    pub bow_hair: bool,
     /// Whether notes are tuned by the bowed sound (the plugin's tuning,
     /// [`colophony::dsp::intonation`]); off, by the free decay (paper A's string).
     pub intonation: bool,
@@ -56,6 +59,7 @@ impl Default for RenderSettings {
             bristle: BristleParams::waveguide_string(),
             reference_hz: colophony::dsp::instrument::REFERENCE_HZ_DEFAULT,
             torsion: true,
+            bow_hair: true,
             intonation: true,
             native_rate: false,
         }
@@ -221,6 +225,7 @@ pub fn render_frames(
         .map_err(RenderError::BadSetting)?;
     instrument.set_friction_model(settings.friction);
     instrument.set_torsion(settings.torsion);
+    instrument.set_bow_hair(settings.bow_hair);
     instrument.set_intonation(
         settings
             .intonation

@@ -71,8 +71,12 @@ fn helmholtz_slip_fraction_equals_beta_with_one_slip_per_period() {
 fn corner_rounding_shrinks_as_bow_force_rises() {
     // Cremer: the losses round the Helmholtz corner, the friction force sharpens it at each
     // slip; more force, sharper corners, so the strict slip time falls toward beta.
+    // From 1 N (F_max / 5 on cello D3): at 0.5 N (F_max / 10) the string with the bow
+    // hair and the intonation table of 2026-11-25 still slips 1.23 times a period after
+    // 1.5 s (docs/playing-space.md: below about F_max / 6 the point bow settles late or
+    // not at all), so the corners there are not Helmholtz corners.
     let base = settings(InstrumentKind::Cello, 50).bow;
-    let strict: Vec<(f64, f64)> = [0.5, 1.0, 2.0, 3.0]
+    let strict: Vec<(f64, f64)> = [1.0, 2.0, 3.0]
         .into_iter()
         .map(|force_n| {
             let stats = cello_d3_slips(BowControl { force_n, ..base });

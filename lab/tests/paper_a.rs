@@ -24,8 +24,10 @@ fn cello_d(friction: FrictionModel, seconds: f64) -> RenderSettings {
         },
         sample_rate_hz: FS,
         friction,
-        // Paper A's string is purely transverse, tuned by its free decay.
+        // Paper A's string is purely transverse, bowed by a rigid point, tuned by its free
+        // decay.
         torsion: false,
+        bow_hair: false,
         intonation: false,
         ..RenderSettings::default()
     }

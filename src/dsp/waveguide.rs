@@ -23,6 +23,8 @@
 //! | `beta` | bow distance from the bridge over the vibrating length | 1 | player |
 //! | `Z_t` | torsional impedance at the surface, [`TORSION_IMPEDANCE_RATIO`] `Z0` | kg/s | CLM Stradivarius model (Serafin, Smith), docs/parameters.md §1.4 |
 //! | `c_t` | torsional wave speed, [`TORSION_SPEED_RATIO`] times the transverse | m/s | same |
+//! | `k_h` | bow hair stiffness in the bowing direction, [`BOW_HAIR_STIFFNESS_N_PER_M`] | N/m | Matusiak et al. lumped hair, §1.5 |
+//! | `d_h` | bow hair damping in the bowing direction, [`BOW_HAIR_DAMPING_KG_PER_S`] | kg/s | same |
 //!
 //! **Torsion.** The bow rubs the string's surface, which moves with the transverse
 //! velocity plus the torsional one. The torsional waves are fast and heavily damped (Q of a
@@ -31,7 +33,22 @@
 //! fast change of the friction force, which damps the ripple and the secondary slips of
 //! the Helmholtz motion. The playing-space map (docs/playing-space.md) measured what it
 //! changes. [`WaveguideString::set_torsion`] turns it off for paper A's purely transverse
-//! string. The probe's bow-point velocity is the surface's (what sticks to the bow).
+//! string. The probe's bow-point velocity is the surface's as the hair sees it (what
+//! sticks to the bow).
+//!
+//! **Bow hair.** The hair that touches the string is not rigidly tied to the bow stick:
+//! the ribbon yields in the bowing direction, a spring `k_h` with a dashpot `d_h` in
+//! parallel (massless; Matusiak, Chatziioannou and van Walstijn's lumped hair, whose
+//! constants were inverse-fitted to measured monochord transients: 4.83e4 N/m and
+//! 5.77 kg/s, docs/parameters.md §1.5). Its admittance `s / (k_h + d_h s)` is the same
+//! high-pass form as the torsion's, with corner `k_h / d_h` (1.3 kHz) and admittance
+//! `1 / d_h` above it, in series with the string at the contact: the friction law sees the
+//! string's surface velocity minus the hair's. While the string sticks the hair holds a
+//! steady deflection `F / k_h` and moves at the bow's velocity; every fast change of the
+//! friction force is partly taken up by the dashpot, which dissipates the secondary waves
+//! the rigid point bow would reflect whole (the playing-space map measured what it
+//! changes, docs/playing-space.md, "Bow hair"). [`WaveguideString::set_bow_hair`] turns it
+//! off for paper A's rigid point contact.
 //!
 //! ```
 //! use colophony::dsp::friction::{BowInput, HyperbolicFriction};
@@ -87,7 +104,9 @@ pub struct StringSpec {
 pub struct StringOutput {
     /// Force of the string on the (rigid) bridge, N.
     pub bridge_force_n: f64,
-    /// String velocity at the bow point, m/s.
+    /// String velocity at the bow point as the bow hair sees it, m/s: the surface's
+    /// (transverse plus torsional) velocity less the hair's yield, so it reads the bow's
+    /// velocity exactly while the string sticks (with the hair off: the surface velocity).
     pub bow_point_velocity_m_per_s: f64,
     /// Friction force of the bow on the string, N.
     pub friction_force_n: f64,
@@ -117,6 +136,10 @@ pub struct WaveguideString {
     dispersion_cap: usize,
     fraction: Allpass1,
     torsion: Torsion,
+    /// The bow hair's yield in the bowing direction, in series with the contact.
+    hair: HighPassAdmittance,
+    /// Whether the bow hair yields (the default; off: paper A's rigid point contact).
+    hair_enabled: bool,
     /// The bow position `bow_index` was computed for (NaN: recompute).
     bow_beta: f64,
 }
@@ -127,39 +150,60 @@ pub struct WaveguideString {
 /// the torsional waves (fast, and damped to a Q of a few tens) leave the bow as into an
 /// endless string of impedance `Z_t` on each side; below it the short twisted segment
 /// between bow and bridge is a stiff torsional spring and the surface follows the
-/// transverse motion: `w_c = c_t / (beta L)`. Discretised by the bilinear transform
-/// (pre-warped at `w_c`), which keeps it passive.
+/// transverse motion: `w_c = c_t / (beta L)`.
+/// ([`HighPassAdmittance`] with `y_hf = 1 / (2 Z_t)`).
 #[derive(Debug, Clone, Copy, Default)]
 struct Torsion {
-    /// Instantaneous admittance `b0 / (2 Z_t)`, s/kg.
-    y0: f64,
-    /// The pole coefficient (the zero is at DC: `b1 = -b0`).
-    a1: f64,
-    /// Transposed direct-form state, m/s.
-    state: f64,
+    filter: HighPassAdmittance,
     /// The bow index the coefficients were computed for.
     index: usize,
     /// Whether the bow feels the torsion (the default; off reproduces the papers' models).
     enabled: bool,
 }
 
-impl Torsion {
-    fn design(&mut self, z_t: f64, w_c_rad_per_s: f64, fs: f64, index: usize, enabled: bool) {
+/// A passive high-pass admittance `Y(s) = y_hf s / (s + w_c)` in series with the contact
+/// (the torsion's and the bow hair's form), discretised by the bilinear transform
+/// pre-warped at `w_c`, which keeps it passive. Off, its admittance and state are 0.
+#[derive(Debug, Clone, Copy, Default)]
+struct HighPassAdmittance {
+    /// Instantaneous admittance `b0 y_hf`, s/kg.
+    y0: f64,
+    /// The pole coefficient (the zero is at DC: `b1 = -b0`).
+    a1: f64,
+    /// Transposed direct-form state, m/s.
+    state: f64,
+}
+
+impl HighPassAdmittance {
+    fn design(&mut self, y_hf_s_per_kg: f64, w_c_rad_per_s: f64, fs: f64, enabled: bool) {
         let w = w_c_rad_per_s.min(0.45 * 2.0 * PI * fs);
         // Bilinear with pre-warping: s = k (1 - z^-1) / (1 + z^-1), k = w / tan(w / 2 fs).
         let k = w / (w / (2.0 * fs)).tan();
         let b0 = k / (k + w);
-        // Off (paper A's rigid point contact): no admittance, the state stays 0.
-        self.y0 = if enabled { b0 / (2.0 * z_t) } else { 0.0 };
+        self.y0 = if enabled { b0 * y_hf_s_per_kg } else { 0.0 };
         self.a1 = (w - k) / (k + w);
-        self.index = index;
+        if !enabled {
+            self.state = 0.0;
+        }
+    }
+
+    /// The velocity the admittance adds under force `force_n` this sample.
+    #[inline]
+    fn velocity(&self, force_n: f64) -> f64 {
+        self.y0 * force_n + self.state
     }
 
     #[inline]
-    fn finish(&mut self, force_n: f64, v_t: f64) {
-        self.state = super::filters::flush_tiny(-self.y0 * force_n - self.a1 * v_t);
+    fn finish(&mut self, force_n: f64, v: f64) {
+        self.state = super::filters::flush_tiny(-self.y0 * force_n - self.a1 * v);
     }
 }
+
+/// Stiffness of the bow hair in the bowing direction, N/m (Matusiak, Chatziioannou and van
+/// Walstijn's lumped hair, inverse-fitted to monochord transients: docs/parameters.md §1.5).
+pub const BOW_HAIR_STIFFNESS_N_PER_M: f64 = 4.83e4;
+/// Damping of the bow hair in the bowing direction, kg/s (the same source).
+pub const BOW_HAIR_DAMPING_KG_PER_S: f64 = 5.77;
 
 /// Torsional over transverse wave speed (CLM's Stradivarius model after Serafin and Smith,
 /// docs/parameters.md: 5.2).
@@ -195,10 +239,34 @@ impl WaveguideString {
                 enabled: true,
                 ..Torsion::default()
             },
+            hair: HighPassAdmittance::default(),
+            hair_enabled: true,
             bow_beta: f64::NAN,
         };
+        s.design_hair();
         s.stop_at(spec.open_hz);
         s
+    }
+
+    /// The bow hair's admittance: corner `k_h / d_h`, `1 / d_h` above it.
+    fn design_hair(&mut self) {
+        self.hair.design(
+            1.0 / BOW_HAIR_DAMPING_KG_PER_S,
+            BOW_HAIR_STIFFNESS_N_PER_M / BOW_HAIR_DAMPING_KG_PER_S,
+            self.sample_rate_hz,
+            self.hair_enabled,
+        );
+    }
+
+    /// Lets the bow hair yield in the bowing direction (the default) or ties the contact
+    /// rigidly to the bow (paper A's point contact). Safe at any time; the hair restarts at
+    /// rest.
+    pub fn set_bow_hair(&mut self, enabled: bool) {
+        if enabled != self.hair_enabled {
+            self.hair_enabled = enabled;
+            self.hair.state = 0.0;
+            self.design_hair();
+        }
     }
 
     pub fn spec(&self) -> StringSpec {
@@ -355,7 +423,7 @@ impl WaveguideString {
     pub fn set_torsion(&mut self, enabled: bool) {
         if enabled != self.torsion.enabled {
             self.torsion.enabled = enabled;
-            self.torsion.state = 0.0;
+            self.torsion.filter.state = 0.0;
             self.torsion.index = usize::MAX;
         }
     }
@@ -366,13 +434,10 @@ impl WaveguideString {
         let beta = self.effective_beta().max(1e-3);
         let w_c = 2.0 * TORSION_SPEED_RATIO * self.fundamental_hz / beta;
         let z_t = TORSION_IMPEDANCE_RATIO * self.spec.z0_kg_per_s;
-        self.torsion.design(
-            z_t,
-            w_c,
-            self.sample_rate_hz,
-            self.bow_index,
-            self.torsion.enabled,
-        );
+        self.torsion
+            .filter
+            .design(0.5 / z_t, w_c, self.sample_rate_hz, self.torsion.enabled);
+        self.torsion.index = self.bow_index;
     }
 
     pub fn reset(&mut self) {
@@ -381,7 +446,8 @@ impl WaveguideString {
         self.loss.reset();
         self.dispersion.iter_mut().for_each(Allpass1::reset);
         self.fraction.reset();
-        self.torsion.state = 0.0;
+        self.torsion.filter.state = 0.0;
+        self.hair.state = 0.0;
     }
 
     /// Energy of the string, J: `(Z0 / fs) * (sum(a^2 + b^2) + S)`, the travelling waves
@@ -425,15 +491,19 @@ impl WaveguideString {
         // Bow junction.
         let (ir, il) = (at(self.bow_index), at(m - 1 - self.bow_index));
         let v_h = self.right[ir] + self.left[il];
-        // The surface under the bow: transverse plus torsional velocity.
+        // The surface under the bow (transverse plus torsional velocity) against the hair
+        // (bow velocity minus its yield): both admittances add to the string's.
+        let (torsion, hair) = (&mut self.torsion.filter, &mut self.hair);
         let load = LoadLine {
-            free_velocity_m_per_s: v_h + self.torsion.state,
-            admittance_s_per_kg: admittance + self.torsion.y0,
+            free_velocity_m_per_s: v_h + torsion.state + hair.state,
+            admittance_s_per_kg: admittance + torsion.y0 + hair.y0,
         };
         let force = contact.solve(load, bow);
         let dv = force * admittance;
-        let v_t = self.torsion.y0 * force + self.torsion.state;
-        self.torsion.finish(force, v_t);
+        let v_t = torsion.velocity(force);
+        torsion.finish(force, v_t);
+        let v_hair = hair.velocity(force);
+        hair.finish(force, v_hair);
         self.right[ir] += dv;
         self.left[il] += dv;
 
@@ -452,7 +522,7 @@ impl WaveguideString {
 
         StringOutput {
             bridge_force_n: 2.0 * z0 * at_bridge,
-            bow_point_velocity_m_per_s: v_h + dv + v_t,
+            bow_point_velocity_m_per_s: v_h + dv + v_t + v_hair,
             friction_force_n: force,
         }
     }
@@ -554,39 +624,59 @@ mod tests {
         for fs in [8_000.0, 44_100.0, 192_000.0] {
             let mut s = WaveguideString::new(cello_d(), fs, 60.0);
             s.set_bow_position(0.1);
-            let t = s.torsion;
             let z_t = TORSION_IMPEDANCE_RATIO * cello_d().z0_kg_per_s;
-            let y = |f: f64| {
-                // Y(z) = y0 (1 - z^-1) / (1 + a1 z^-1) at z = e^jw.
-                let w = 2.0 * PI * f / fs;
-                let (c, sn) = (w.cos(), w.sin());
-                let num = (t.y0 * (1.0 - c), t.y0 * sn);
-                let den = (1.0 + t.a1 * c, -t.a1 * sn);
-                let d2 = den.0 * den.0 + den.1 * den.1;
-                (
-                    (num.0 * den.0 + num.1 * den.1) / d2,
-                    (num.1 * den.0 - num.0 * den.1) / d2,
-                )
-            };
             let f_c = TORSION_SPEED_RATIO * s.fundamental_hz() / (PI * s.effective_beta());
-            for k in 1..400 {
-                let f = k as f64 / 400.0 * 0.5 * fs;
-                assert!(y(f).0 >= -1e-15, "fs {fs}: Re Y({f}) = {}", y(f).0);
-            }
-            let high = (0.2 * fs).max(4.0 * f_c).min(0.45 * fs);
-            if high > 3.0 * f_c {
-                let m = y(high).0.hypot(y(high).1) * 2.0 * z_t;
-                assert!(
-                    m > 0.85 && m < 1.0 + 1e-9,
-                    "fs {fs}: |Y| 2 Z_t = {m} at {high} Hz"
-                );
-            }
-            let low = 0.1 * f_c;
-            let m = y(low).0.hypot(y(low).1) * 2.0 * z_t;
-            // A first-order high-pass one decade below its corner: 1/sqrt(101).
-            assert!(m < 0.11, "fs {fs}: |Y| 2 Z_t = {m} at {low} Hz");
+            assert_passive_high_pass(&s.torsion.filter, fs, 0.5 / z_t, f_c);
         }
     }
+
+    /// The bow hair: a spring and a dashpot in parallel, `s / (k_h + d_h s)`: no
+    /// admittance at DC (a sticking string moves at the bow's velocity), `1 / d_h` above
+    /// `k_h / (2 pi d_h)`; off, none at all.
+    #[test]
+    fn the_bow_hair_is_a_passive_high_pass_that_holds_the_bow_velocity_at_dc() {
+        for fs in [8_000.0, 44_100.0, 192_000.0] {
+            let mut s = WaveguideString::new(cello_d(), fs, 60.0);
+            let f_c = BOW_HAIR_STIFFNESS_N_PER_M / (2.0 * PI * BOW_HAIR_DAMPING_KG_PER_S);
+            assert_passive_high_pass(&s.hair, fs, 1.0 / BOW_HAIR_DAMPING_KG_PER_S, f_c);
+            s.set_bow_hair(false);
+            assert_eq!((s.hair.y0, s.hair.state), (0.0, 0.0));
+        }
+    }
+
+    /// Checks `Y(z) = y0 (1 - z^-1) / (1 + a1 z^-1)` against `y_hf s / (s + w_c)`: real part
+    /// never negative (passive), `|Y|` within 15 % of `y_hf` well above the corner (where
+    /// the rate leaves room for it) and below `y_hf / 9` a decade below it (a first-order
+    /// high-pass: `1 / sqrt(101)`).
+    fn assert_passive_high_pass(h: &HighPassAdmittance, fs: f64, y_hf: f64, f_c: f64) {
+        let y = |f: f64| {
+            let w = 2.0 * PI * f / fs;
+            let (c, sn) = (w.cos(), w.sin());
+            let num = (h.y0 * (1.0 - c), h.y0 * sn);
+            let den = (1.0 + h.a1 * c, -h.a1 * sn);
+            let d2 = den.0 * den.0 + den.1 * den.1;
+            (
+                (num.0 * den.0 + num.1 * den.1) / d2,
+                (num.1 * den.0 - num.0 * den.1) / d2,
+            )
+        };
+        for k in 1..400 {
+            let f = k as f64 / 400.0 * 0.5 * fs;
+            assert!(y(f).0 >= -1e-15, "fs {fs}: Re Y({f}) = {}", y(f).0);
+        }
+        let high = (0.2 * fs).max(4.0 * f_c).min(0.45 * fs);
+        if high > 3.0 * f_c {
+            let m = y(high).0.hypot(y(high).1) / y_hf;
+            assert!(
+                m > 0.85 && m < 1.0 + 1e-9,
+                "fs {fs}: |Y| / y_hf = {m} at {high} Hz"
+            );
+        }
+        let low = 0.1 * f_c;
+        let m = y(low).0.hypot(y(low).1) / y_hf;
+        assert!(m < 0.11, "fs {fs}: |Y| / y_hf = {m} at {low} Hz");
+    }
+
     use crate::dsp::friction::HyperbolicFriction;
 
     fn cello_d() -> StringSpec {
