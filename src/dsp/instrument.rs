@@ -719,11 +719,16 @@ impl Instrument {
                 return None;
             }
             let s = &voice.string;
-            // The fundamental's own decay, measured after the bow lifts (cello D3, the
-            // defaults, energy over 6-10 s): Q 516 where the loop is designed for 500. The
-            // estimate takes Q1 5 % high so that it stays an upper bound; the 3 % is not
-            // yet explained (the loop's filters are unity but for the loss, which is fitted
-            // to Q1 exactly at the fundamental).
+            // Measured after the bow lifts (cello D3, 2.5 N, the energy's decay over
+            // successive seconds, in periods of the fundamental): Q 500 over 1-6 s, then
+            // 516, 551, 601, 633 and 641 by 24-29 s, with or without torsion and hair. The
+            // slow part is the loop's DC pair (a right-going and a left-going wave of
+            // opposite constant value: no string velocity, a constant force), which the
+            // bow's mean friction force charges and which decays at the one-pole loss's DC
+            // gain (above its gain at the fundamental): Q about 640 per period here. The
+            // estimate takes Q1 5 % high, enough for the default note's tail (the tail
+            // test); a loud note's tail can still outlast it. A DC blocker in the loop is
+            // the fix (docs/playing-space.md, "With the bow hair too").
             let q = RING_OUT_Q_MARGIN * s.spec().q1;
             longest = longest.max(ring_out_s(s.energy_j(), s.fundamental_hz(), q));
         }
