@@ -318,6 +318,13 @@ pub const MAX_NOTE_BEND_SEMITONES: f64 = 48.0;
 /// while keeping the violin's strings near the forces players use (0.9-1.8 N).
 pub const WEIGHT_REFERENCE_Z0: f64 = 0.2;
 
+/// The most force String Weight bows a string with, N: the Bow Force parameter's top.
+/// Without the cap the parameter's 10 N would bow the cello's C string with 95 N (five
+/// times its `F_max` at 0.1 m/s), raucous and up to 14 dB over full scale (measured,
+/// every point law, 44.1 kHz); at 10 N it peaks at 0.2-0.7 of full scale. The defaults
+/// stay under it on every string (the cello's C string: 9.55 N).
+pub const MAX_WEIGHTED_FORCE_N: f64 = 10.0;
+
 /// The most a note's pressure may multiply its string's bow force.
 pub const MAX_NOTE_FORCE_SCALE: f64 = 4.0;
 /// A note's own bow position stays within the Bow Position parameter's range.
@@ -799,6 +806,7 @@ impl Instrument {
         let mut bridge = 0.0;
         let mut frame = Frame::default();
         let skipping = self.skipping;
+        let weighting = self.weighted;
         self.body_asleep = false;
         if let Some(retune) = self.fingering.glide_tick() {
             for (voice, hz) in self.voices.iter_mut().zip(retune) {
@@ -812,12 +820,18 @@ impl Instrument {
                 continue;
             }
             let bow_gain = voice.bow.advance(self.ramp_step);
+            // Weighted, a string is never bowed harder than the force parameter's top.
+            let weighted = if weighting {
+                (bow.force_n * voice.weight).min(MAX_WEIGHTED_FORCE_N)
+            } else {
+                bow.force_n
+            };
             let (force, beta) = if !voice.expressive {
-                (bow.force_n * voice.weight, bow.position_beta)
+                (weighted, bow.position_beta)
             } else {
                 let e = self.fingering.expression(i);
                 (
-                    bow.force_n * voice.weight * e.force_scale,
+                    weighted * e.force_scale,
                     (bow.position_beta * e.position_scale).clamp(MIN_NOTE_BETA, MAX_NOTE_BETA),
                 )
             };
@@ -1099,5 +1113,12 @@ mod tests {
                 );
             }
         }
+        // The top of the force parameter on the cello's C string (weight 9.55): bowed with
+        // the cap, 10 N, not 95.5 N.
+        let c = InstrumentKind::Cello;
+        assert_eq!(
+            render(c, 36, true, 10.0),
+            render(c, 36, false, MAX_WEIGHTED_FORCE_N)
+        );
     }
 }
