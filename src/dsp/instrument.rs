@@ -339,7 +339,7 @@ struct StringVoice {
     awake: bool,
     /// Whether the note's expression is not neutral (one test per sample instead of three).
     expressive: bool,
-    /// The bow force's factor on this string: 1, or [`InstrumentKind::string_weight`].
+    /// The bow force's factor on this string when weighted ([`InstrumentKind::string_weight`]).
     weight: f64,
 }
 
@@ -429,7 +429,7 @@ impl Instrument {
             bow: BowEnvelope::default(),
             awake: false,
             expressive: false,
-            weight: 1.0,
+            weight: kind.string_weight(i),
         });
         Self {
             kind,
@@ -460,7 +460,6 @@ impl Instrument {
     /// the player (the String Weight parameter). Real-time safe.
     pub fn set_string_weighting(&mut self, on: bool) {
         self.weighted = on;
-        self.update_weights();
     }
 
     /// Whether the bow force is weighted per string.
@@ -470,11 +469,7 @@ impl Instrument {
 
     fn update_weights(&mut self) {
         for (i, voice) in self.voices.iter_mut().enumerate() {
-            voice.weight = if self.weighted {
-                self.kind.string_weight(i)
-            } else {
-                1.0
-            };
+            voice.weight = self.kind.string_weight(i);
         }
     }
 

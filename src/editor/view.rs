@@ -144,6 +144,17 @@ impl EditorUi {
             .unwrap_or(0)
     }
 
+    /// What the point-bow strings multiply the force parameter by on `string` (String
+    /// Weight; 1 when it is off). The thermal model is not weighted.
+    fn string_weight(&self, kind: InstrumentKind, string: usize) -> f64 {
+        let thermal = self.params.friction_model.value() == FrictionChoice::Thermal;
+        if self.params.string_weight.value() && !thermal {
+            kind.string_weight(string)
+        } else {
+            1.0
+        }
+    }
+
     /// The Schelleng window for the current note and bow position, `None` while the bow
     /// rubs a modal resonator instead of the strings.
     pub fn window(&self) -> Option<SchellengWindow> {
@@ -166,10 +177,7 @@ impl EditorUi {
         }
         // Weighted strings: the window in the force parameter's units (the string is
         // bowed with the parameter times its weight).
-        if self.params.string_weight.value() {
-            return Some(window.seen_through_weight(kind.string_weight(string)));
-        }
-        Some(window)
+        Some(window.seen_through_weight(self.string_weight(kind, string)))
     }
 
     /// Draws one frame.
@@ -410,7 +418,7 @@ impl EditorUi {
         let open = kind.open_notes()[string];
         // The string's own impedance and bridge resistance; the limits below are in the
         // force parameter's units, divided by the string's weight where it is weighted.
-        let weight = w.z0_kg_per_s.recip() * kind.strings()[string].z0_kg_per_s;
+        let weight = self.string_weight(kind, string);
         let heard = if self.link.note().is_some() {
             "last note"
         } else {
