@@ -95,11 +95,14 @@ pub fn friction_table() -> Result<String, String> {
 }
 
 /// The default string (hyperbolic cello D, as above) at other host rates: the plugin's
-/// strings at their internal 48 kHz resampled to the host rate, against the same strings
+/// strings at their internal rate resampled to the host rate, against the same strings
 /// run at the host rate itself ([`RenderSettings::native_rate`]); x real time.
 fn host_rate_rows() -> Result<Vec<String>, String> {
     let mut lines = vec![
-        "| host rate (kHz) | plugin (48 kHz inside, resampled): x real time | strings at the host rate: x real time |".into(),
+        format!(
+            "| host rate (kHz) | plugin ({} kHz inside, resampled): x real time | strings at the host rate: x real time |",
+            colophony::dsp::instrument::INTERNAL_RATE_HZ / 1e3
+        ),
         "|---|---|---|".into(),
     ];
     for fs in [44_100.0, 48_000.0, 96_000.0, 192_000.0] {

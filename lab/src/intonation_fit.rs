@@ -3,23 +3,25 @@
 //! which the bowed note misses equal temperament at nominal bowing, folded into the
 //! table the engines tune by ([`colophony::dsp::intonation`]).
 //!
-//! Each pass bows every entry twice through the engines the plugin plays
-//! ([`crate::playing_space::render_cell`]): with the plugin's defaults (0.1 m/s, 1 N,
-//! beta 0.1) and at the geometric middle of the note's Schelleng window (beta 0.1), one
-//! second each, measured after the 0.3 s settling time as the playing-space map measures.
-//! The residual of an entry is the mean of the two bowed pitches that sounded near the
-//! note (within [`TRUSTED_CENTS`]); an entry with neither takes the residual of its
-//! neighbours on the same string, and the residuals of a string are smoothed by a median
-//! over five semitones (an irregular regime scatters the pitch; the correction changes
-//! smoothly with the stopped length). The first pass starts from free-decay tuning (a zero
+//! A player tunes by the note as they usually bow it. Each pass bows every entry through
+//! the engines the plugin plays ([`crate::playing_space::render_cell`]) at the plugin's
+//! defaults (0.1 m/s, 1 N on the knob times the string's weight, beta 0.1: `F_max / 2` of
+//! the point laws' window on every string), [`FIT_SECONDS`] long, and measures it after
+//! the 0.3 s settling time as the playing-space map measures. An entry's residual is the
+//! bowed pitch only where the note is in Helmholtz motion by the map's full criterion (one
+//! slip a period, slip fraction within 15 % of beta, sticking at the bow velocity) and
+//! within [`TRUSTED_CENTS`]: the pitch of another regime is not the note's. An entry
+//! without one takes the residual of its neighbours on the same string (linear between
+//! the nearest two). Trusted entries are not smoothed: the bowed pitch of neighbouring
+//! semitones differs by several cents (the Helmholtz period locks to the discretisation:
+//! docs/playing-space.md, "Tuned at the defaults"), and a smoothed table leaves each note
+//! that difference out of tune. The first pass starts from free-decay tuning (a zero
 //! table); each later pass bows with the table so far and adds its residuals, so a pass
-//! corrects what the previous one's correction changed (a string tuned lower slips a
-//! little differently).
+//! corrects what the previous one's correction changed.
 
 use crate::playing_space::{measure, Bowing, Cell, Model};
 use colophony::dsp::instrument::{InstrumentKind, MAX_STOP_SEMITONES, STRINGS};
 use colophony::dsp::intonation::{model_index, IntonationTable};
-use colophony::editor::regime::Regime;
 use rayon::prelude::*;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -62,49 +64,40 @@ fn entries(models: &[Model]) -> Vec<Entry> {
     v
 }
 
-/// The residual one bowed cell says, if it can be trusted.
-fn trusted(cents: f64, regime: Option<Regime>) -> Option<f64> {
-    let sounding = matches!(
-        regime,
-        Some(Regime::Helmholtz | Regime::MultipleSlips(_) | Regime::Raucous)
-    );
-    (sounding && cents.is_finite() && cents.abs() < TRUSTED_CENTS).then_some(cents)
+/// The residual one bowed cell says, if it can be trusted: a note in Helmholtz motion
+/// near its pitch.
+fn trusted(cents: f64, helmholtz: bool) -> Option<f64> {
+    (helmholtz && cents.is_finite() && cents.abs() < TRUSTED_CENTS).then_some(cents)
 }
 
-/// One pass: bows every entry with `table` and returns each entry's residual (NaN where
-/// no bowing could be trusted) and the cells' pitches.
+/// Length of each fitting render, s: [`crate::playing_space::SETTLE_S`] to settle, then
+/// 0.9 s measured (above a hundred periods of the lowest note).
+pub const FIT_SECONDS: f64 = 1.2;
+
+/// One pass: bows every entry with `table` at the defaults and returns each entry's
+/// residual (NaN where the note is not in Helmholtz motion near its pitch).
 fn residuals(
     entries: &[Entry],
     table: &'static IntonationTable,
     rate_hz: f64,
     bar: &indicatif::ProgressBar,
-) -> Result<Vec<(f64, f64, f64)>, String> {
+) -> Result<Vec<f64>, String> {
     entries
         .par_iter()
         .map(|e| {
-            let mut pitches = [f64::NAN; 2];
-            for (k, bowing) in [Bowing::Defaults, Bowing::Middle].into_iter().enumerate() {
-                let mut cell = Cell::on_string(
-                    e.model,
-                    e.kind,
-                    e.note(),
-                    Some(e.string),
-                    rate_hz,
-                    bowing,
-                    1.0,
-                );
-                cell.intonation = Some(table);
-                let m = measure(&cell)?;
-                pitches[k] = trusted(m.cents, m.regime).unwrap_or(f64::NAN);
-                bar.inc(1);
-            }
-            let valid: Vec<f64> = pitches.iter().copied().filter(|c| c.is_finite()).collect();
-            let r = if valid.is_empty() {
-                f64::NAN
-            } else {
-                valid.iter().sum::<f64>() / valid.len() as f64
-            };
-            Ok((r, pitches[0], pitches[1]))
+            let mut cell = Cell::on_string(
+                e.model,
+                e.kind,
+                e.note(),
+                Some(e.string),
+                rate_hz,
+                Bowing::Defaults,
+                FIT_SECONDS,
+            );
+            cell.intonation = Some(table);
+            let m = measure(&cell)?;
+            bar.inc(1);
+            Ok(trusted(m.cents, m.helmholtz).unwrap_or(f64::NAN))
         })
         .collect()
 }
@@ -137,28 +130,6 @@ fn fill_gaps(values: &mut [f64]) {
     }
 }
 
-/// Replaces each value by the median of itself and its neighbours up to `half` semitones
-/// away on the same string: the bowed pitch of an irregular regime is scattered, while
-/// the correction a string needs changes smoothly with its stopped length.
-fn median_filter(values: &mut [f64], half: usize) {
-    let source = values.to_vec();
-    for (i, v) in values.iter_mut().enumerate() {
-        let lo = i.saturating_sub(half);
-        let hi = (i + half + 1).min(source.len());
-        let mut w = source[lo..hi].to_vec();
-        w.sort_by(f64::total_cmp);
-        let n = w.len();
-        *v = if n % 2 == 1 {
-            w[n / 2]
-        } else {
-            0.5 * (w[n / 2 - 1] + w[n / 2])
-        };
-    }
-}
-
-/// Neighbours on each side in the median filter of the residuals.
-const MEDIAN_HALF_WIDTH: usize = 2;
-
 /// Runs `passes` passes at `rate_hz` for `models` and returns the table and a report.
 pub fn fit(
     models: &[Model],
@@ -172,7 +143,7 @@ pub fn fit(
     for pass in 0..passes.max(1) {
         // The engines hold the table by a static reference; one leak per pass, in a tool.
         let current: &'static IntonationTable = Box::leak(Box::new(table.clone()));
-        let bar = indicatif::ProgressBar::new(2 * entries.len() as u64);
+        let bar = indicatif::ProgressBar::new(entries.len() as u64);
         if let Ok(style) = indicatif::ProgressStyle::with_template(
             "{elapsed_precise} [{bar:40}] {pos}/{len} cells, eta {eta}",
         ) {
@@ -187,28 +158,23 @@ pub fn fit(
             pass
         );
         for &model in models {
-            let rows: Vec<(usize, &(f64, f64, f64))> = entries
+            let cells: Vec<f64> = entries
                 .iter()
                 .zip(&measured)
-                .enumerate()
-                .filter(|(_, (e, _))| e.model == model)
-                .map(|(i, (_, m))| (i, m))
+                .filter(|(e, c)| e.model == model && c.is_finite())
+                .map(|(_, &c)| c)
                 .collect();
-            let cells: Vec<f64> = rows
-                .iter()
-                .flat_map(|(_, m)| [m.1, m.2])
-                .filter(|c| c.is_finite())
-                .collect();
+            let total = entries.iter().filter(|e| e.model == model).count();
             let within = cells.iter().filter(|c| c.abs() <= 3.0).count();
             let mut abs: Vec<f64> = cells.iter().map(|c| c.abs()).collect();
             abs.sort_by(f64::total_cmp);
             let median = abs.get(abs.len() / 2).copied().unwrap_or(f64::NAN);
             let _ = writeln!(
                 report,
-                "  {:15} {} of {} nominal cells sounded near the note; {} ({:.0} %) within 3 cents; median |error| {:.1} cents",
+                "  {:15} {} of {} notes in Helmholtz motion near their pitch at the defaults; {} ({:.0} %) within 3 cents; median |error| {:.1} cents",
                 model.name(),
                 cells.len(),
-                2 * rows.len(),
+                total,
                 within,
                 100.0 * within as f64 / cells.len().max(1) as f64,
                 median
@@ -217,9 +183,8 @@ pub fn fit(
         // Fold the residuals in, string by string.
         for chunk in entries.chunks(per_string).zip(measured.chunks(per_string)) {
             let (es, ms) = chunk;
-            let mut r: Vec<f64> = ms.iter().map(|m| m.0).collect();
+            let mut r: Vec<f64> = ms.to_vec();
             fill_gaps(&mut r);
-            median_filter(&mut r, MEDIAN_HALF_WIDTH);
             for (e, r) in es.iter().zip(r) {
                 let row = model_index(e.model.name());
                 let old = table.get(row, e.kind, e.string, e.semitone);
@@ -248,9 +213,11 @@ pub fn run(out: &Path, models: &[Model], rate_hz: f64, passes: usize) -> Result<
     }
     let text = format!(
         "# Intonation by the bowed sound (src/dsp/intonation.rs): cents each stopped note is moved\n\
-         # from its equal-tempered free-decay pitch so that it sounds in tune bowed at nominal.\n\
-         # Measured by `colophony bench intonation` at {rate_hz} Hz, {passes} passes.\n{}",
-        merged.to_csv()
+         # from its equal-tempered free-decay pitch so that it sounds in tune bowed at the defaults.\n\
+         # Measured by `colophony bench intonation` at a host rate of {rate_hz} Hz (the point strings\n\
+         # run at {internal} Hz inside), {passes} passes.\n{}",
+        merged.to_csv(),
+        internal = colophony::dsp::instrument::INTERNAL_RATE_HZ,
     );
     std::fs::write(out, text).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
     Ok(format!("{report}wrote {}", out.display()))
@@ -271,17 +238,10 @@ mod tests {
     }
 
     #[test]
-    fn the_median_filter_drops_a_lone_outlier_and_keeps_a_trend() {
-        let mut v = [1.0, 2.0, 3.0, 40.0, 5.0, 6.0, 7.0];
-        median_filter(&mut v, 2);
-        assert_eq!(v, [2.0, 2.5, 3.0, 5.0, 6.0, 6.5, 6.0]);
-    }
-
-    #[test]
-    fn far_or_silent_pitches_do_not_steer_the_table() {
-        assert_eq!(trusted(5.0, Some(Regime::Helmholtz)), Some(5.0));
-        assert_eq!(trusted(80.0, Some(Regime::Helmholtz)), None);
-        assert_eq!(trusted(1.0, Some(Regime::Sliding)), None);
-        assert_eq!(trusted(1.0, None), None);
+    fn only_a_note_in_helmholtz_motion_near_its_pitch_steers_the_table() {
+        assert_eq!(trusted(5.0, true), Some(5.0));
+        assert_eq!(trusted(80.0, true), None);
+        assert_eq!(trusted(1.0, false), None);
+        assert_eq!(trusted(f64::NAN, true), None);
     }
 }

@@ -94,7 +94,7 @@ enum Command {
         #[arg(long)]
         bridge: Option<PathBuf>,
     },
-    /// Draw a figure as PNG: serafin-fig7, serafin-modal, bridge-fit.
+    /// Draw a figure as PNG: serafin-fig7, serafin-modal, maestre-fig6, maestre-fig7, maestre-fig8, bridge-fit.
     Figure {
         name: String,
         #[arg(long)]
