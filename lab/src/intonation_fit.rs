@@ -18,6 +18,10 @@
 //! that difference out of tune. The first pass starts from free-decay tuning (a zero
 //! table); each later pass bows with the table so far and adds its residuals, so a pass
 //! corrects what the previous one's correction changed.
+//!
+//! The shipped table (2026-11-25) was fitted by the earlier procedure (the mean of the
+//! defaults and the window's middle, smoothed by a median over five semitones); this one
+//! was measured but not installed yet: docs/playing-space.md, "The sample-grid lock".
 
 use crate::playing_space::{measure, Bowing, Cell, Model};
 use colophony::dsp::instrument::{InstrumentKind, MAX_STOP_SEMITONES, STRINGS};

@@ -357,21 +357,18 @@ fn the_bowed_string_plays_the_same_motion_and_pitch_at_every_host_rate() {
                 let pitch = peak_frequency_hz(window(&out.audio, 0.5, 1.5, fs), fs, f0, 50.0);
                 (stats, pitch)
             };
-            // The reference: the host at the internal rate, where no resampler runs.
-            let internal = colophony::dsp::instrument::INTERNAL_RATE_HZ;
-            let (reference, reference_pitch) = measure(internal);
-            for fs in [22_050.0, 44_100.0, 48_000.0, 192_000.0, 384_000.0] {
+            let (reference, reference_pitch) = measure(48_000.0);
+            for fs in [22_050.0, 44_100.0, 96_000.0, 192_000.0, 384_000.0] {
                 let (stats, pitch) = measure(fs);
                 let label = format!("{} {instrument:?} {note} at {fs} Hz", friction.name());
                 // The host rate only resamples the output. The probe holds the last
-                // internal sample: above the internal rate it sees every one (a slip's
-                // edges move by up to one internal sample in a period of 653 or 109);
-                // below, it skips some, so the motion is compared there through the pitch
-                // alone.
-                if fs > internal {
+                // internal sample: above 48 kHz it sees every one (a slip's edges move by
+                // up to one internal sample in a period of 327 or 55); below, it skips
+                // some, so the motion is compared there through the pitch alone.
+                if fs > 48_000.0 {
                     assert!(
                         (stats.slips_per_period - reference.slips_per_period).abs() < 0.05,
-                        "{label}: {} slips per period against {} at the internal rate",
+                        "{label}: {} slips per period against {} at 48 kHz",
                         stats.slips_per_period,
                         reference.slips_per_period
                     );
@@ -388,7 +385,7 @@ fn the_bowed_string_plays_the_same_motion_and_pitch_at_every_host_rate() {
                 let moved = cents(pitch, reference_pitch).abs();
                 assert!(
                     moved < 0.1,
-                    "{label}: pitch moved {moved} cents from the internal rate"
+                    "{label}: pitch moved {moved} cents from 48 kHz"
                 );
             }
         }

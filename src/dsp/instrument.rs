@@ -34,15 +34,9 @@ use super::waveguide::{StringSpec, WaveguideString};
 /// motion or a double slip: both are stable over much of the window, and which one an
 /// attack falls into changes with any detail of the discretisation) and its pitch then do
 /// not depend on the project's rate, and the intonation table, measured at this rate,
-/// holds at every rate. 96 kHz (48 kHz until 2026-11-25): the Helmholtz period of a point
-/// bow locks to the sample grid (the slip starts on a sample), so a note's bowed pitch
-/// scatters from its neighbours' by up to about `866 / P` cents for a period of `P`
-/// samples, most on the high notes; at twice the rate the scatter halves and the bow
-/// position is placed twice as finely. Measured at the plugin's defaults, every semitone
-/// of the three instruments, the intonation table fitted the same way at each rate:
-/// notes in Helmholtz motion, hyperbolic 245 -> 278 of 384, and of those within 3 cents
-/// 78 -> 87 % (docs/precision.md, "One internal rate for the point strings").
-pub const INTERNAL_RATE_HZ: f64 = 96_000.0;
+/// holds at every rate. 48 kHz: the commonest host rate (no resampling there), and twice
+/// the hearing range. Measured in docs/precision.md (issue 16, item 3).
+pub const INTERNAL_RATE_HZ: f64 = 48_000.0;
 
 pub const STRINGS: usize = 4;
 /// Highest note above the highest open string (about the end of the fingerboard).
@@ -384,7 +378,7 @@ pub struct Instrument {
 
 impl Instrument {
     /// The instrument the plugin plays at host rate `host_rate_hz`: strings and body at
-    /// [`INTERNAL_RATE_HZ`], resampled to the host rate (no resampler at that rate).
+    /// [`INTERNAL_RATE_HZ`], resampled to the host rate (no resampler at 48 kHz).
     /// Allocates everything; instrument changes later do not allocate.
     pub fn new(kind: InstrumentKind, host_rate_hz: f64) -> Self {
         Self::with_internal_rate(kind, host_rate_hz, INTERNAL_RATE_HZ)

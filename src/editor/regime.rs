@@ -159,8 +159,8 @@ fn repeats_every_period(onsets: &[usize], n: usize, period: f32, sample_rate: f3
     spans.sort_by(f32::total_cmp);
     let median = spans[spans.len() / 2];
     // Two samples of the model: each onset is found to within one. The point strings run
-    // at INTERNAL_RATE_HZ whatever the host's rate and the probe holds their last sample,
-    // so above it an onset moves in steps of several host samples.
+    // at 48 kHz whatever the host's rate and the probe holds their last sample, so above
+    // 48 kHz an onset moves in steps of several host samples.
     let model_sample = (sample_rate / INTERNAL_RATE_HZ as f32).max(1.0);
     let tolerance = (PERIOD_JITTER * median).max(2.0 * model_sample);
     (period / PERIOD_RANGE..=period * PERIOD_RANGE).contains(&median)
