@@ -19,9 +19,9 @@
 //! table); each later pass bows with the table so far and adds its residuals, so a pass
 //! corrects what the previous one's correction changed.
 //!
-//! The point laws' rows of the shipped table come from this procedure at 48 kHz, three
-//! passes (2026-11-25; before, the mean of the defaults and the window's middle, smoothed
-//! over five semitones): docs/playing-space.md, "The sample-grid lock".
+//! The shipped table (2026-11-25) was fitted by the earlier procedure (the mean of the
+//! defaults and the window's middle, smoothed by a median over five semitones); this one
+//! was measured but not installed yet: docs/playing-space.md, "The sample-grid lock".
 
 use crate::playing_space::{measure, Bowing, Cell, Model};
 use colophony::dsp::instrument::{InstrumentKind, MAX_STOP_SEMITONES, STRINGS};

@@ -12,10 +12,9 @@
 //! The table does what the player's ear does, once, offline: for every friction model,
 //! instrument, string and semitone above the open string (0..=
 //! [`MAX_STOP_SEMITONES`](super::instrument::MAX_STOP_SEMITONES)) it holds the cents the
-//! note is moved so that bowing it as a player usually does sounds at equal temperament:
-//! for the point laws the plugin's defaults (0.1 m/s, 1 N times the string's weight,
-//! beta 0.1), measured on notes in Helmholtz motion; for the thermal model the mean of
-//! the defaults and the geometric middle of the note's Schelleng window. It is measured through the same engines the plugin plays by
+//! note is moved so that bowing it at nominal (the plugin's defaults, 0.1 m/s, 1 N,
+//! beta 0.1, and the geometric middle of the note's Schelleng window) sounds at equal
+//! temperament. It is measured through the same engines the plugin plays by
 //! `colophony bench intonation` (`lab/src/intonation_fit.rs`), written to
 //! `assets/intonation.csv` and compiled in. Between semitones (pitch bend, vibrato) it is
 //! interpolated linearly. The change of pitch with force and bow position is left as the
