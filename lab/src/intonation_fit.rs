@@ -14,7 +14,7 @@
 //! without one takes the residual of its neighbours on the same string (linear between
 //! the nearest two). Trusted entries are not smoothed: the bowed pitch of neighbouring
 //! semitones differs by several cents (the Helmholtz period locks to the discretisation:
-//! docs/playing-space.md, "Tuned at the defaults"), and a smoothed table leaves each note
+//! docs/playing-space.md, "The sample-grid lock"), and a smoothed table leaves each note
 //! that difference out of tune. The first pass starts from free-decay tuning (a zero
 //! table); each later pass bows with the table so far and adds its residuals, so a pass
 //! corrects what the previous one's correction changed.

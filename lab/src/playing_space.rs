@@ -331,17 +331,12 @@ fn thermal_bridge(kind: InstrumentKind) -> crate::admittance_fit::BridgeModes {
     }
 }
 
-/// Renders and measures one cell after [`SETTLE_S`], to its end.
+/// Renders and measures one cell.
 pub fn measure(cell: &Cell) -> Result<Measured, String> {
-    measure_from(cell, SETTLE_S)
-}
-
-/// Renders and measures one cell from `from_s` seconds to its end.
-pub fn measure_from(cell: &Cell, from_s: f64) -> Result<Measured, String> {
     let (audio, probe) = render_cell(cell)?;
     let fs = cell.rate_hz;
     let f0 = cell.nominal_hz();
-    let start = ((from_s * fs) as usize).min(audio.len());
+    let start = ((SETTLE_S * fs) as usize).min(audio.len());
     let period = fs / f0;
     // Whole periods of the note for the slip statistics.
     let periods = ((audio.len() - start) as f64 / period).floor();
