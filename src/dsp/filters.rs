@@ -125,6 +125,23 @@ impl OnePoleLoss {
         Self { g, p, y1: 0.0 }
     }
 
+    /// The loss of a string's loop, one design for both string models: per round trip the
+    /// fundamental `f1_hz` keeps `exp(-pi / q1)` of its amplitude (it decays at `Q1`), and
+    /// ten times it (at most `0.4 fs`) decays at a Q interpolated in log frequency between
+    /// `q1` and `q_hi` (`q_hi` at exactly ten times). `termination_gain` is what the loop's
+    /// own real (frequency-independent) terminations keep per round trip (1 for rigid
+    /// ones): the filter supplies only the rest, and nothing where they alone lose more.
+    /// `fs` is the loop's sample rate.
+    pub fn for_string(f1_hz: f64, fs: f64, q1: f64, q_hi: f64, termination_gain: f64) -> Self {
+        let w1 = 2.0 * PI * f1_hz / fs;
+        let f2 = (10.0 * f1_hz).min(0.4 * fs);
+        let q2 = q1 * (q_hi / q1).powf((f2 / f1_hz).log10());
+        let t = termination_gain.clamp(1e-3, 1.0);
+        let gain1 = ((-PI / q1).exp() / t).min(1.0);
+        let gain2 = ((-PI * f2 / (q2 * f1_hz)).exp() / t).min(gain1);
+        Self::fit(w1, gain1, 2.0 * PI * f2 / fs, gain2)
+    }
+
     fn unit_gain(p: f64, w: f64) -> f64 {
         (1.0 - p) / (1.0 - 2.0 * p * w.cos() + p * p).sqrt()
     }

@@ -262,6 +262,8 @@ impl ThermalInstrument {
                     f0_hz: s.open_hz,
                     z0_kg_per_s: s.z0_kg_per_s,
                     length_m: length,
+                    q1: s.q1,
+                    q_hi: s.q_hi,
                     ..ThermalStringSpec::cello_c()
                 };
                 ThermalString::with_capacity(

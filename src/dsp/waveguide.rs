@@ -313,13 +313,8 @@ impl WaveguideString {
             return;
         }
         let w1 = 2.0 * PI * f1_hz / fs;
-        // Loss: per-period gain exp(-pi f / (Q(f) f1)), Q interpolated in log f between the
-        // fundamental and ten times it.
-        let f2 = (10.0 * f1_hz).min(0.4 * fs);
-        let q2 = self.spec.q1 * (self.spec.q_hi / self.spec.q1).powf((f2 / f1_hz).log10());
-        let gain1 = (-PI / self.spec.q1).exp();
-        let gain2 = (-PI * f2 / (q2 * f1_hz)).exp();
-        self.loss = OnePoleLoss::fit(w1, gain1, 2.0 * PI * f2 / fs, gain2);
+        // Loss: Q1 at the fundamental, q_hi at ten times it; the bridge and nut are rigid.
+        self.loss = OnePoleLoss::for_string(f1_hz, fs, self.spec.q1, self.spec.q_hi, 1.0);
         let b = self.spec.inharmonicity_open * (f1_hz / self.spec.open_hz).powi(2);
         let budget = n - 2.0 * 2.0 - 0.5 - self.loss.phase_delay(w1);
         let (stages, a) = fit_dispersion(f1_hz, b, fs, &self.loss, budget, self.dispersion_cap);

@@ -325,6 +325,9 @@ pub struct ThermalStringSpec {
     pub length_m: f64,
     /// Quality factor of the fundamental (loss at the bridge).
     pub q1: f64,
+    /// Quality factor at ten times the fundamental (the loop's loss falls log-linearly
+    /// from `q1`: [`OnePoleLoss::for_string`], the waveguide string's design).
+    pub q_hi: f64,
     /// Nut admittance (real, PSD), s/kg, [[hh, hv], [hv, vv]].
     pub nut_admittance: [[f64; 2]; 2],
     /// Bridge admittance (real, PSD), s/kg.
@@ -354,6 +357,7 @@ impl ThermalStringSpec {
             z0_kg_per_s: 1.88,
             length_m: 0.69,
             q1: 500.0,
+            q_hi: 250.0,
             // Small resistive terminations with polarisation coupling (eigenvalues > 0),
             // losing less per round trip than Q1 allows (C string, horizontal: 0.5 % of
             // the amplitude against exp(-pi / 500) = 0.6 %), so the loop's loss filter
@@ -531,27 +535,22 @@ fn check_psd(name: &str, y: [[f64; 2]; 2]) -> Result<(), String> {
     }
 }
 
-/// The loop at `fs` for a fundamental `f0`: loss filter (the fundamental decays at `Q1`,
-/// twenty times its frequency at `Q1 / 2`, counting the real terminations' own loss
-/// `termination_gain`, the horizontal wave's amplitude kept per round trip), integer
-/// half-loop `m` and the Thiran coefficient of the remaining delay `d` in `[0.5, 2.5)`:
-/// `2 m + d = fs / f0 - loss delay - extra`, `extra` being a termination's phase delay at
-/// `f0` in samples (a modal bridge's; 0 for the real 2x2 terminations).
+/// The loop at `fs` for a fundamental `f0`: loss filter ([`OnePoleLoss::for_string`]: the
+/// fundamental decays at `Q1`, ten times its frequency at `q_hi`, counting the real
+/// terminations' own loss `termination_gain`, the horizontal wave's amplitude kept per
+/// round trip), integer half-loop `m` and the Thiran coefficient of the remaining delay
+/// `d` in `[0.5, 2.5)`: `2 m + d = fs / f0 - loss delay - extra`, `extra` being a
+/// termination's phase delay at `f0` in samples (a modal bridge's; 0 for the real 2x2
+/// terminations).
 fn loop_tuning(
     fs: f64,
     f0: f64,
-    q1: f64,
+    (q1, q_hi): (f64, f64),
     extra_delay: f64,
     termination_gain: f64,
 ) -> (OnePoleLoss, usize, f64) {
     let w1 = 2.0 * PI * f0 / fs;
-    let w2 = (20.0 * w1).min(0.4 * PI);
-    // The terminations are real (frequency-independent): the filter supplies the rest, and
-    // nothing if they alone lose more.
-    let t = termination_gain.clamp(1e-3, 1.0);
-    let g1 = ((-PI / q1).exp() / t).min(1.0);
-    let g2 = ((-PI * (w2 / w1) / (0.5 * q1)).exp() / t).min(g1);
-    let loss = OnePoleLoss::fit(w1, g1, w2, g2);
+    let loss = OnePoleLoss::for_string(f0, fs, q1, q_hi, termination_gain);
     let remainder = fs / f0 - loss.phase_delay(w1) - extra_delay;
     let (m, d) = split_loop(remainder);
     let a = Allpass1::coefficient_for_delay(d, w1);
@@ -612,8 +611,13 @@ impl ThermalString {
         thermal.validate()?;
         check_psd("nut", spec.nut_admittance)?;
         check_psd("bridge", spec.bridge_admittance)?;
-        if !(spec.f0_hz > 0.0 && spec.z0_kg_per_s > 0.0 && spec.length_m > 0.0 && spec.q1 > 0.0) {
-            return Err("string frequency, impedance, length and Q must be positive".into());
+        if !(spec.f0_hz > 0.0
+            && spec.z0_kg_per_s > 0.0
+            && spec.length_m > 0.0
+            && spec.q1 > 0.0
+            && spec.q_hi > 0.0)
+        {
+            return Err("string frequency, impedance, length and Qs must be positive".into());
         }
         let ThermalCapacity {
             max_nodes,
@@ -691,7 +695,7 @@ impl ThermalString {
         let (loss, m, a) = loop_tuning(
             fs,
             self.spec.f0_hz,
-            self.spec.q1,
+            (self.spec.q1, self.spec.q_hi),
             0.0,
             self.termination_gain(),
         );
@@ -785,7 +789,7 @@ impl ThermalString {
         let (loss, m, a) = loop_tuning(
             self.internal_rate_hz,
             f0_hz,
-            self.spec.q1,
+            (self.spec.q1, self.spec.q_hi),
             extra_delay,
             self.termination_gain(),
         );
