@@ -25,11 +25,12 @@
 //! with the table so far and adds its residuals, so a pass corrects what the previous
 //! one's correction changed.
 //!
-//! Lighter bowing sounds sharper (the flattening with force runs the other way): the
-//! window's geometric middle (`F_max / 11`) is not what the table centres; the earlier
-//! procedure averaged it in (and smoothed over five semitones), leaving the notes played
-//! at the defaults half that difference out of tune (docs/playing-space.md, "Tuned at the
-//! defaults").
+//! The window's geometric middle (`F_max / 11`), the other nominal bowing, is not what the
+//! table centres: for the point laws it is rarely Helmholtz motion, and its pitch (its
+//! regime's) lies some cents from the defaults' (hyperbolic -4.8, static +6.6 cents,
+//! median). The earlier procedure averaged it in (and smoothed over five semitones),
+//! leaving the notes played at the defaults half that difference out of tune
+//! (docs/playing-space.md, "Tuned at the defaults").
 
 use crate::playing_space::{measure, Bowing, Cell, Model};
 use colophony::dsp::instrument::{InstrumentKind, MAX_STOP_SEMITONES, STRINGS};
@@ -275,7 +276,7 @@ mod tests {
     }
 
     #[test]
-    fn only_a_note_in_helmholtz_motion_near_its_pitch_steers_the_table() {
+    fn trusted_first_means_helmholtz_motion_near_the_pitch() {
         assert_eq!(trusted(5.0, true), Some(5.0));
         assert_eq!(trusted(80.0, true), None);
         assert_eq!(trusted(1.0, false), None);
