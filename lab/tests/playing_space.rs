@@ -179,9 +179,9 @@ fn bowed_at_the_defaults_the_point_laws_centre_on_equal_temperament() {
 /// The thermal model bowed at nominal (the plugin's defaults, 1 N, and the middle of each
 /// note's window) in Helmholtz motion sounds in tune: with paper B's eq. (1) as written
 /// its notes were 17 cents flat at the defaults (median) and the middle slid. Both nominal
-/// bowings stick with the default constants since 2026-11-25, and the intonation table is
-/// fitted to the mean of the two; the defaults alone sit a few cents flat (printed) where
-/// 1 N is near a thin string's `F_max` (the violin's E string: 1.15 N).
+/// bowings stick with the default constants since 2026-11-25. The intonation table is
+/// fitted at the defaults (with the mean of the two, the defaults sat 3.4 cents flat);
+/// the middle sounds a little sharper, the pitch falling with force (both printed).
 #[test]
 fn the_thermal_model_bowed_at_nominal_is_in_tune_where_it_is_helmholtz() {
     let results = nominal_results();

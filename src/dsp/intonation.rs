@@ -13,9 +13,7 @@
 //! instrument, string and semitone above the open string (0..=
 //! [`MAX_STOP_SEMITONES`](super::instrument::MAX_STOP_SEMITONES)) it holds the cents the
 //! note is moved so that bowing it at the plugin's defaults (0.1 m/s, 1 N on the knob,
-//! String Weight on, beta 0.1) sounds at equal temperament (the thermal rows: the mean
-//! of the defaults and the geometric middle of the note's Schelleng window, measured
-//! before the point laws' rows were re-fitted at the defaults alone). It is measured through the same engines the plugin plays by
+//! String Weight on for the point laws, beta 0.1) sounds at equal temperament. It is measured through the same engines the plugin plays by
 //! `colophony bench intonation` (`lab/src/intonation_fit.rs`), written to
 //! `assets/intonation.csv` and compiled in. Between semitones (pitch bend, vibrato) it is
 //! interpolated linearly. The change of pitch with force and bow position is left as the
