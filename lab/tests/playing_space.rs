@@ -124,9 +124,9 @@ fn bowed_at_the_defaults_the_point_laws_centre_on_equal_temperament() {
     {
         for rate in RATES {
             let of = |bowing: Bowing| {
-                results
-                    .iter()
-                    .filter(move |(c, _)| c.model == model && c.rate_hz == rate && c.bowing == bowing)
+                results.iter().filter(move |(c, _)| {
+                    c.model == model && c.rate_hz == rate && c.bowing == bowing
+                })
             };
             let mut cents: Vec<f64> = of(Bowing::Defaults).map(|(_, m)| m.cents).collect();
             cents.sort_by(f64::total_cmp);
@@ -140,8 +140,8 @@ fn bowed_at_the_defaults_the_point_laws_centre_on_equal_temperament() {
             // Middle minus defaults, note by note, where both sound near the note.
             let mut lighter: Vec<f64> = of(Bowing::Middle)
                 .filter_map(|(c, m)| {
-                    let d = of(Bowing::Defaults)
-                        .find(|(d, _)| d.kind == c.kind && d.note == c.note)?;
+                    let d =
+                        of(Bowing::Defaults).find(|(d, _)| d.kind == c.kind && d.note == c.note)?;
                     let diff = m.cents - d.1.cents;
                     (m.cents.abs() < 60.0 && d.1.cents.abs() < 60.0).then_some(diff)
                 })
