@@ -138,7 +138,7 @@ fn bowed_at_the_defaults_the_point_laws_centre_on_equal_temperament() {
                 .filter(|(_, m)| m.helmholtz && m.cents.abs() <= 3.0)
                 .count();
             // Middle minus defaults, note by note, where both sound near the note.
-            let mut lighter: Vec<f64> = of(Bowing::Middle)
+            let mut middle_offsets: Vec<f64> = of(Bowing::Middle)
                 .filter_map(|(c, m)| {
                     let d =
                         of(Bowing::Defaults).find(|(d, _)| d.kind == c.kind && d.note == c.note)?;
@@ -146,8 +146,11 @@ fn bowed_at_the_defaults_the_point_laws_centre_on_equal_temperament() {
                     (m.cents.abs() < 60.0 && d.1.cents.abs() < 60.0).then_some(diff)
                 })
                 .collect();
-            lighter.sort_by(f64::total_cmp);
-            let sharper = lighter.get(lighter.len() / 2).copied().unwrap_or(f64::NAN);
+            middle_offsets.sort_by(f64::total_cmp);
+            let middle_offset = middle_offsets
+                .get(middle_offsets.len() / 2)
+                .copied()
+                .unwrap_or(f64::NAN);
             let mut both: Vec<f64> = of(Bowing::Defaults)
                 .chain(of(Bowing::Middle))
                 .map(|(_, m)| m.cents)
@@ -156,10 +159,10 @@ fn bowed_at_the_defaults_the_point_laws_centre_on_equal_temperament() {
             let both_within =
                 both.iter().filter(|c| c.abs() <= 10.0).count() as f64 / both.len() as f64;
             let line = format!(
-                "{} at {rate} Hz, defaults: median {median:+.1} cents, {:.0} % within 10 cents, {in_tune} of {helmholtz} in Helmholtz motion within 3 cents; the middle {sharper:+.1} cents from the defaults (median of {} notes); both bowings: median {:+.1} cents, {:.0} % within 10 cents",
+                "{} at {rate} Hz, defaults: median {median:+.1} cents, {:.0} % within 10 cents, {in_tune} of {helmholtz} in Helmholtz motion within 3 cents; the middle {middle_offset:+.1} cents from the defaults (median of {} notes); both bowings: median {:+.1} cents, {:.0} % within 10 cents",
                 model.name(),
                 100.0 * within,
-                lighter.len(),
+                middle_offsets.len(),
                 both[both.len() / 2],
                 100.0 * both_within
             );

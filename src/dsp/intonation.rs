@@ -13,11 +13,11 @@
 //! instrument, string and semitone above the open string (0..=
 //! [`MAX_STOP_SEMITONES`](super::instrument::MAX_STOP_SEMITONES)) it holds the cents the
 //! note is moved so that bowing it at the plugin's defaults (0.1 m/s, 1 N on the knob,
-//! String Weight on for the point laws, beta 0.1) sounds at equal temperament. It is measured through the same engines the plugin plays by
-//! `colophony bench intonation` (`lab/src/intonation_fit.rs`), written to
-//! `assets/intonation.csv` and compiled in. Between semitones (pitch bend, vibrato) it is
-//! interpolated linearly. The change of pitch with force and bow position is left as the
-//! physics gives it.
+//! String Weight on for the point laws, beta 0.1) sounds at equal temperament. It is
+//! measured through the same engines the plugin plays by `colophony bench intonation`
+//! (`lab/src/intonation_fit.rs`), written to `assets/intonation.csv` and compiled in.
+//! Between semitones (pitch bend, vibrato) it is interpolated linearly. The change of
+//! pitch with force and bow position is left as the physics gives it.
 //!
 //! ```
 //! use colophony::dsp::instrument::InstrumentKind;
