@@ -13,9 +13,9 @@
 //! assert!(sound > 0.0);
 //! ```
 
-use super::instrument::{BowControl, Frame, Instrument, NoteExpression};
+use super::instrument::{BowControl, Frame, NoteExpression};
 use super::rubbed::RubbedInstrument;
-use super::thermal_instrument::ThermalInstrument;
+use super::strings::{FourStrings, StringBank};
 
 /// An instrument the notes play.
 pub trait Engine {
@@ -58,61 +58,54 @@ pub trait Engine {
     fn reset(&mut self);
 }
 
-/// The string instruments already have every method under the trait's name.
-macro_rules! string_engine {
-    ($t:ty) => {
-        impl Engine for $t {
-            fn note_on(&mut self, note: u8) -> Option<usize> {
-                <$t>::note_on(self, note)
-            }
-            fn note_on_gliding(&mut self, note: u8, glide_s: f64) -> Option<usize> {
-                <$t>::note_on_gliding(self, note, glide_s)
-            }
-            fn note_off(&mut self, note: u8) {
-                <$t>::note_off(self, note)
-            }
-            fn all_notes_off(&mut self) {
-                <$t>::all_notes_off(self)
-            }
-            fn set_pitch_bend(&mut self, semitones: f64) {
-                <$t>::set_pitch_bend(self, semitones)
-            }
-            fn set_note_expression(&mut self, string: usize, expression: NoteExpression) {
-                <$t>::set_note_expression(self, string, expression)
-            }
-            fn set_preferred_string(&mut self, string: Option<usize>) {
-                <$t>::set_preferred_string(self, string)
-            }
-            fn set_reference_pitch(&mut self, a4_hz: f64) {
-                <$t>::set_reference_pitch(self, a4_hz)
-            }
-            fn update_sleep(&mut self) {
-                <$t>::update_sleep(self)
-            }
-            fn is_sounding(&self) -> bool {
-                <$t>::is_sounding(self)
-            }
-            fn is_ringing(&self) -> bool {
-                <$t>::is_ringing(self)
-            }
-            fn ring_out_s(&self) -> Option<f64> {
-                <$t>::ring_out_s(self)
-            }
-            fn tick(&mut self, bow: BowControl) -> Frame {
-                <$t>::tick(self, bow)
-            }
-            fn latency_samples(&self) -> f64 {
-                <$t>::latency_samples(self)
-            }
-            fn reset(&mut self) {
-                <$t>::reset(self)
-            }
-        }
-    };
+/// Both string instruments are [`FourStrings`]: every method is already there.
+impl<B: StringBank> Engine for FourStrings<B> {
+    fn note_on(&mut self, note: u8) -> Option<usize> {
+        FourStrings::note_on(self, note)
+    }
+    fn note_on_gliding(&mut self, note: u8, glide_s: f64) -> Option<usize> {
+        FourStrings::note_on_gliding(self, note, glide_s)
+    }
+    fn note_off(&mut self, note: u8) {
+        FourStrings::note_off(self, note)
+    }
+    fn all_notes_off(&mut self) {
+        FourStrings::all_notes_off(self)
+    }
+    fn set_pitch_bend(&mut self, semitones: f64) {
+        FourStrings::set_pitch_bend(self, semitones)
+    }
+    fn set_note_expression(&mut self, string: usize, expression: NoteExpression) {
+        FourStrings::set_note_expression(self, string, expression)
+    }
+    fn set_preferred_string(&mut self, string: Option<usize>) {
+        FourStrings::set_preferred_string(self, string)
+    }
+    fn set_reference_pitch(&mut self, a4_hz: f64) {
+        FourStrings::set_reference_pitch(self, a4_hz)
+    }
+    fn update_sleep(&mut self) {
+        FourStrings::update_sleep(self)
+    }
+    fn is_sounding(&self) -> bool {
+        FourStrings::is_sounding(self)
+    }
+    fn is_ringing(&self) -> bool {
+        FourStrings::is_ringing(self)
+    }
+    fn ring_out_s(&self) -> Option<f64> {
+        FourStrings::ring_out_s(self)
+    }
+    fn tick(&mut self, bow: BowControl) -> Frame {
+        FourStrings::tick(self, bow)
+    }
+    fn latency_samples(&self) -> f64 {
+        FourStrings::latency_samples(self)
+    }
+    fn reset(&mut self) {
+        FourStrings::reset(self)
+    }
 }
-
-string_engine!(Instrument);
-string_engine!(ThermalInstrument);
 
 /// The rubbed objects take every note as one exciter on the active object (a note held
 /// twice counts twice: the performer sends each held key once).

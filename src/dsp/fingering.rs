@@ -1,10 +1,10 @@
 //! What both string instruments (the point-bow [`super::instrument::Instrument`] and
-//! paper B's [`super::thermal_instrument::ThermalInstrument`]) share between a note and
-//! their strings: which string a note goes to, where the finger stops it (equal
-//! temperament under the pitch bend, the note's own bend, a finger glide and the
-//! reference pitch, moved by the intonation table), and the bow's envelope on each
-//! string. The instruments keep what differs: their strings, how a string is retuned, and
-//! how they sleep.
+//! paper B's [`super::thermal_instrument::ThermalInstrument`], both a
+//! [`super::strings::FourStrings`]) hold between a note and their strings: which string a
+//! note goes to, where the finger stops it (equal temperament under the pitch bend, the
+//! note's own bend, a finger glide and the reference pitch, moved by the intonation
+//! table), and the bow's envelope on each string. The string banks keep what differs:
+//! their strings, how a string is retuned, and how they sleep.
 //!
 //! ```
 //! use colophony::dsp::fingering::{BowEnvelope, Fingering};

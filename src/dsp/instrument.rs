@@ -12,6 +12,11 @@
 //! decays. A string whose energy falls below [`SLEEP_ENERGY_J`] with the bow lifted is
 //! cleared and skipped until the next note on it.
 //!
+//! The notes, fingers and bow envelopes are the four-string instrument's
+//! ([`super::strings::FourStrings`], shared with paper B's instrument); this module holds
+//! the strings and body it plays ([`WaveguideBank`]) and what only they have (friction
+//! laws, torsion, bow hair, custom bodies).
+//!
 //! ```
 //! use colophony::dsp::instrument::{BowControl, Instrument, InstrumentKind};
 //! let mut cello = Instrument::new(InstrumentKind::Cello, 48_000.0);
@@ -22,11 +27,12 @@
 //! ```
 
 use super::body::{BodyMode, BodyModes, MAX_BODY_MODES};
-use super::fingering::{BowEnvelope, Fingering};
 use super::friction::bristle::{BristleParams, SolverStats};
 use super::friction::{AnyFriction, BowInput, FrictionContact, FrictionModel};
-use super::intonation::{self, IntonationTable, MAX_CORRECTION_CENTS};
+use super::intonation::{self, MAX_CORRECTION_CENTS};
 use super::resample::Resampler;
+pub use super::strings::FourStrings;
+use super::strings::{StringBank, StringBow};
 use super::waveguide::{StringSpec, WaveguideString};
 
 /// The rate the point-bow strings and their body run at, whatever the host's: the output
@@ -331,49 +337,190 @@ pub const MAX_NOTE_FORCE_SCALE: f64 = 4.0;
 pub const MIN_NOTE_BETA: f64 = 0.02;
 pub const MAX_NOTE_BETA: f64 = 0.5;
 
+/// One point-bow string with its contact.
 #[derive(Debug, Clone)]
 struct StringVoice {
     string: WaveguideString,
     contact: AnyFriction,
-    bow: BowEnvelope,
     awake: bool,
-    /// Whether the note's expression is not neutral (one test per sample instead of three).
-    expressive: bool,
-    /// The bow force's factor on this string when weighted ([`InstrumentKind::string_weight`]).
-    weight: f64,
 }
 
+/// The point-bow instrument's strings and body at the internal rate: four independent
+/// waveguide strings, each with its own friction contact, whose bridge forces drive the
+/// body's modes ([`super::body`]); the bridge is rigid for the strings.
 #[derive(Debug, Clone)]
-pub struct Instrument {
+pub struct WaveguideBank {
     kind: InstrumentKind,
     /// The rate the strings and body run at ([`INTERNAL_RATE_HZ`], or the host's for
     /// [`Instrument::native`]).
     sample_rate_hz: f64,
-    /// The rate [`Instrument::tick`] is called at.
-    host_rate_hz: f64,
-    /// From the internal rate to the host's; `None` where they are the same.
-    /// Boxed: taking it out for a tick moves a pointer, not the resampler.
-    resampler: Option<Box<Resampler>>,
-    /// The probe of the last internal sample (what a resampled tick reports).
-    last: Frame,
     voices: [StringVoice; STRINGS],
-    /// Notes, fingers and tuning ([`Fingering`]).
-    fingering: Fingering,
     body: BodyModes,
     /// Each instrument's body in place of the generic one ([`Instrument::set_body`]):
     /// modes and their count, per [`InstrumentKind::ALL`] index.
     custom_bodies: [Option<([BodyMode; MAX_BODY_MODES], usize)>; 3],
-    probed: usize,
-    ramp_step: f64,
     output_scale: f64,
+    /// The probed string's last internal sample: velocity at the bow, friction force.
+    probe: (f64, f64),
     /// Whether quiet lifted strings sleep (the default; off only to measure the saving).
     skipping: bool,
     /// No string awake and the body rung out: a sample costs nothing.
     body_asleep: bool,
-    /// Times the non-finite guard in [`Instrument::tick`] reset the instrument.
-    recoveries: u64,
-    /// Whether the bow force is weighted per string ([`Instrument::set_string_weighting`]).
-    weighted: bool,
+}
+
+/// The four waveguide strings of a violin, viola or cello with a shared bow, note
+/// handling and a generic body (see the module doc): [`FourStrings`] over
+/// [`WaveguideBank`].
+pub type Instrument = FourStrings<WaveguideBank>;
+
+impl WaveguideBank {
+    /// The body `kind` plays: its custom one if set, else the generic one.
+    fn body_of(&self, kind: InstrumentKind) -> BodyModes {
+        let k = InstrumentKind::ALL.iter().position(|&x| x == kind);
+        match k.and_then(|k| self.custom_bodies[k].as_ref()) {
+            Some((modes, n)) => BodyModes::new(&modes[..*n], 1.0, self.sample_rate_hz),
+            None => BodyModes::new(&kind.body_modes(), 1.0, self.sample_rate_hz),
+        }
+    }
+}
+
+impl StringBank for WaveguideBank {
+    type Settings = ();
+
+    fn internal_rate_hz(&self) -> f64 {
+        self.sample_rate_hz
+    }
+
+    fn stop(&mut self, i: usize, hz: f64) -> bool {
+        let string = &mut self.voices[i].string;
+        string.stop_at(hz);
+        string.is_playable()
+    }
+
+    fn bend(&mut self, i: usize, hz: f64) -> bool {
+        let string = &mut self.voices[i].string;
+        string.bend_to(hz);
+        string.is_playable()
+    }
+
+    fn wake(&mut self, i: usize) {
+        let voice = &mut self.voices[i];
+        voice.awake = voice.string.is_playable();
+    }
+
+    fn string_awake(&self, i: usize) -> bool {
+        self.voices[i].awake
+    }
+
+    #[inline(always)]
+    fn is_awake(&self) -> bool {
+        !(self.body_asleep && self.voices.iter().all(|v| !v.awake))
+    }
+
+    fn set_skipping(&mut self, skipping: bool) {
+        self.skipping = skipping;
+    }
+
+    /// One internal sample.
+    #[inline(always)]
+    fn sample(&mut self, probed: usize, mut bow_of: impl FnMut(usize) -> StringBow) -> f64 {
+        // `tick` checked that something is awake; sleep changes only between blocks.
+        let mut bridge = 0.0;
+        let skipping = self.skipping;
+        self.body_asleep = false;
+        for (i, voice) in self.voices.iter_mut().enumerate() {
+            if !voice.awake && skipping {
+                continue;
+            }
+            let bow = bow_of(i);
+            voice.string.set_bow_position(bow.position_beta);
+            let input = BowInput {
+                velocity_m_per_s: bow.velocity_m_per_s,
+                normal_force_n: bow.force,
+            };
+            let out = voice.string.tick(&mut voice.contact, input);
+            bridge += out.bridge_force_n;
+            if i == probed {
+                self.probe = (out.bow_point_velocity_m_per_s, out.friction_force_n);
+            }
+        }
+        super::filters::flush_tiny(self.body.tick(bridge) * self.output_scale)
+    }
+
+    fn probe(&self) -> (f64, f64) {
+        self.probe
+    }
+
+    fn sleep(&mut self, lifted: &[bool; STRINGS]) -> bool {
+        // The body sleeps too once no string is awake and its modes have rung out
+        // (state below 1e-12 N: output below -200 dB of a bowed note).
+        self.body_asleep = self.voices.iter().all(|v| !v.awake) && self.body.is_quiet(BODY_QUIET_N);
+        if self.body_asleep {
+            self.body.reset();
+        }
+        for (voice, &lifted) in self.voices.iter_mut().zip(lifted) {
+            if voice.awake && lifted && voice.string.energy_j() < SLEEP_ENERGY_J {
+                voice.string.reset();
+                voice.awake = false;
+            }
+        }
+        self.body_asleep
+    }
+
+    /// Each awake string's energy is taken to fall at its fundamental's rate
+    /// ([`ring_out_s`]), the slowest of its partials; the body then rings out from its
+    /// present state at its modes' own rates (an overestimate: it will have decayed while
+    /// the strings did).
+    fn ring_out_s(&self, lifted: &[bool; STRINGS]) -> Option<f64> {
+        let body_s = if self.body_asleep {
+            0.0
+        } else {
+            self.body.samples_below(BODY_QUIET_N) / self.sample_rate_hz
+        };
+        let mut longest = 0.0f64;
+        for (voice, &lifted) in self.voices.iter().zip(lifted) {
+            if !voice.awake {
+                continue;
+            }
+            if !lifted {
+                return None;
+            }
+            let s = &voice.string;
+            // Measured after the bow lifts (cello D3, 2.5 N, the energy's decay over
+            // successive seconds, in periods of the fundamental): Q 500 over 1-6 s, then
+            // 516, 551, 601, 633 and 641 by 24-29 s, with or without torsion and hair. The
+            // slow part is the loop's DC pair (a right-going and a left-going wave of
+            // opposite constant value: no string velocity, a constant force), which the
+            // bow's mean friction force charges and which decays at the one-pole loss's DC
+            // gain (above its gain at the fundamental): Q about 640 per period here. The
+            // estimate takes Q1 5 % high, enough for the default note's tail (the tail
+            // test); a loud note's tail can still outlast it. A DC blocker in the loop is
+            // the fix (docs/playing-space.md, "With the bow hair too").
+            let q = RING_OUT_Q_MARGIN * s.spec().q1;
+            longest = longest.max(ring_out_s(s.energy_j(), s.fundamental_hz(), q));
+        }
+        Some(longest + body_s)
+    }
+
+    fn energy_j(&self) -> f64 {
+        self.voices.iter().map(|v| v.string.energy_j()).sum()
+    }
+
+    fn reset(&mut self) {
+        for voice in &mut self.voices {
+            voice.string.reset();
+            voice.contact.reset();
+            voice.awake = false;
+        }
+        self.body.reset();
+        self.probe = (0.0, 0.0);
+    }
+
+    fn settings(&self) {}
+
+    fn configure(&mut self, _settings: ()) -> Result<(), String> {
+        Ok(())
+    }
 }
 
 impl Instrument {
@@ -407,13 +554,6 @@ impl Instrument {
                     .expect("finite positive rates are always resampled"),
             )
         });
-        let mut instrument = Self::at_rate(kind, sample_rate_hz);
-        instrument.host_rate_hz = host_rate_hz;
-        instrument.resampler = resampler;
-        instrument
-    }
-
-    fn at_rate(kind: InstrumentKind, sample_rate_hz: f64) -> Self {
         // Lowest fundamental any instrument can reach: cello C bent down at the lowest
         // reference pitch.
         let lowest_hz = midi_to_hz(36.0 + LOWEST_TUNING_SEMITONES) * 0.99;
@@ -426,71 +566,26 @@ impl Instrument {
                 sample_rate_hz,
             )
             .expect("the built-in bristle parameters are valid"),
-            bow: BowEnvelope::default(),
             awake: false,
-            expressive: false,
-            weight: kind.string_weight(i),
         });
-        Self {
+        let bank = WaveguideBank {
             kind,
             sample_rate_hz,
-            host_rate_hz: sample_rate_hz,
-            resampler: None,
-            last: Frame::default(),
             voices,
-            fingering: Fingering::new(
-                kind,
-                Some(intonation::model_index(FrictionModel::Hyperbolic.name())),
-            ),
             body: BodyModes::new(&kind.body_modes(), 1.0, sample_rate_hz),
             custom_bodies: [None; 3],
-            probed: 0,
-            ramp_step: 1.0 / (BOW_RAMP_S * sample_rate_hz),
             output_scale: kind.output_scale_per_n(),
+            probe: (0.0, 0.0),
             skipping: true,
             body_asleep: true,
-            recoveries: 0,
-            weighted: false,
-        }
-    }
-
-    /// Weights the bow force per string (on: string `i` is bowed with the force times
-    /// [`InstrumentKind::string_weight`]`(i)`; off, the default: every string gets the
-    /// force as given, the bare model the tools measure). The performer turns it on for
-    /// the player (the String Weight parameter). Real-time safe.
-    pub fn set_string_weighting(&mut self, on: bool) {
-        self.weighted = on;
-    }
-
-    /// Whether the bow force is weighted per string.
-    pub fn string_weighting(&self) -> bool {
-        self.weighted
-    }
-
-    fn update_weights(&mut self) {
-        for (i, voice) in self.voices.iter_mut().enumerate() {
-            voice.weight = self.kind.string_weight(i);
-        }
-    }
-
-    pub fn kind(&self) -> InstrumentKind {
-        self.kind
-    }
-
-    /// The host rate [`Instrument::tick`] runs at.
-    pub fn sample_rate_hz(&self) -> f64 {
-        self.host_rate_hz
-    }
-
-    /// The rate the strings and body run at.
-    pub fn internal_rate_hz(&self) -> f64 {
-        self.sample_rate_hz
-    }
-
-    /// How late the output is behind the strings, host samples (the resampler's delay;
-    /// 0 at the internal rate).
-    pub fn latency_samples(&self) -> f64 {
-        self.resampler.as_ref().map_or(0.0, |r| r.latency_samples())
+        };
+        Self::from_bank(
+            bank,
+            kind,
+            host_rate_hz,
+            resampler,
+            intonation::model_index(FrictionModel::Hyperbolic.name()),
+        )
     }
 
     /// Switches instrument: every string is replaced and silenced. Real-time safe.
@@ -498,17 +593,16 @@ impl Instrument {
         if kind == self.kind {
             return;
         }
-        self.kind = kind;
-        self.fingering.set_kind(kind);
-        for (voice, spec) in self.voices.iter_mut().zip(kind.strings()) {
+        self.set_kind_notes(kind);
+        let bank = &mut self.bank;
+        bank.kind = kind;
+        for (voice, spec) in bank.voices.iter_mut().zip(kind.strings()) {
             voice.string.set_spec(spec);
             voice.contact.reset();
-            voice.bow = BowEnvelope::default();
             voice.awake = false;
         }
-        self.body = self.body_of(kind);
-        self.output_scale = kind.output_scale_per_n();
-        self.update_weights();
+        bank.body = bank.body_of(kind);
+        bank.output_scale = kind.output_scale_per_n();
     }
 
     /// Plays `kind`'s body as `modes` (at most [`MAX_BODY_MODES`]; a fitted bridge's
@@ -519,7 +613,8 @@ impl Instrument {
         let Some(k) = InstrumentKind::ALL.iter().position(|&x| x == kind) else {
             return;
         };
-        self.custom_bodies[k] = modes.map(|m| {
+        let bank = &mut self.bank;
+        bank.custom_bodies[k] = modes.map(|m| {
             let mut kept = [BodyMode {
                 freq_hz: 0.0,
                 q: 1.0,
@@ -529,360 +624,29 @@ impl Instrument {
             kept[..n].copy_from_slice(&m[..n]);
             (kept, n)
         });
-        if kind == self.kind {
-            self.body = self.body_of(kind);
-            self.body_asleep = false;
+        if kind == bank.kind {
+            bank.body = bank.body_of(kind);
+            bank.body_asleep = false;
         }
-    }
-
-    /// The body `kind` plays: its custom one if set, else the generic one.
-    fn body_of(&self, kind: InstrumentKind) -> BodyModes {
-        let k = InstrumentKind::ALL.iter().position(|&x| x == kind);
-        match k.and_then(|k| self.custom_bodies[k].as_ref()) {
-            Some((modes, n)) => BodyModes::new(&modes[..*n], 1.0, self.sample_rate_hz),
-            None => BodyModes::new(&kind.body_modes(), 1.0, self.sample_rate_hz),
-        }
-    }
-
-    pub fn reset(&mut self) {
-        for voice in &mut self.voices {
-            voice.string.reset();
-            voice.contact.reset();
-            voice.bow = BowEnvelope::default();
-            voice.awake = false;
-        }
-        self.fingering.release_all();
-        self.body.reset();
-        if let Some(r) = &mut self.resampler {
-            r.reset();
-        }
-        self.last = Frame::default();
-    }
-
-    /// Stops the string for `note` and lands the bow on it. Returns the string index, or
-    /// `None` if the instrument cannot play the note (it is then ignored).
-    pub fn note_on(&mut self, note: u8) -> Option<usize> {
-        let index = self.fingering.string_for_note_on(note)?;
-        self.fingering.start(index, note);
-        let hz = self.fingering.tuned_hz(index);
-        let voice = &mut self.voices[index];
-        voice.expressive = false;
-        voice.string.stop_at(hz);
-        voice.bow.bowed = true;
-        voice.awake = voice.string.is_playable();
-        self.probed = index;
-        Some(index)
-    }
-
-    /// A legato note that slides the finger (portamento): on a string already bowed with
-    /// another note, the stopping point glides from that note's place to this one over
-    /// `glide_s` seconds (linearly in semitones, retuned every [`GLIDE_EVERY`](super::fingering::GLIDE_EVERY) samples);
-    /// otherwise, or with `glide_s` not positive, as [`Instrument::note_on`].
-    pub fn note_on_gliding(&mut self, note: u8, glide_s: f64) -> Option<usize> {
-        let index = self.fingering.string_for_note_on(note)?;
-        let voice = &self.voices[index];
-        let from = match self.fingering.note(index) {
-            Some(old) if voice.bow.bowed && voice.awake && glide_s > 0.0 && glide_s.is_finite() => {
-                old as f64 + self.fingering.glide(index)
-            }
-            _ => return self.note_on(note),
-        };
-        let distance = from - note as f64;
-        self.fingering
-            .glide_to(index, note, distance, glide_s, self.sample_rate_hz);
-        self.probed = index;
-        let hz = self.fingering.tuned_hz(index);
-        self.voices[index].string.bend_to(hz);
-        Some(index)
-    }
-
-    /// Lifts the bow from the string playing `note`, if any.
-    pub fn note_off(&mut self, note: u8) {
-        for (i, voice) in self.voices.iter_mut().enumerate() {
-            if self.fingering.note(i) == Some(note) {
-                voice.bow.bowed = false;
-            }
-        }
-    }
-
-    /// Lifts the bow from every string.
-    pub fn all_notes_off(&mut self) {
-        for voice in &mut self.voices {
-            voice.bow.bowed = false;
-        }
-    }
-
-    /// Asks later notes to go to string `preferred` (0 = the lowest) where it can play
-    /// them ([`InstrumentKind::string_for_note_on`]); `None` restores the usual choice.
-    /// Notes already sounding stay where they are.
-    pub fn set_preferred_string(&mut self, preferred: Option<usize>) {
-        self.fingering.set_preferred_string(preferred);
-    }
-
-    /// Pitch bend in semitones (clamped to [`MAX_BEND_RANGE_SEMITONES`]): moves every
-    /// stopping point, as far as the string reaches ([`intonation::tuned_hz`]).
-    pub fn set_pitch_bend(&mut self, semitones: f64) {
-        if self.fingering.set_pitch_bend(semitones) {
-            self.retune();
-        }
-    }
-
-    /// Gives string `index` its note's own expression (sanitized; see
-    /// [`NoteExpression`]); a changed bend retunes it at once. A new note on the string
-    /// starts neutral again.
-    pub fn set_note_expression(&mut self, index: usize, expression: NoteExpression) {
-        if index >= STRINGS {
-            return;
-        }
-        let bent = self.fingering.set_expression(index, expression);
-        self.voices[index].expressive = self.fingering.expression(index) != NoteExpression::NEUTRAL;
-        if bent {
-            let hz = self.fingering.tuned_hz(index);
-            self.voices[index].string.bend_to(hz);
-        }
-    }
-
-    /// String `index`'s note expression.
-    pub fn note_expression(&self, index: usize) -> NoteExpression {
-        self.fingering.expression(index)
-    }
-
-    /// Tunes every note from the reference pitch `a4_hz` (415..466 Hz; see
-    /// [`reference_semitones`]); sounding notes follow at once.
-    pub fn set_reference_pitch(&mut self, a4_hz: f64) {
-        if self.fingering.set_reference_pitch(a4_hz) {
-            self.retune();
-        }
-    }
-
-    /// Moves every stopped note to its pitch under the current bend and reference.
-    fn retune(&mut self) {
-        for i in 0..STRINGS {
-            if self.fingering.note(i).is_some() {
-                let hz = self.fingering.tuned_hz(i);
-                self.voices[i].string.bend_to(hz);
-            }
-        }
-    }
-
-    /// Tunes by the bowed sound with `table` (the default is the shipped one), or by the
-    /// free decay with `None` (paper A's scenes, the free-string tuning tests). Sounding
-    /// notes follow at once.
-    pub fn set_intonation(&mut self, table: Option<&'static IntonationTable>) {
-        self.fingering.set_intonation(table);
-        self.retune();
     }
 
     /// The string a note was sent to, with its current tuning (for tests and tools).
-    /// How far the bow rests on string `index`: 0 lifted, 1 fully on (it ramps between
-    /// over [`BOW_RAMP_S`]); 0 for a string that does not exist.
-    pub fn bow_gain(&self, index: usize) -> f64 {
-        self.voices.get(index).map_or(0.0, |v| v.bow.gain)
-    }
-
     pub fn string(&self, index: usize) -> &WaveguideString {
-        &self.voices[index].string
-    }
-
-    /// Total wave energy of all strings, J.
-    pub fn energy_j(&self) -> f64 {
-        self.voices.iter().map(|v| v.string.energy_j()).sum()
-    }
-
-    /// Whether any string is awake (bowed or still ringing).
-    pub fn is_sounding(&self) -> bool {
-        self.voices.iter().any(|v| v.awake)
-    }
-
-    /// Whether anything still rings: an awake string, or the body after the strings slept.
-    pub fn is_ringing(&self) -> bool {
-        self.is_sounding() || !self.body_asleep
-    }
-
-    /// Seconds until every string and the body would fall asleep if no bow lands again
-    /// (the host's tail), or `None` while a bow is on a string. Each awake string's energy
-    /// is taken to fall at its fundamental's rate ([`ring_out_s`]), the slowest of its
-    /// partials; the body then rings out from its present state at its modes' own rates
-    /// (an overestimate: it will have decayed while the strings did). Walks the delay
-    /// lines: call once per block.
-    pub fn ring_out_s(&self) -> Option<f64> {
-        let body_s = if self.body_asleep {
-            0.0
-        } else {
-            self.body.samples_below(BODY_QUIET_N) / self.sample_rate_hz
-        };
-        self.strings_ring_out_s().map(|s| s + body_s)
-    }
-
-    fn strings_ring_out_s(&self) -> Option<f64> {
-        let mut longest = 0.0f64;
-        for voice in self.voices.iter().filter(|v| v.awake) {
-            if !voice.bow.is_lifted() {
-                return None;
-            }
-            let s = &voice.string;
-            // Measured after the bow lifts (cello D3, 2.5 N, the energy's decay over
-            // successive seconds, in periods of the fundamental): Q 500 over 1-6 s, then
-            // 516, 551, 601, 633 and 641 by 24-29 s, with or without torsion and hair. The
-            // slow part is the loop's DC pair (a right-going and a left-going wave of
-            // opposite constant value: no string velocity, a constant force), which the
-            // bow's mean friction force charges and which decays at the one-pole loss's DC
-            // gain (above its gain at the fundamental): Q about 640 per period here. The
-            // estimate takes Q1 5 % high, enough for the default note's tail (the tail
-            // test); a loud note's tail can still outlast it. A DC blocker in the loop is
-            // the fix (docs/playing-space.md, "With the bow hair too").
-            let q = RING_OUT_Q_MARGIN * s.spec().q1;
-            longest = longest.max(ring_out_s(s.energy_j(), s.fundamental_hz(), q));
-        }
-        Some(longest)
-    }
-
-    /// Puts lifted strings whose energy fell below [`SLEEP_ENERGY_J`] to sleep. Called once
-    /// per block by the plugin and the renderer (it walks the delay lines).
-    pub fn update_sleep(&mut self) {
-        if !self.skipping {
-            return;
-        }
-        // The body sleeps too once no string is awake and its modes have rung out
-        // (state below 1e-12 N: output below -200 dB of a bowed note).
-        self.body_asleep = self.voices.iter().all(|v| !v.awake) && self.body.is_quiet(BODY_QUIET_N);
-        if self.body_asleep {
-            self.body.reset();
-            // What the resampler still holds is below -200 dB: asleep is silence.
-            if let Some(r) = &mut self.resampler {
-                r.reset();
-            }
-        }
-        for voice in &mut self.voices {
-            if voice.awake && voice.bow.is_lifted() && voice.string.energy_j() < SLEEP_ENERGY_J {
-                voice.string.reset();
-                voice.awake = false;
-            }
-        }
-    }
-
-    /// One host sample: the internal samples it needs, resampled (the bow control holds
-    /// over them), or one internal sample where the rates are the same.
-    #[inline]
-    pub fn tick(&mut self, bow: BowControl) -> Frame {
-        if self.asleep() {
-            // Silence; the resampler was cleared when the instrument fell asleep.
-            return Frame::default();
-        }
-        let Some(mut resampler) = self.resampler.take() else {
-            return self.tick_internal(bow);
-        };
-        let mut out = [0.0];
-        resampler.process(
-            || {
-                let frame = self.tick_internal(bow);
-                self.last = frame;
-                frame.audio
-            },
-            &mut out,
-        );
-        self.resampler = Some(resampler);
-        Frame {
-            audio: super::filters::flush_tiny(out[0]),
-            ..self.last
-        }
-    }
-
-    /// Sleeping is on and nothing is awake: an internal sample is silence.
-    #[inline]
-    fn asleep(&self) -> bool {
-        self.skipping && self.body_asleep && self.voices.iter().all(|v| !v.awake)
-    }
-
-    /// One internal sample.
-    #[inline]
-    fn tick_internal(&mut self, bow: BowControl) -> Frame {
-        // `tick` checked that something is awake; sleep changes only between blocks.
-        let mut bridge = 0.0;
-        let mut frame = Frame::default();
-        let skipping = self.skipping;
-        let weighting = self.weighted;
-        self.body_asleep = false;
-        if let Some(retune) = self.fingering.glide_tick() {
-            for (voice, hz) in self.voices.iter_mut().zip(retune) {
-                if let Some(hz) = hz {
-                    voice.string.bend_to(hz);
-                }
-            }
-        }
-        for (i, voice) in self.voices.iter_mut().enumerate() {
-            if !voice.awake && skipping {
-                continue;
-            }
-            let bow_gain = voice.bow.advance(self.ramp_step);
-            // Weighted, a string is never bowed harder than the force parameter's top.
-            let weighted = if weighting {
-                (bow.force_n * voice.weight).min(MAX_WEIGHTED_FORCE_N)
-            } else {
-                bow.force_n
-            };
-            let (force, beta) = if !voice.expressive {
-                (weighted, bow.position_beta)
-            } else {
-                let e = self.fingering.expression(i);
-                (
-                    weighted * e.force_scale,
-                    (bow.position_beta * e.position_scale).clamp(MIN_NOTE_BETA, MAX_NOTE_BETA),
-                )
-            };
-            voice.string.set_bow_position(beta);
-            let input = BowInput {
-                velocity_m_per_s: bow.velocity_m_per_s,
-                normal_force_n: force * bow_gain,
-            };
-            let out = voice.string.tick(&mut voice.contact, input);
-            bridge += out.bridge_force_n;
-            if i == self.probed {
-                frame.bow_point_velocity_m_per_s = out.bow_point_velocity_m_per_s;
-                frame.friction_force_n = out.friction_force_n;
-            }
-        }
-        frame.audio = super::filters::flush_tiny(self.body.tick(bridge) * self.output_scale);
-        if !frame.audio.is_finite() {
-            // Cannot happen with finite inputs; if it ever does, recover to silence rather
-            // than emit garbage.
-            self.reset();
-            self.recoveries += 1;
-            frame = Frame::default();
-        }
-        frame
-    }
-
-    /// Turns sleeping off (every string is computed every sample) or on. Off only serves
-    /// to measure what skipping saves and changes: `colophony bench scenes`.
-    pub fn set_skipping(&mut self, skipping: bool) {
-        self.skipping = skipping;
-    }
-
-    /// Whether sleeping strings are skipped (the default; see [`Instrument::set_skipping`]).
-    pub fn is_skipping(&self) -> bool {
-        self.skipping
+        &self.bank.voices[index].string
     }
 
     /// Strings computed on the next sample.
     pub fn awake_strings(&self) -> usize {
-        self.voices.iter().filter(|v| v.awake).count()
-    }
-
-    /// Renders `out.len()` samples of audio with constant bow settings: a loop over
-    /// [`Instrument::tick`], tested to give the same output bit for bit.
-    pub fn process(&mut self, bow: BowControl, out: &mut [f64]) {
-        for sample in out {
-            *sample = self.tick(bow).audio;
-        }
+        self.bank.voices.iter().filter(|v| v.awake).count()
     }
 
     /// Switches every string's friction law, handing over force and stick state (no click).
     pub fn set_friction_model(&mut self, model: FrictionModel) {
-        for voice in &mut self.voices {
+        for voice in &mut self.bank.voices {
             voice.contact.set_model(model);
         }
         if self
+            .hands
             .fingering
             .set_intonation_row(intonation::model_index(model.name()))
         {
@@ -893,7 +657,7 @@ impl Instrument {
     /// Turns the strings' torsion at the bow on (the default) or off
     /// ([`WaveguideString::set_torsion`]).
     pub fn set_torsion(&mut self, enabled: bool) {
-        for voice in &mut self.voices {
+        for voice in &mut self.bank.voices {
             voice.string.set_torsion(enabled);
         }
     }
@@ -901,16 +665,17 @@ impl Instrument {
     /// Lets the bow hair yield (the default) or ties the contact rigidly to the bow
     /// ([`WaveguideString::set_bow_hair`]).
     pub fn set_bow_hair(&mut self, enabled: bool) {
-        for voice in &mut self.voices {
+        for voice in &mut self.bank.voices {
             voice.string.set_bow_hair(enabled);
         }
     }
 
     /// Replaces the bristle parameters of every string (validated; real-time safe).
     pub fn set_bristle_params(&mut self, params: BristleParams) -> Result<(), String> {
-        for voice in &mut self.voices {
+        let rate = self.bank.sample_rate_hz;
+        for voice in &mut self.bank.voices {
             let model = voice.contact.model();
-            voice.contact = AnyFriction::new(model, params, self.sample_rate_hz)?;
+            voice.contact = AnyFriction::new(model, params, rate)?;
         }
         Ok(())
     }
@@ -919,7 +684,7 @@ impl Instrument {
     /// [`crate::dsp::friction::bristle::BristleFriction::set_newton_tolerance`]). Call it
     /// after [`Self::set_bristle_params`], which rebuilds the contacts at the default.
     pub fn set_newton_tolerance(&mut self, tolerance_m_per_s: f64) {
-        for voice in &mut self.voices {
+        for voice in &mut self.bank.voices {
             voice
                 .contact
                 .bristle_mut()
@@ -934,7 +699,7 @@ impl Instrument {
         &mut self,
         integrator: crate::dsp::friction::bristle::BristleIntegrator,
     ) {
-        for voice in &mut self.voices {
+        for voice in &mut self.bank.voices {
             voice.contact.bristle_mut().set_integrator(integrator);
         }
     }
@@ -943,35 +708,29 @@ impl Instrument {
     /// see [`super::waveguide::WaveguideString::set_dispersion_cap`]). For the
     /// work-precision bench, not the audio thread.
     pub fn set_dispersion_cap(&mut self, stages: usize) {
-        for voice in &mut self.voices {
+        for voice in &mut self.bank.voices {
             voice.string.set_dispersion_cap(stages);
         }
     }
 
     pub fn friction_model(&self) -> FrictionModel {
-        self.voices[0].contact.model()
+        self.bank.voices[0].contact.model()
     }
 
     /// Newton statistics of the probed string's bristle contact.
     pub fn probed_solver_stats(&self) -> SolverStats {
-        self.voices[self.probed].contact.bristle().stats
+        self.bank.voices[self.hands.probed].contact.bristle().stats
     }
 
     /// Newton statistics of string `index`'s bristle contact (the stress suite checks
     /// every string's).
     pub fn solver_stats(&self, index: usize) -> SolverStats {
-        self.voices[index].contact.bristle().stats
-    }
-
-    /// How often the non-finite guard in [`Instrument::tick`] has fired (it never should:
-    /// the stress suite asserts zero, since the guard would otherwise hide a NaN).
-    pub fn recoveries(&self) -> u64 {
-        self.recoveries
+        self.bank.voices[index].contact.bristle().stats
     }
 
     /// Whether the contact of the probed string is sticking (for analysis).
     pub fn probed_is_sticking(&self) -> bool {
-        self.voices[self.probed].contact.is_sticking()
+        self.bank.voices[self.hands.probed].contact.is_sticking()
     }
 }
 

@@ -1,9 +1,10 @@
 //! The DSP core. It never imports the plugin framework: it takes plain settings in SI
 //! units. Parts: friction contacts ([`friction`]), resonators ([`waveguide`]), the body
 //! ([`body`]) on one delay line ([`delay`]), the instrument that wires them to notes and a
-//! bow ([`instrument`]); paper B's
-//! finite-width thermal bow ([`thermal`]) and its four-string instrument at the modal bridge
-//! ([`thermal_instrument`]).
+//! bow ([`instrument`]); paper B's finite-width thermal bow ([`thermal`]) and its
+//! four-string instrument at the modal bridge ([`thermal_instrument`]). Both instruments
+//! are one [`strings::FourStrings`] (notes, fingers, the bow on each string, sleep,
+//! resampling) over their own [`strings::StringBank`].
 
 pub mod body;
 pub mod bridge;
@@ -18,6 +19,7 @@ pub mod intonation;
 pub mod modal;
 pub mod resample;
 pub mod rubbed;
+pub mod strings;
 pub mod thermal;
 pub mod thermal_instrument;
 pub mod waveguide;

@@ -472,7 +472,7 @@ impl WaveguideString {
     /// Indexing: the right-going wave at position `x` (0 = bridge) was written at the bridge
     /// `x` samples ago, the left-going one at the nut `M - 1 - x` samples ago; both lines
     /// share the time index `t`.
-    #[inline]
+    #[inline(always)]
     pub fn tick(&mut self, contact: &mut impl FrictionContact, bow: BowInput) -> StringOutput {
         if !self.playable {
             return StringOutput::default();

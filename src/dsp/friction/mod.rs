@@ -292,7 +292,7 @@ impl AnyFriction {
 }
 
 impl FrictionContact for AnyFriction {
-    #[inline]
+    #[inline(always)]
     fn solve(&mut self, load: LoadLine, bow: BowInput) -> f64 {
         let f = match self.model {
             FrictionModel::Hyperbolic => self.hyperbolic.solve(load, bow),

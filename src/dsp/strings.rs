@@ -1,0 +1,628 @@
+//! One four-string instrument, generic over the string model and its bridge: the
+//! point-bow [`super::instrument::Instrument`] (paper A's waveguide strings on a body) and
+//! paper B's [`super::thermal_instrument::ThermalInstrument`] (two-polarisation strings
+//! under a finite-width thermal bow, coupled at a modal bridge) are both
+//! [`FourStrings`], each over its own [`StringBank`].
+//!
+//! What exists once, here: which string a note goes to and where the finger stops it
+//! ([`Fingering`]), the bow landing and lifting on each string ([`BowEnvelope`]), the
+//! note's own expression and the per-string force weighting turned into each string's
+//! bow, the finger's glide, the pitch bend and reference pitch retuning what sounds, the
+//! resampler from the strings' internal rate to the host's, sleeping, the host's tail,
+//! the fade around a change of discretisation, and the guard that turns a non-finite
+//! sample into silence. What the bank keeps: its strings, how one is stopped and
+//! retuned, how a sample is computed, and how its parts fall asleep.
+//!
+//! **Rates.** The bow envelope's ramp over [`BOW_RAMP_S`], the glide's steps and each
+//! string's bow move once per internal sample, inside the resampler's pull: with the
+//! host's bow held over a host sample, the strings meet the same inputs at every host
+//! rate, so a note's regime and pitch do not depend on the project's rate (the
+//! resampler is all that differs). Once per host sample: the output's fade, the
+//! non-finite guard and the probe.
+//!
+//! ```
+//! use colophony::dsp::instrument::{BowControl, Instrument, InstrumentKind};
+//! // The point-bow instrument is `FourStrings<WaveguideBank>`.
+//! let mut violin = Instrument::new(InstrumentKind::Violin, 44_100.0);
+//! assert_eq!(violin.note_on(69), Some(2)); // A4 on the A string
+//! let bow = BowControl { velocity_m_per_s: 0.2, force_n: 0.5, position_beta: 0.12 };
+//! let peak = (0..22_050).map(|_| violin.tick(bow).audio.abs()).fold(0.0, f64::max);
+//! assert!(peak > 0.01 && peak < 1.0);
+//! violin.note_off(69);
+//! ```
+
+use super::filters::flush_tiny;
+use super::fingering::{BowEnvelope, Fingering};
+use super::instrument::{
+    BowControl, Frame, InstrumentKind, NoteExpression, BOW_RAMP_S, MAX_NOTE_BETA,
+    MAX_WEIGHTED_FORCE_N, MIN_NOTE_BETA, STRINGS,
+};
+use super::intonation::IntonationTable;
+use super::resample::Resampler;
+
+/// The bow on one string for one host sample, as the bank takes it.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct StringBow {
+    /// Signed bow velocity, m/s.
+    pub velocity_m_per_s: f64,
+    /// Normal force in the bank's unit ([`StringBank::force_divisor`]: N for a point bow,
+    /// N/m spread over a bow's width), the envelope and expression applied.
+    pub force: f64,
+    /// Bow position over the vibrating length.
+    pub position_beta: f64,
+}
+
+/// The strings and bridge of one four-string instrument at their internal rate (see the
+/// module doc for what stays in [`FourStrings`]).
+pub trait StringBank {
+    /// The discretisation whose change rebuilds the strings (paper B's node count and bow
+    /// width; `()` where nothing does).
+    type Settings: Copy + PartialEq + std::fmt::Debug;
+
+    /// The rate [`StringBank::sample`] runs at, Hz.
+    fn internal_rate_hz(&self) -> f64;
+    /// The bow force in newtons is divided by this before it reaches the strings (1 for a
+    /// point bow; the bow's width for a bow whose force is per metre).
+    fn force_divisor(&self) -> f64 {
+        1.0
+    }
+    /// What multiplies the resampled output (the bank's own output scale where it is
+    /// applied after resampling; 1 where [`StringBank::sample`] already gives audio).
+    fn output_gain(&self) -> f64 {
+        1.0
+    }
+    /// Stops string `i` for a new note sounding `hz`; false if it cannot (the note is
+    /// then refused and the string is as before, or silenced).
+    fn stop(&mut self, i: usize, hz: f64) -> bool;
+    /// Moves string `i`'s sounding note to `hz` (a bend, a glide, a new reference); false
+    /// if the string cannot follow (its bow is then lifted).
+    fn bend(&mut self, i: usize, hz: f64) -> bool;
+    /// A bow landed on string `i`: it is computed from the next sample.
+    fn wake(&mut self, i: usize);
+    /// Whether string `i` is being computed (bowed, or ringing on).
+    fn string_awake(&self, i: usize) -> bool;
+    /// Whether anything is computed: a string, or the bridge or body ringing on.
+    fn is_awake(&self) -> bool;
+    /// Whether the strings themselves are awake (not only the body).
+    fn strings_awake(&self) -> bool {
+        (0..STRINGS).any(|i| self.string_awake(i))
+    }
+    /// Whether sleeping strings are skipped (off only to measure the saving).
+    fn set_skipping(&mut self, skipping: bool);
+    /// One internal sample: the output before [`StringBank::output_gain`]. `bow_of(i)`
+    /// gives string `i`'s bow (and moves its envelope): call it once for each string
+    /// computed, in order, and not for a string that sleeps. `probed`: the string whose
+    /// contact [`StringBank::probe`] reports.
+    fn sample(&mut self, probed: usize, bow_of: impl FnMut(usize) -> StringBow) -> f64;
+    /// The internal samples `out.len()` host samples need, through `resampler`, each
+    /// computed by `step` (which sets the bows, moving at the internal rate, and calls
+    /// [`StringBank::sample`]).
+    #[inline(always)]
+    fn render(
+        &mut self,
+        resampler: &mut Resampler,
+        out: &mut [f64],
+        mut step: impl FnMut(&mut Self) -> f64,
+    ) {
+        resampler.process(|| step(self), out);
+    }
+    /// The probed string's last internal sample: velocity at the bow and friction force.
+    fn probe(&self) -> (f64, f64);
+    /// Once per block, with which strings' bows are lifted and at rest: puts quiet parts
+    /// to sleep. Returns whether everything sleeps now (what the resampler holds is then
+    /// cleared).
+    fn sleep(&mut self, lifted: &[bool; STRINGS]) -> bool;
+    /// Seconds until everything would sleep with every bow lifted (`None` while a bow is
+    /// on an awake string); walks the delay lines.
+    fn ring_out_s(&self, lifted: &[bool; STRINGS]) -> Option<f64>;
+    /// Total energy of the strings (and the bridge where it stores any), J.
+    fn energy_j(&self) -> f64;
+    /// Silences everything.
+    fn reset(&mut self);
+    /// The current discretisation.
+    fn settings(&self) -> Self::Settings;
+    /// Rebuilds the strings for `settings` (silenced, asleep; no allocation): the caller
+    /// re-lands the held notes. On an error nothing changed.
+    fn configure(&mut self, settings: Self::Settings) -> Result<(), String>;
+}
+
+/// A violin, viola or cello: four strings of one model on one bridge, played by notes
+/// and one bow (see the module doc).
+#[derive(Debug, Clone)]
+pub struct FourStrings<B: StringBank> {
+    pub(super) bank: B,
+    pub(super) kind: InstrumentKind,
+    /// Fingers and bow on each string.
+    pub(super) hands: Hands,
+    /// From the internal rate to the host's; `None` where they are the same. Boxed: the
+    /// instrument moves as a whole when the performer swaps engines.
+    pub(super) resampler: Option<Box<Resampler>>,
+    /// The rate [`FourStrings::tick`] is called at, Hz.
+    host_rate_hz: f64,
+    /// Whether quiet lifted strings sleep (the default; off only to measure the saving).
+    skipping: bool,
+    /// Times the non-finite guard in [`FourStrings::tick`] reset the instrument.
+    recoveries: u64,
+    /// A change of discretisation waiting for the fade-out to end.
+    pending: Option<B::Settings>,
+    fade: f64,
+    fade_step: f64,
+}
+
+/// The player's hands on the four strings: the notes and fingers, and the bow on each
+/// string, moved once per internal sample ([`Hands::step`]).
+#[derive(Debug, Clone)]
+pub(super) struct Hands {
+    /// Notes, fingers and tuning.
+    pub(super) fingering: Fingering,
+    /// The bow on each string.
+    pub(super) bows: [BowEnvelope; STRINGS],
+    /// Whether each string's note has an expression of its own (one test a sample).
+    expressive: [bool; STRINGS],
+    /// The bow force's factor on each string when weighted ([`InstrumentKind::string_weight`]).
+    weights: [f64; STRINGS],
+    /// Whether the bow force is weighted per string ([`FourStrings::set_string_weighting`]).
+    weighted: bool,
+    /// The string the last note went to (the probe's).
+    pub(super) probed: usize,
+    /// The bow envelope's step per internal sample.
+    ramp_step: f64,
+}
+
+impl Hands {
+    /// One internal sample of `bank` with the player's bow `bow`: the finger's glide, then
+    /// the bank's sample, asking for each string's bow as it computes it (the envelope,
+    /// the weighting and the note's expression on the shared bow).
+    #[inline(always)]
+    fn step<B: StringBank>(&mut self, bank: &mut B, bow: BowControl) -> f64 {
+        if let Some(retune) = self.fingering.glide_tick() {
+            for (i, hz) in retune.into_iter().enumerate() {
+                if let Some(hz) = hz {
+                    if !bank.bend(i, hz) {
+                        self.bows[i].bowed = false;
+                    }
+                }
+            }
+        }
+        let divisor = bank.force_divisor();
+        let probed = self.probed;
+        bank.sample(probed, move |i| self.string_bow(i, bow, divisor))
+    }
+
+    /// String `i`'s bow for this internal sample (its envelope moves one step).
+    #[inline(always)]
+    fn string_bow(&mut self, i: usize, bow: BowControl, divisor: f64) -> StringBow {
+        let gain = self.bows[i].advance(self.ramp_step);
+        // Weighted, a string is never bowed harder than the force parameter's top.
+        let base = if self.weighted {
+            (bow.force_n * self.weights[i]).min(MAX_WEIGHTED_FORCE_N)
+        } else {
+            bow.force_n
+        };
+        let base = base.max(0.0) / divisor;
+        if !self.expressive[i] {
+            StringBow {
+                velocity_m_per_s: bow.velocity_m_per_s,
+                force: base * gain,
+                position_beta: bow.position_beta,
+            }
+        } else {
+            let e = self.fingering.expression(i);
+            StringBow {
+                velocity_m_per_s: bow.velocity_m_per_s,
+                force: base * e.force_scale * gain,
+                position_beta: (bow.position_beta * e.position_scale)
+                    .clamp(MIN_NOTE_BETA, MAX_NOTE_BETA),
+            }
+        }
+    }
+}
+
+/// Fade-out before the strings are rebuilt for a new discretisation, s.
+pub const RECONFIGURE_FADE_S: f64 = 0.01;
+
+/// The bow envelope's step per internal sample at `rate_hz`.
+fn ramp_step(rate_hz: f64) -> f64 {
+    1.0 / (BOW_RAMP_S * rate_hz).max(1.0)
+}
+
+impl<B: StringBank> FourStrings<B> {
+    /// `bank` played at `host_rate_hz` (finite and positive: the constructors check),
+    /// through `resampler` where the rates differ. `intonation_row`: the shipped
+    /// intonation table's row the notes are tuned by.
+    pub(super) fn from_bank(
+        bank: B,
+        kind: InstrumentKind,
+        host_rate_hz: f64,
+        resampler: Option<Box<Resampler>>,
+        intonation_row: usize,
+    ) -> Self {
+        let internal_rate_hz = bank.internal_rate_hz();
+        Self {
+            bank,
+            kind,
+            hands: Hands {
+                fingering: Fingering::new(kind, Some(intonation_row)),
+                bows: [BowEnvelope::default(); STRINGS],
+                expressive: [false; STRINGS],
+                weights: std::array::from_fn(|i| kind.string_weight(i)),
+                weighted: false,
+                probed: 0,
+                ramp_step: ramp_step(internal_rate_hz),
+            },
+            resampler,
+            host_rate_hz,
+            skipping: true,
+            recoveries: 0,
+            pending: None,
+            fade: 1.0,
+            fade_step: 1.0 / (RECONFIGURE_FADE_S * host_rate_hz).max(1.0),
+        }
+    }
+
+    pub fn kind(&self) -> InstrumentKind {
+        self.kind
+    }
+
+    /// The host rate [`FourStrings::tick`] runs at.
+    pub fn sample_rate_hz(&self) -> f64 {
+        self.host_rate_hz
+    }
+
+    /// The rate the strings run at.
+    pub fn internal_rate_hz(&self) -> f64 {
+        self.bank.internal_rate_hz()
+    }
+
+    /// How late the output is behind the strings, host samples (the resampler's delay;
+    /// 0 at the internal rate).
+    pub fn latency_samples(&self) -> f64 {
+        self.resampler.as_ref().map_or(0.0, |r| r.latency_samples())
+    }
+
+    /// Weights the bow force per string (on: string `i` is bowed with the force times
+    /// [`InstrumentKind::string_weight`]`(i)`, never more than [`MAX_WEIGHTED_FORCE_N`];
+    /// off, the default: every string gets the force as given, the bare model the tools
+    /// measure). The performer turns it on for the player (the String Weight parameter).
+    pub fn set_string_weighting(&mut self, on: bool) {
+        self.hands.weighted = on;
+    }
+
+    /// Whether the bow force is weighted per string.
+    pub fn string_weighting(&self) -> bool {
+        self.hands.weighted
+    }
+
+    /// Another instrument's notes, weights and bows (the bank changes its strings).
+    pub(super) fn set_kind_notes(&mut self, kind: InstrumentKind) {
+        self.kind = kind;
+        self.hands.fingering.set_kind(kind);
+        self.hands.bows = [BowEnvelope::default(); STRINGS];
+        self.hands.expressive = [false; STRINGS];
+        self.hands.weights = std::array::from_fn(|i| kind.string_weight(i));
+    }
+
+    /// Stops the string for `note` and lands the bow on it. Returns the string, or `None`
+    /// if no string can play the note (it is then ignored).
+    pub fn note_on(&mut self, note: u8) -> Option<usize> {
+        let index = self.hands.fingering.string_for_note_on(note)?;
+        let before = (
+            self.hands.fingering.note(index),
+            self.hands.fingering.expression(index),
+        );
+        self.hands.fingering.start(index, note);
+        let hz = self.hands.fingering.tuned_hz(index);
+        if !self.bank.stop(index, hz) {
+            self.hands.fingering.restore(index, before.0, before.1);
+            return None;
+        }
+        self.hands.expressive[index] = false;
+        self.hands.bows[index].bowed = true;
+        self.bank.wake(index);
+        self.hands.probed = index;
+        Some(index)
+    }
+
+    /// A legato note that slides the finger (portamento): on a string already bowed with
+    /// another note, the stopping point glides from that note's place to this one over
+    /// `glide_s` seconds (linearly in semitones, retuned every
+    /// [`GLIDE_EVERY`](super::fingering::GLIDE_EVERY) host samples); otherwise, or with
+    /// `glide_s` not positive, as [`FourStrings::note_on`].
+    pub fn note_on_gliding(&mut self, note: u8, glide_s: f64) -> Option<usize> {
+        let index = self.hands.fingering.string_for_note_on(note)?;
+        let from = match self.hands.fingering.note(index) {
+            Some(old)
+                if self.hands.bows[index].bowed
+                    && self.bank.string_awake(index)
+                    && self.pending.is_none()
+                    && glide_s > 0.0
+                    && glide_s.is_finite() =>
+            {
+                old as f64 + self.hands.fingering.glide(index)
+            }
+            _ => return self.note_on(note),
+        };
+        let distance = from - note as f64;
+        let rate = self.bank.internal_rate_hz();
+        self.hands
+            .fingering
+            .glide_to(index, note, distance, glide_s, rate);
+        self.hands.probed = index;
+        let hz = self.hands.fingering.tuned_hz(index);
+        if !self.bank.bend(index, hz) {
+            self.hands.bows[index].bowed = false;
+        }
+        Some(index)
+    }
+
+    /// Lifts the bow from the string playing `note`, if any (the string rings on).
+    pub fn note_off(&mut self, note: u8) {
+        for (i, bow) in self.hands.bows.iter_mut().enumerate() {
+            if self.hands.fingering.note(i) == Some(note) {
+                bow.bowed = false;
+            }
+        }
+    }
+
+    /// Lifts the bow from every string.
+    pub fn all_notes_off(&mut self) {
+        for bow in &mut self.hands.bows {
+            bow.bowed = false;
+        }
+    }
+
+    /// Asks later notes to go to string `preferred` (0 = the lowest) where it can play
+    /// them ([`InstrumentKind::string_for_note_on`]); `None` restores the usual choice.
+    /// Notes already sounding stay where they are.
+    pub fn set_preferred_string(&mut self, preferred: Option<usize>) {
+        self.hands.fingering.set_preferred_string(preferred);
+    }
+
+    /// Pitch bend in semitones (clamped to the bend range): moves every stopping point,
+    /// as far as the string reaches ([`super::intonation::tuned_hz`]).
+    pub fn set_pitch_bend(&mut self, semitones: f64) {
+        if self.hands.fingering.set_pitch_bend(semitones) {
+            self.retune();
+        }
+    }
+
+    /// Gives string `index` its note's own expression (sanitized; see
+    /// [`NoteExpression`]); a changed bend retunes it at once (a bend the string cannot
+    /// follow lifts its bow). A new note on the string starts neutral again.
+    pub fn set_note_expression(&mut self, index: usize, expression: NoteExpression) {
+        if index >= STRINGS {
+            return;
+        }
+        let bent = self.hands.fingering.set_expression(index, expression);
+        self.hands.expressive[index] =
+            self.hands.fingering.expression(index) != NoteExpression::NEUTRAL;
+        if bent {
+            let hz = self.hands.fingering.tuned_hz(index);
+            if !self.bank.bend(index, hz) {
+                self.hands.bows[index].bowed = false;
+            }
+        }
+    }
+
+    /// String `index`'s note expression.
+    pub fn note_expression(&self, index: usize) -> NoteExpression {
+        self.hands.fingering.expression(index)
+    }
+
+    /// Tunes every note from the reference pitch `a4_hz` (415..466 Hz; see
+    /// [`super::instrument::reference_semitones`]); sounding notes follow at once.
+    pub fn set_reference_pitch(&mut self, a4_hz: f64) {
+        if self.hands.fingering.set_reference_pitch(a4_hz) {
+            self.retune();
+        }
+    }
+
+    /// Tunes by the bowed sound with `table` (the default is the shipped one), or by the
+    /// free decay with `None` (paper A's scenes, the free-string tuning tests). Sounding
+    /// notes follow at once.
+    pub fn set_intonation(&mut self, table: Option<&'static IntonationTable>) {
+        self.hands.fingering.set_intonation(table);
+        self.retune();
+    }
+
+    /// Moves every stopped note to its pitch under the current bend and reference; a
+    /// string that cannot follow has its bow lifted and rings on.
+    pub(super) fn retune(&mut self) {
+        for i in 0..STRINGS {
+            if self.hands.fingering.note(i).is_some() {
+                let hz = self.hands.fingering.tuned_hz(i);
+                if !self.bank.bend(i, hz) {
+                    self.hands.bows[i].bowed = false;
+                }
+            }
+        }
+    }
+
+    /// How far the bow rests on string `index`: 0 lifted, 1 fully on (it ramps between
+    /// over [`BOW_RAMP_S`]); 0 for a string that does not exist.
+    pub fn bow_gain(&self, index: usize) -> f64 {
+        self.hands.bows.get(index).map_or(0.0, |b| b.gain)
+    }
+
+    /// Total energy of the strings (and of the bridge where it stores any), J.
+    pub fn energy_j(&self) -> f64 {
+        self.bank.energy_j()
+    }
+
+    /// Whether any string is awake (bowed or still ringing).
+    pub fn is_sounding(&self) -> bool {
+        self.bank.strings_awake()
+    }
+
+    /// Whether anything still rings: an awake string, or the bridge or body after the
+    /// strings slept.
+    pub fn is_ringing(&self) -> bool {
+        self.bank.is_awake()
+    }
+
+    fn lifted(&self) -> [bool; STRINGS] {
+        std::array::from_fn(|i| self.hands.bows[i].is_lifted())
+    }
+
+    /// Seconds until everything would fall asleep if no bow lands again (the host's
+    /// tail), or `None` while a bow is on a string or a change of discretisation is
+    /// pending. Walks the delay lines: call once per block.
+    pub fn ring_out_s(&self) -> Option<f64> {
+        if self.pending.is_some() && self.bank.is_awake() {
+            return None;
+        }
+        self.bank.ring_out_s(&self.lifted())
+    }
+
+    /// Puts what is lifted and quiet to sleep. Called once per block by the plugin and
+    /// the renderer (it walks the delay lines).
+    pub fn update_sleep(&mut self) {
+        if !self.skipping || self.pending.is_some() {
+            return;
+        }
+        if self.bank.sleep(&self.lifted()) {
+            // What the resampler still holds is below -200 dB: asleep is silence.
+            if let Some(r) = &mut self.resampler {
+                r.reset();
+            }
+        }
+    }
+
+    /// Silences every string and forgets every note.
+    pub fn reset(&mut self) {
+        self.bank.reset();
+        self.hands.bows = [BowEnvelope::default(); STRINGS];
+        self.hands.expressive = [false; STRINGS];
+        self.hands.fingering.clear();
+        if let Some(r) = &mut self.resampler {
+            r.reset();
+        }
+    }
+
+    /// Turns sleeping off (every string is computed every sample) or on. Off only serves
+    /// to measure what skipping saves and changes: `colophony bench scenes`.
+    pub fn set_skipping(&mut self, skipping: bool) {
+        self.skipping = skipping;
+        self.bank.set_skipping(skipping);
+    }
+
+    /// Whether sleeping strings are skipped (the default; see [`FourStrings::set_skipping`]).
+    pub fn is_skipping(&self) -> bool {
+        self.skipping
+    }
+
+    /// How often the non-finite guard in [`FourStrings::tick`] has fired (it never should:
+    /// the stress suite asserts zero, since the guard would otherwise hide a NaN).
+    pub fn recoveries(&self) -> u64 {
+        self.recoveries
+    }
+
+    /// Asks for a new discretisation. If the instrument sounds, the output fades out
+    /// first and the change lands after [`RECONFIGURE_FADE_S`].
+    pub(super) fn request_settings(&mut self, settings: B::Settings) {
+        if settings == self.bank.settings() && self.pending.is_none() {
+            return;
+        }
+        if self.bank.is_awake() {
+            self.pending = Some(settings);
+        } else {
+            // Within the limits every setting is valid; keep the old one if not.
+            let _ = self.apply_settings(settings);
+        }
+    }
+
+    /// Rebuilds the strings for `settings` now; the held notes' bows land again.
+    pub(super) fn apply_settings(&mut self, settings: B::Settings) -> Result<(), String> {
+        self.bank.configure(settings)?;
+        self.hands.ramp_step = ramp_step(self.bank.internal_rate_hz());
+        if let Some(r) = &mut self.resampler {
+            // Within its capacity: the bank's rates are bounded at construction.
+            let _ = r.set_input_rate(self.bank.internal_rate_hz());
+        }
+        let reference = 2f64.powf(self.hands.fingering.reference_semitones() / 12.0);
+        for i in 0..STRINGS {
+            self.hands.bows[i].gain = 0.0;
+            let hz = match self.hands.fingering.note(i) {
+                Some(_) => self.hands.fingering.tuned_hz(i),
+                None => self.kind.strings()[i].open_hz * reference,
+            };
+            if !self.bank.stop(i, hz) {
+                self.hands.bows[i] = BowEnvelope::default();
+                self.hands.fingering.clear_string(i);
+                self.hands.expressive[i] = false;
+            }
+        }
+        for i in 0..STRINGS {
+            if self.hands.bows[i].bowed {
+                self.bank.wake(i);
+            }
+        }
+        Ok(())
+    }
+
+    /// One host sample: the internal samples it needs, resampled (the bows hold over
+    /// them), or one internal sample where the rates are the same.
+    #[inline]
+    pub fn tick(&mut self, bow: BowControl) -> Frame {
+        if self.skipping && !self.bank.is_awake() {
+            // Silence; the resampler was cleared when the instrument fell asleep.
+            return Frame::default();
+        }
+        self.tick_awake(bow)
+    }
+
+    /// [`FourStrings::tick`] while something is awake. Out of line, with the bank's
+    /// sample inlined into it, so the caller's loop stays small. Its cost over the
+    /// strings' own work (callgrind, `colophony render` of cello D3 with the hyperbolic
+    /// law, 192 000 samples): 528 instructions a sample here against 507 in the point-bow
+    /// instrument before it became a `FourStrings` (the fade, the probe and the closure
+    /// that hands each string its bow).
+    #[inline(never)]
+    fn tick_awake(&mut self, bow: BowControl) -> Frame {
+        if let Some(settings) = self.pending {
+            self.fade -= self.fade_step;
+            if self.fade <= 0.0 {
+                self.pending = None;
+                self.fade = 1.0;
+                let _ = self.apply_settings(settings);
+                return Frame::default();
+            }
+        }
+        let out = match &mut self.resampler {
+            None => self.hands.step(&mut self.bank, bow),
+            Some(resampler) => {
+                let hands = &mut self.hands;
+                let mut out = [0.0];
+                self.bank
+                    .render(resampler, &mut out, |bank| hands.step(bank, bow));
+                out[0]
+            }
+        };
+        let mut audio = out * self.bank.output_gain();
+        if self.pending.is_some() {
+            audio *= self.fade;
+        }
+        let audio = flush_tiny(audio);
+        if !audio.is_finite() {
+            // Cannot happen with finite inputs; if it ever does, recover to silence rather
+            // than emit garbage.
+            self.reset();
+            self.recoveries += 1;
+            return Frame::default();
+        }
+        let (velocity, force) = self.bank.probe();
+        Frame {
+            audio,
+            bow_point_velocity_m_per_s: velocity,
+            friction_force_n: force,
+        }
+    }
+
+    /// Renders `out.len()` samples of audio with constant bow settings: a loop over
+    /// [`FourStrings::tick`].
+    pub fn process(&mut self, bow: BowControl, out: &mut [f64]) {
+        for sample in out {
+            *sample = self.tick(bow).audio;
+        }
+    }
+}
