@@ -218,6 +218,46 @@ fn per_sample_and_block_processing_give_identical_output() {
         .all(|(x, y)| x.to_bits() == y.to_bits()));
 }
 
+/// Asleep, a block is zeros without a per-sample call: the same bits as ticking, through
+/// an asleep start, a note, its release and the string falling asleep again (violin E6:
+/// its energy falls to the sleep threshold within the run), with `update_sleep` at every
+/// block boundary as the plugin calls it.
+#[test]
+fn block_processing_through_sleep_gives_the_same_bits_as_ticking() {
+    let bow = BowControl::default();
+    let mut a = Instrument::new(InstrumentKind::Violin, FS);
+    let mut b = a.clone();
+    let block = 256;
+    let (mut ticks, mut blocks) = (Vec::new(), Vec::new());
+    let mut slept = 0;
+    for k in 0..(8.0 * FS) as usize / block {
+        let t = k * block;
+        for inst in [&mut a, &mut b] {
+            inst.update_sleep();
+            if t == block * 20 {
+                inst.note_on(100);
+            }
+            if t == block * 20 + (0.3 * FS) as usize / block * block {
+                inst.note_off(100);
+            }
+        }
+        if !a.is_ringing() {
+            slept += 1;
+        }
+        ticks.extend((0..block).map(|_| a.tick(bow).audio));
+        let mut out = vec![1.0; block];
+        b.process(bow, &mut out);
+        blocks.extend(out);
+    }
+    assert!(rms(&ticks) > 1e-4, "the note did not sound");
+    assert!(!a.is_ringing(), "the string never fell asleep again");
+    assert!(slept > 40, "asleep for only {slept} blocks");
+    assert!(ticks
+        .iter()
+        .zip(&blocks)
+        .all(|(x, y)| x.to_bits() == y.to_bits()));
+}
+
 #[test]
 fn switching_friction_law_while_a_note_sounds_gives_no_click_or_blow_up() {
     let bow = BowControl {

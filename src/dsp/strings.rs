@@ -618,9 +618,15 @@ impl<B: StringBank> FourStrings<B> {
         }
     }
 
-    /// Renders `out.len()` samples of audio with constant bow settings: a loop over
-    /// [`FourStrings::tick`].
+    /// Renders `out.len()` samples of audio with constant bow settings: the same samples
+    /// as a loop over [`FourStrings::tick`]. Asleep, the block is zeros without a
+    /// per-sample call (nothing wakes within a block: only a note and
+    /// [`FourStrings::update_sleep`], between blocks, change it).
     pub fn process(&mut self, bow: BowControl, out: &mut [f64]) {
+        if self.skipping && !self.bank.is_awake() {
+            out.fill(0.0);
+            return;
+        }
         for sample in out {
             *sample = self.tick(bow).audio;
         }
