@@ -568,17 +568,6 @@ impl<B: StringBank> FourStrings<B> {
             // Silence; the resampler was cleared when the instrument fell asleep.
             return Frame::default();
         }
-        self.tick_awake(bow)
-    }
-
-    /// [`FourStrings::tick`] while something is awake. Out of line, with the bank's
-    /// sample inlined into it, so the caller's loop stays small. Its cost over the
-    /// strings' own work (callgrind, `colophony render` of cello D3 with the hyperbolic
-    /// law, 192 000 samples): 528 instructions a sample here against 507 in the point-bow
-    /// instrument before it became a `FourStrings` (the fade, the probe and the closure
-    /// that hands each string its bow).
-    #[inline(never)]
-    fn tick_awake(&mut self, bow: BowControl) -> Frame {
         if let Some(settings) = self.pending {
             self.fade -= self.fade_step;
             if self.fade <= 0.0 {
