@@ -138,7 +138,6 @@ fn host_rate_rows() -> Result<Vec<String>, String> {
 /// bowed (paper B's Figure 6 bow), resampled to 48 kHz; and a double stop (C and G bowed).
 pub fn table1() -> Result<String, String> {
     use crate::admittance_fit::shipped_cello_bridge;
-    use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
     let paper = [
         (3, 4.3),
         (6, 9.2),
@@ -147,15 +146,9 @@ pub fn table1() -> Result<String, String> {
         (33, 119.0),
         (60, 334.0),
     ];
-    // Paper B's Figure 6 bow: 0.15 m/s, beta 0.07, 300 N/m over 1 cm (3 N).
-    let bow = BowControl {
-        velocity_m_per_s: 0.15,
-        force_n: 3.0,
-        position_beta: 0.07,
-    };
+    let bow = FIG6_BOW;
     let bridge = shipped_cello_bridge().modes;
     let audio_s = 1.0;
-    let out_rate = 48_000.0;
     let mut lines = vec![
         format!("The plugin's thermal cello (4 strings x 2 polarisations, {}-mode bridge, resampled to 48 kHz), 1 s of audio after a 0.2 s onset, best of three, % of one core:", bridge.len()),
         String::new(),
@@ -163,30 +156,7 @@ pub fn table1() -> Result<String, String> {
         "|---|---|---|---|---|---|".to_string(),
     ];
     for (nodes, paper_percent) in paper {
-        let mut cost = [0.0; 2];
-        let mut instrument = None;
-        for (k, notes) in [&[36u8][..], &[36, 43][..]].iter().enumerate() {
-            let mut cello = ThermalInstrument::new(
-                InstrumentKind::Cello,
-                &bridge,
-                out_rate,
-                ThermalSettings {
-                    nodes,
-                    width_m: 0.01,
-                },
-            )?;
-            for &note in *notes {
-                cello.note_on(note);
-            }
-            let mut out = vec![0.0; (audio_s * out_rate) as usize];
-            cello.process(bow, &mut out[..(0.2 * out_rate) as usize]);
-            cost[k] = best_of_three(|| {
-                cello.process(bow, &mut out);
-                std::hint::black_box(&out);
-            });
-            instrument = Some(cello);
-        }
-        let cello = instrument.expect("two runs");
+        let (cost, cello) = thermal_cello_cost(nodes, &bridge, bow, audio_s)?;
         let n = cello.nodes_per_string();
         lines.push(format!(
             "| {nodes} | {}/{}/{}/{} | {:.1} | {:.1} | {:.1} | {paper_percent} |",
@@ -200,6 +170,98 @@ pub fn table1() -> Result<String, String> {
         ));
     }
     Ok(lines.join("\n"))
+}
+
+/// Paper B's Figure 6 bow: 0.15 m/s, beta 0.07, 300 N/m over 1 cm (3 N).
+const FIG6_BOW: BowControl = BowControl {
+    velocity_m_per_s: 0.15,
+    force_n: 3.0,
+    position_beta: 0.07,
+};
+
+/// Seconds of CPU for `audio_s` of the plugin's thermal cello at 48 kHz with `nodes` bow
+/// nodes over 1 cm, after a 0.2 s onset, best of three: the C string bowed, and the
+/// double stop C+G. Returns the instrument of the last run too.
+fn thermal_cello_cost(
+    nodes: usize,
+    bridge: &[colophony::dsp::bridge::BridgeMode],
+    bow: BowControl,
+    audio_s: f64,
+) -> Result<
+    (
+        [f64; 2],
+        colophony::dsp::thermal_instrument::ThermalInstrument,
+    ),
+    String,
+> {
+    use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
+    let out_rate = 48_000.0;
+    let mut cost = [0.0; 2];
+    let mut instrument = None;
+    for (k, notes) in [&[36u8][..], &[36, 43][..]].iter().enumerate() {
+        let mut cello = ThermalInstrument::new(
+            InstrumentKind::Cello,
+            bridge,
+            out_rate,
+            ThermalSettings {
+                nodes,
+                width_m: 0.01,
+            },
+        )?;
+        for &note in *notes {
+            cello.note_on(note);
+        }
+        let mut out = vec![0.0; (audio_s * out_rate) as usize];
+        cello.process(bow, &mut out[..(0.2 * out_rate) as usize]);
+        cost[k] = best_of_three(|| {
+            cello.process(bow, &mut out);
+            std::hint::black_box(&out);
+        });
+        instrument = Some(cello);
+    }
+    Ok((cost, instrument.expect("two runs")))
+}
+
+/// Seconds of CPU for `seconds` of the performer in the plugin's 512-sample blocks,
+/// silent (every engine asleep: a silent block is skipped whole, `Performer::skip`) or
+/// with cello D3 bowed; best of five, interleaved.
+fn performer_silence_cost(seconds: f64) -> (f64, f64) {
+    let fs = 48_000.0;
+    let performer_run = |bowed: bool| {
+        let setup = colophony::performer::Setup::default();
+        let mut p = colophony::performer::Performer::new(InstrumentKind::Cello);
+        p.activate(&setup, fs).expect("the default setup activates");
+        p.configure(&setup);
+        if bowed {
+            p.note_on(50, 0.8);
+        }
+        let bow = BowControl::default();
+        let mut out = vec![0.0f32; 512];
+        let mut sum = 0.0f64;
+        // Timed from here: building the engines is the host's activation, not playing.
+        let start = std::time::Instant::now();
+        for _ in 0..(seconds * fs) as usize / 512 {
+            p.configure(&setup);
+            if p.is_asleep() {
+                p.skip(512, bow);
+                out.fill(0.0);
+            } else {
+                for y in out.iter_mut() {
+                    *y = p.tick(bow).audio as f32;
+                }
+            }
+            sum += out[0] as f64;
+        }
+        let elapsed = start.elapsed().as_secs_f64();
+        std::hint::black_box(sum);
+        elapsed
+    };
+    let (mut silent_s, mut bowed_s) = (f64::MAX, f64::MAX);
+    for _ in 0..5 {
+        silent_s = silent_s.min(performer_run(false));
+        bowed_s = bowed_s.min(performer_run(true));
+    }
+    (silent_s, bowed_s)
 }
 
 /// `colophony bench scenes`: the cost of common scenes with and without skipping what does
@@ -340,40 +402,7 @@ pub fn scenes() -> Result<String, String> {
     ));
     // Through the performer in the plugin's blocks: a silent block with nothing landing
     // is skipped whole (`Performer::skip`).
-    let performer_run = |bowed: bool| {
-        let setup = colophony::performer::Setup::default();
-        let mut p = colophony::performer::Performer::new(InstrumentKind::Cello);
-        p.activate(&setup, fs).expect("the default setup activates");
-        p.configure(&setup);
-        if bowed {
-            p.note_on(50, 0.8);
-        }
-        let bow = BowControl::default();
-        let mut out = vec![0.0f32; 512];
-        let mut sum = 0.0f64;
-        // Timed from here: building the engines is the host's activation, not playing.
-        let start = std::time::Instant::now();
-        for _ in 0..(seconds * fs) as usize / 512 {
-            p.configure(&setup);
-            if p.is_asleep() {
-                p.skip(512, bow);
-                out.fill(0.0);
-            } else {
-                for y in out.iter_mut() {
-                    *y = p.tick(bow).audio as f32;
-                }
-            }
-            sum += out[0] as f64;
-        }
-        let elapsed = start.elapsed().as_secs_f64();
-        std::hint::black_box(sum);
-        elapsed
-    };
-    let (mut silent_s, mut bowed_s) = (f64::MAX, f64::MAX);
-    for _ in 0..5 {
-        silent_s = silent_s.min(performer_run(false));
-        bowed_s = bowed_s.min(performer_run(true));
-    }
+    let (silent_s, bowed_s) = performer_silence_cost(seconds);
     lines.push(format!(
         "Through the performer in 512-sample blocks (as the plugin): silence {:.4} % of a core, one bowed string {:.3} %; silence costs {:.2} % of one bowed string.",
         100.0 * silent_s / seconds,
@@ -563,6 +592,53 @@ pub fn peers(seconds: f64, dir: &std::path::Path) -> Result<String, String> {
             "{name:<32} {cpu:8.3} s  {:6.1}x real time  {:5.2}x STK",
             seconds / cpu,
             cpu / best[0]
+        ));
+    }
+    // Issue 20's table, from this run: the two strings against STK above, silence
+    // through the performer, and paper B's whole cello at N_B = 60 (`bench scenes` and
+    // `bench table1` measure the same).
+    let (silent_s, bowed_s) = performer_silence_cost(4.0);
+    let bridge = crate::admittance_fit::shipped_cello_bridge().modes;
+    let (table1, _) = thermal_cello_cost(60, &bridge, FIG6_BOW, 1.0)?;
+    let goals = [
+        (
+            "hyperbolic string (default)",
+            best[1] / best[0],
+            "x STK",
+            0.8,
+        ),
+        (
+            "elasto-plastic string (paper A)",
+            best[2] / best[0],
+            "x STK",
+            3.0,
+        ),
+        (
+            "silence, % of one bowed string",
+            100.0 * silent_s / bowed_s,
+            "%",
+            1.0,
+        ),
+        (
+            "thermal cello N_B 60, C bowed",
+            100.0 * table1[0],
+            "% of a core",
+            10.0,
+        ),
+        (
+            "double stop C+G at N_B 60",
+            100.0 * table1[1],
+            "% of a core",
+            15.0,
+        ),
+    ];
+    lines.push(String::new());
+    lines.push("| what | measured | goal | met |".into());
+    lines.push("|---|---|---|---|".into());
+    for (what, value, unit, goal) in goals {
+        lines.push(format!(
+            "| {what} | {value:.2} {unit} | <= {goal} | {} |",
+            if value <= goal { "yes" } else { "no" }
         ));
     }
     Ok(lines.join("\n"))

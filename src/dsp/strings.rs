@@ -61,6 +61,9 @@ pub trait StringBank {
 
     /// The rate [`StringBank::sample`] runs at, Hz.
     fn internal_rate_hz(&self) -> f64;
+    /// Whether [`StringBank::sample`]'s output is already flushed of subnormals (then,
+    /// without a resampler, it is not flushed again).
+    const SAMPLE_IS_FLUSHED: bool = false;
     /// The bow force in newtons is divided by this before it reaches the strings (1 for a
     /// point bow; the bow's width for a bow whose force is per metre).
     fn force_divisor(&self) -> f64 {
@@ -199,7 +202,7 @@ impl Hands {
         } else {
             bow.force_n
         };
-        let base = base.max(0.0) / divisor;
+        let base = base / divisor;
         if !self.expressive[i] {
             StringBow {
                 velocity_m_per_s: bow.velocity_m_per_s,
@@ -578,6 +581,11 @@ impl<B: StringBank> FourStrings<B> {
             }
         }
         let out = match &mut self.resampler {
+            None if B::SAMPLE_IS_FLUSHED && self.pending.is_none() => {
+                // One internal sample, already audio: as it is.
+                let audio = self.hands.step(&mut self.bank, bow) * self.bank.output_gain();
+                return self.finish(audio);
+            }
             None => self.hands.step(&mut self.bank, bow),
             Some(resampler) => {
                 let hands = &mut self.hands;
@@ -591,7 +599,12 @@ impl<B: StringBank> FourStrings<B> {
         if self.pending.is_some() {
             audio *= self.fade;
         }
-        let audio = flush_tiny(audio);
+        self.finish(flush_tiny(audio))
+    }
+
+    /// The host sample `audio` with the probe, or silence (and a reset) if it is not finite.
+    #[inline(always)]
+    fn finish(&mut self, audio: f64) -> Frame {
         if !audio.is_finite() {
             // Cannot happen with finite inputs; if it ever does, recover to silence rather
             // than emit garbage.

@@ -127,10 +127,13 @@ impl Core {
     fn tick(&mut self, probed: usize, mut bow_of: impl FnMut(usize) -> StringBow) -> f64 {
         for (i, string) in self.strings.iter_mut().enumerate() {
             let bow = bow_of(i);
+            // A pressing force only (the force parameter is never negative; this keeps a
+            // stray sign from pulling the hair off the string).
+            let force = bow.force.max(0.0);
             // Lifted, cleared and cooled: the contact has nothing to compute. Only the
             // probed string's velocity is read, and a sleeping one's is zero (its lines
             // hold zeros; it still takes, or drops, what the bridge sends back).
-            if bow.force <= 0.0 && string.contact_idle() && (i != probed || string.is_asleep()) {
+            if force <= 0.0 && string.contact_idle() && (i != probed || string.is_asleep()) {
                 self.arriving[i] = string.arriving_at_bridge();
                 if i == probed {
                     self.probe = (0.0, 0.0);
@@ -139,7 +142,7 @@ impl Core {
             }
             let f = string.tick_contact(ThermalBowControl {
                 velocity_m_per_s: bow.velocity_m_per_s,
-                force_per_m: bow.force,
+                force_per_m: force,
                 position_beta: bow.position_beta,
             });
             if i == probed {
