@@ -54,7 +54,9 @@ impl BowEnvelope {
     }
 }
 
-/// Ticks between two retunes of a gliding finger (1.3 ms at 48 kHz).
+/// Ticks between two retunes of a gliding finger at 48 kHz (1.3 ms); at another tick
+/// rate, as many as make the same time ([`Fingering::glide_to`]), so a string at a high
+/// internal rate (paper B's at N_B 60: 542 kHz) is not retuned eleven times as often.
 pub const GLIDE_EVERY: u32 = 64;
 
 /// Notes, fingers and tuning of the four strings (see the module doc).
@@ -71,6 +73,8 @@ pub struct Fingering {
     /// Whether a finger glides, and the ticks to its next step.
     gliding: bool,
     glide_countdown: u32,
+    /// Ticks between two retunes at the glide's tick rate.
+    glide_every: u32,
     /// The string the player asks notes to go to (0 = lowest), `None` for the usual choice.
     preferred_string: Option<usize>,
     bend_semitones: f64,
@@ -94,6 +98,7 @@ impl Fingering {
             glide_steps: [0.0; STRINGS],
             gliding: false,
             glide_countdown: 0,
+            glide_every: GLIDE_EVERY,
             preferred_string: None,
             bend_semitones: 0.0,
             reference_semitones: 0.0,
@@ -138,9 +143,15 @@ impl Fingering {
     /// `string`'s note becomes `note` with the finger `glide` semitones away from it,
     /// keeping the note's expression (a legato glide), to arrive after `glide_s` seconds of
     /// [`Fingering::glide_tick`] called at `rate_hz` (linearly in semitones, a step every
-    /// [`GLIDE_EVERY`] ticks).
+    /// [`GLIDE_EVERY`] ticks at 48 kHz, the same time at `rate_hz`).
     pub fn glide_to(&mut self, string: usize, note: u8, glide: f64, glide_s: f64, rate_hz: f64) {
-        let steps = (glide_s * rate_hz / GLIDE_EVERY as f64).max(1.0);
+        let every = (GLIDE_EVERY as f64 * rate_hz / 48_000.0).round();
+        self.glide_every = if every.is_finite() {
+            every.clamp(1.0, 1e6) as u32
+        } else {
+            GLIDE_EVERY
+        };
+        let steps = (glide_s * rate_hz / self.glide_every as f64).max(1.0);
         self.notes[string] = Some(note);
         self.glides[string] = glide;
         self.glide_steps[string] = glide.abs() / steps;
@@ -149,9 +160,10 @@ impl Fingering {
     }
 
     /// One tick of the instrument (a sample at the rate given to
-    /// [`Fingering::glide_to`]): every [`GLIDE_EVERY`] ticks while a finger glides, moves
-    /// every gliding finger one step and returns the pitch (Hz) each string that moved and
-    /// holds a note should now be tuned to.
+    /// [`Fingering::glide_to`]): every [`GLIDE_EVERY`] ticks (at 48 kHz; the same time at
+    /// another rate) while a finger glides, moves every gliding finger one step and
+    /// returns the pitch (Hz) each string that moved and holds a note should now be tuned
+    /// to.
     #[inline]
     pub fn glide_tick(&mut self) -> Option<[Option<f64>; STRINGS]> {
         if !self.gliding {
@@ -159,7 +171,7 @@ impl Fingering {
         }
         let due = self.glide_countdown == 0;
         let retune = due.then(|| {
-            self.glide_countdown = GLIDE_EVERY;
+            self.glide_countdown = self.glide_every;
             self.advance_glides()
         });
         self.glide_countdown -= 1;
@@ -304,5 +316,44 @@ impl Fingering {
             self.bend_semitones + self.glides[string] + self.expressions[string].bend_semitones,
             self.reference_semitones,
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A glide takes the time asked and retunes about every 1.3 ms at any tick rate: 64
+    /// ticks at 48 kHz, 128 at 96 kHz, 1445 at paper B's 1.08 MHz ceiling.
+    #[test]
+    fn a_glide_retunes_at_the_same_time_step_and_arrives_on_time_at_every_rate() {
+        for rate in [48_000.0, 96_000.0, 541_600.0, 1_084_000.0] {
+            let mut f = Fingering::new(InstrumentKind::Cello, None);
+            let string = f.string_for_note_on(50).unwrap();
+            f.start(string, 50);
+            // From two semitones below, over 0.1 s.
+            f.glide_to(string, 52, -2.0, 0.1, rate);
+            let (mut retunes, mut arrived) = (Vec::new(), None);
+            for tick in 0..(0.2 * rate) as usize {
+                if f.glide_tick().is_some() {
+                    retunes.push(tick);
+                }
+                if arrived.is_none() && f.glide(string) == 0.0 {
+                    arrived = Some(tick as f64 / rate);
+                }
+            }
+            let step_s = (retunes[1] - retunes[0]) as f64 / rate;
+            // The step is rounded to whole ticks: within one tick of 64/48000 s.
+            assert!(
+                (step_s - 64.0 / 48_000.0).abs() <= 1.0 / rate,
+                "{rate} Hz: a retune every {step_s} s"
+            );
+            // Arrives within one step of the 0.1 s asked.
+            let arrived = arrived.expect("the glide arrives");
+            assert!(
+                (arrived - 0.1).abs() <= step_s,
+                "{rate} Hz: arrived after {arrived} s"
+            );
+        }
     }
 }

@@ -329,7 +329,7 @@ impl<B: StringBank> FourStrings<B> {
     /// A legato note that slides the finger (portamento): on a string already bowed with
     /// another note, the stopping point glides from that note's place to this one over
     /// `glide_s` seconds (linearly in semitones, retuned every
-    /// [`GLIDE_EVERY`](super::fingering::GLIDE_EVERY) host samples); otherwise, or with
+    /// [`GLIDE_EVERY`](super::fingering::GLIDE_EVERY) samples at 48 kHz); otherwise, or with
     /// `glide_s` not positive, as [`FourStrings::note_on`].
     pub fn note_on_gliding(&mut self, note: u8, glide_s: f64) -> Option<usize> {
         let index = self.hands.fingering.string_for_note_on(note)?;
