@@ -15,7 +15,7 @@
 //! | `quality` | Quality | - | draft, good, reference, auto, custom | good |
 //! | `reference_pitch` | Reference Pitch | Hz (A4) | 415 .. 466 | 440 |
 //! | `dynamics_guard` | Dynamics Guard | - | off, on (the dynamics keep the bow in Schelleng's window) | on |
-//! | `string_weight` | String Weight | - | off, on (each string bowed with the force times its impedance over 0.25 kg/s) | on |
+//! | `string_weight` | String Weight | - | off, on (each string bowed with the force times its impedance over 0.2 kg/s; paper B's thermal model over 1 kg/s) | on |
 
 use crate::dsp::friction::FrictionModel;
 use crate::dsp::instrument::InstrumentKind;
@@ -243,7 +243,7 @@ pub struct ColophonyParams {
     pub vibrato_rate: FloatParam,
     #[id = "dynamics_guard"]
     pub dynamics_guard: BoolParam,
-    /// The point-bow strings weighted by their impedance ([`crate::performer::Setup`]).
+    /// The strings weighted by their impedance ([`crate::performer::Setup`]).
     #[id = "string_weight"]
     pub string_weight: BoolParam,
     /// The editor window's size, saved with the plugin state (not a parameter).

@@ -166,7 +166,9 @@ pub struct Setup {
     /// The strings weighted (on by default): the point-bow strings are bowed with the
     /// force times their impedance over [`crate::dsp::instrument::WEIGHT_REFERENCE_Z0`],
     /// so one force keeps its place in every string's window. Off, every string gets the
-    /// force as set. Paper B's thermal model and the rubbed objects take the force as set.
+    /// force as set. Paper B's thermal model is weighted against its own reference
+    /// ([`crate::dsp::thermal_instrument::THERMAL_WEIGHT_REFERENCE_Z0`]); the rubbed
+    /// objects take the force as set.
     pub string_weight: bool,
 }
 
@@ -493,6 +495,7 @@ impl Performer {
             engine.set_preferred_string(setup.preferred_string);
         }
         for engine in &mut self.thermal {
+            engine.set_string_weighting(setup.string_weight);
             engine.set_settings(settings);
         }
         self.apply_source(wanted);

@@ -34,7 +34,9 @@ use colophony::dsp::instrument::{
 };
 use colophony::dsp::intonation::{self, IntonationTable};
 use colophony::dsp::thermal::ThermalParams;
-use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
+use colophony::dsp::thermal_instrument::{
+    ThermalInstrument, ThermalSettings, THERMAL_WEIGHT_REFERENCE_Z0,
+};
 use colophony::editor::live::ContactSample;
 use colophony::editor::mapping::SchellengWindow;
 use colophony::editor::regime::{classify_regime, Regime};
@@ -209,10 +211,11 @@ impl Cell {
         }
         let (f_min, f_max) = (window.min_force_n(v), window.max_force_n(v));
         let force = match bowing {
-            // The plugin weights the point-bow strings by default; not the thermal model.
+            // The plugin weights the strings by default (String Weight), each model against
+            // its own reference.
             Bowing::Defaults => match model {
                 Model::Point(_) => kind.string_weight(index),
-                Model::Thermal => 1.0,
+                Model::Thermal => kind.string_weight_for(index, THERMAL_WEIGHT_REFERENCE_Z0),
             },
             Bowing::Middle | Bowing::Centre(_) => (f_min * f_max).sqrt(),
             Bowing::TwiceMin(_) => 2.0 * f_min,

@@ -172,7 +172,14 @@ impl InstrumentKind {
     /// keeps the same place in every string's window, as a player leans into the heavy
     /// strings.
     pub fn string_weight(self, index: usize) -> f64 {
-        self.strings()[index.min(STRINGS - 1)].z0_kg_per_s / WEIGHT_REFERENCE_Z0
+        self.string_weight_for(index, WEIGHT_REFERENCE_Z0)
+    }
+
+    /// String `index`'s impedance over `reference_z0` (kg/s): its weight for a model whose
+    /// force parameter is the force on a string of that impedance (paper B's thermal
+    /// model: [`crate::dsp::thermal_instrument::THERMAL_WEIGHT_REFERENCE_Z0`]).
+    pub fn string_weight_for(self, index: usize, reference_z0: f64) -> f64 {
+        self.strings()[index.min(STRINGS - 1)].z0_kg_per_s / reference_z0
     }
 
     /// Output scale: bridge force to a sample value, so that a default note of any

@@ -64,6 +64,10 @@ pub trait StringBank {
     /// Whether [`StringBank::sample`]'s output is already flushed of subnormals (then,
     /// without a resampler, it is not flushed again).
     const SAMPLE_IS_FLUSHED: bool = false;
+    /// The impedance of the string the force parameter is the force on when the strings
+    /// are weighted ([`FourStrings::set_string_weighting`]), kg/s: string `i` is bowed
+    /// with the force times its `Z0` over this.
+    const WEIGHT_REFERENCE_Z0: f64 = crate::dsp::instrument::WEIGHT_REFERENCE_Z0;
     /// The bow force in newtons is divided by this before it reaches the strings (1 for a
     /// point bow; the bow's width for a bow whose force is per metre).
     fn force_divisor(&self) -> f64 {
@@ -248,7 +252,7 @@ impl<B: StringBank> FourStrings<B> {
                 fingering: Fingering::new(kind, Some(intonation_row)),
                 bows: [BowEnvelope::default(); STRINGS],
                 expressive: [false; STRINGS],
-                weights: std::array::from_fn(|i| kind.string_weight(i)),
+                weights: std::array::from_fn(|i| kind.string_weight_for(i, B::WEIGHT_REFERENCE_Z0)),
                 weighted: false,
                 probed: 0,
                 ramp_step: ramp_step(internal_rate_hz),
@@ -284,7 +288,8 @@ impl<B: StringBank> FourStrings<B> {
     }
 
     /// Weights the bow force per string (on: string `i` is bowed with the force times
-    /// [`InstrumentKind::string_weight`]`(i)`, never more than [`MAX_WEIGHTED_FORCE_N`];
+    /// its impedance over the bank's [`StringBank::WEIGHT_REFERENCE_Z0`], never more than
+    /// [`MAX_WEIGHTED_FORCE_N`];
     /// off, the default: every string gets the force as given, the bare model the tools
     /// measure). The performer turns it on for the player (the String Weight parameter).
     pub fn set_string_weighting(&mut self, on: bool) {
@@ -302,7 +307,8 @@ impl<B: StringBank> FourStrings<B> {
         self.hands.fingering.set_kind(kind);
         self.hands.bows = [BowEnvelope::default(); STRINGS];
         self.hands.expressive = [false; STRINGS];
-        self.hands.weights = std::array::from_fn(|i| kind.string_weight(i));
+        self.hands.weights =
+            std::array::from_fn(|i| kind.string_weight_for(i, B::WEIGHT_REFERENCE_Z0));
     }
 
     /// Stops the string for `note` and lands the bow on it. Returns the string, or `None`

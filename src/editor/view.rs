@@ -13,6 +13,7 @@ use super::presets::PresetBar;
 use super::regime::{classify_regime, Regime};
 use super::{EditorLink, EditorSize};
 use crate::dsp::instrument::{midi_to_hz, InstrumentKind};
+use crate::dsp::thermal_instrument::THERMAL_WEIGHT_REFERENCE_Z0;
 use crate::params::{ColophonyParams, FrictionChoice, QualityChoice, ResonatorChoice};
 use egui::{vec2, Color32, Layout, RichText, Ui};
 use nice_plug::context::gui::GuiContext;
@@ -144,14 +145,16 @@ impl EditorUi {
             .unwrap_or(0)
     }
 
-    /// What the point-bow strings multiply the force parameter by on `string` (String
-    /// Weight; 1 when it is off). The thermal model is not weighted.
+    /// What the strings multiply the force parameter by on `string` (String Weight; 1
+    /// when it is off): the string's impedance over the model's reference.
     fn string_weight(&self, kind: InstrumentKind, string: usize) -> f64 {
         let thermal = self.params.friction_model.value() == FrictionChoice::Thermal;
-        if self.params.string_weight.value() && !thermal {
-            kind.string_weight(string)
-        } else {
+        if !self.params.string_weight.value() {
             1.0
+        } else if thermal {
+            kind.string_weight_for(string, THERMAL_WEIGHT_REFERENCE_Z0)
+        } else {
+            kind.string_weight(string)
         }
     }
 
