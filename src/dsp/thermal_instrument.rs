@@ -70,7 +70,7 @@ pub const MAX_NODES: usize = 60;
 /// steeply with force. Chosen by measurement (docs/playing-space.md, "Weighted strings
 /// for paper B's model"): at the defaults, every third semitone at 48 kHz, the classifier
 /// finds one slip a period on 47 of 48 notes with this reference, 43-45 with 0.3-0.75,
-/// 35 unweighted (the violin's A and E strings raucous at 1 N).
+/// 35 unweighted (the top of the violin's A string and all of its E string raucous at 1 N).
 pub const THERMAL_WEIGHT_REFERENCE_Z0: f64 = 1.0;
 /// Narrowest and widest bow, m (a tilted bow touches with a few mm of hair; a flat
 /// violin bow with about 1 cm, paper B's value).
