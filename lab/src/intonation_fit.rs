@@ -58,10 +58,10 @@ impl Entry {
     }
 }
 
-fn entries(models: &[Model]) -> Vec<Entry> {
+fn entries(models: &[Model], kinds: &[InstrumentKind]) -> Vec<Entry> {
     let mut v = Vec::new();
     for &model in models {
-        for kind in InstrumentKind::ALL {
+        for &kind in kinds {
             for string in 0..STRINGS {
                 for semitone in 0..=MAX_STOP_SEMITONES as usize {
                     v.push(Entry {
@@ -156,10 +156,11 @@ fn fill_gaps(values: &mut [f64]) {
 /// Runs `passes` passes at `rate_hz` for `models` and returns the table and a report.
 pub fn fit(
     models: &[Model],
+    kinds: &[InstrumentKind],
     rate_hz: f64,
     passes: usize,
 ) -> Result<(IntonationTable, String), String> {
-    let entries = entries(models);
+    let entries = entries(models, kinds);
     let mut table = IntonationTable::zero();
     let mut report = String::new();
     let per_string = MAX_STOP_SEMITONES as usize + 1;
@@ -223,15 +224,22 @@ pub fn fit(
     Ok((table, report))
 }
 
-/// `colophony bench intonation --out FILE [--rates HZ] [--models ..]`: fits the table at
-/// the first rate given (48 kHz by default) and writes it, with a header, to `out`.
-pub fn run(out: &Path, models: &[Model], rate_hz: f64, passes: usize) -> Result<String, String> {
-    let (table, report) = fit(models, rate_hz, passes)?;
-    // Models not fitted keep the shipped entries.
+/// `colophony bench intonation --out FILE [--rates HZ] [--models ..] [--instruments ..]`:
+/// fits the table at the first rate given (48 kHz by default) and writes it, with a
+/// header, to `out`.
+pub fn run(
+    out: &Path,
+    models: &[Model],
+    kinds: &[InstrumentKind],
+    rate_hz: f64,
+    passes: usize,
+) -> Result<String, String> {
+    let (table, report) = fit(models, kinds, rate_hz, passes)?;
+    // Models and instruments not fitted keep the shipped entries.
     let mut merged = colophony::dsp::intonation::shipped().clone();
     for &model in models {
         let row = model_index(model.name());
-        for kind in InstrumentKind::ALL {
+        for &kind in kinds {
             for string in 0..STRINGS {
                 for s in 0..=MAX_STOP_SEMITONES as usize {
                     merged.set(row, kind, string, s, table.get(row, kind, string, s));
@@ -243,7 +251,7 @@ pub fn run(out: &Path, models: &[Model], rate_hz: f64, passes: usize) -> Result<
         "# Intonation by the bowed sound (src/dsp/intonation.rs): cents each stopped note is moved\n\
          # from its equal-tempered free-decay pitch so that it sounds in tune bowed at the defaults.\n\
          # Measured by `colophony bench intonation` at a host rate of {rate_hz} Hz (the point strings\n\
-         # run at {internal} Hz inside), {passes} passes.\n{}",
+         # run at {internal} Hz inside, the violin's and viola's at twice that), {passes} passes.\n{}",
         merged.to_csv(),
         internal = colophony::dsp::instrument::INTERNAL_RATE_HZ,
     );

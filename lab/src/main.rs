@@ -132,6 +132,10 @@ enum Command {
         /// playing-space, intonation: friction models, comma-separated (default all five).
         #[arg(long, value_delimiter = ',')]
         models: Vec<String>,
+        /// playing-space, intonation: instruments, comma-separated (default all three;
+        /// the intonation fit then rewrites only their rows).
+        #[arg(long, value_delimiter = ',')]
+        instruments: Vec<String>,
         /// intonation: measuring passes (default 2).
         #[arg(long)]
         passes: Option<usize>,
@@ -369,6 +373,7 @@ fn main() -> ExitCode {
             rates,
             step,
             models,
+            instruments,
             passes,
             seconds,
         } => report(match what.as_str() {
@@ -384,15 +389,15 @@ fn main() -> ExitCode {
                 None => Err("bench precision needs --out DIR".into()),
             },
             "playing-space" => match out {
-                Some(dir) => colophony_lab::playing_space::Plan::from_options(quick, &rates, step, &models)
+                Some(dir) => colophony_lab::playing_space::Plan::from_options(quick, &rates, step, &models, &instruments)
                     .and_then(|plan| colophony_lab::playing_space::run(&dir, &plan)),
                 None => Err("bench playing-space needs --out DIR".into()),
             },
             "intonation" => match out {
-                Some(file) => colophony_lab::playing_space::Plan::from_options(false, &rates, None, &models)
+                Some(file) => colophony_lab::playing_space::Plan::from_options(false, &rates, None, &models, &instruments)
                     .and_then(|plan| {
                         let rate = if rates.is_empty() { 48_000.0 } else { plan.rates_hz[0] };
-                        colophony_lab::intonation_fit::run(&file, &plan.models, rate, passes.unwrap_or(2))
+                        colophony_lab::intonation_fit::run(&file, &plan.models, &plan.kinds, rate, passes.unwrap_or(2))
                     }),
                 None => Err("bench intonation needs --out FILE (the shipped one: assets/intonation.csv)".into()),
             },

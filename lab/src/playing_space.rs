@@ -420,8 +420,19 @@ impl Plan {
         rates_hz: &[f64],
         step: Option<usize>,
         models: &[String],
+        instruments: &[String],
     ) -> Result<Self, String> {
         let mut plan = if quick { Self::quick() } else { Self::full() };
+        if !instruments.is_empty() {
+            plan.kinds = instruments
+                .iter()
+                .map(|name| {
+                    InstrumentKind::from_name(&name.to_ascii_lowercase()).ok_or_else(|| {
+                        format!("unknown instrument '{name}': choose from violin, viola, cello")
+                    })
+                })
+                .collect::<Result<_, _>>()?;
+        }
         if !rates_hz.is_empty() {
             if let Some(bad) = rates_hz
                 .iter()

@@ -29,6 +29,7 @@
 use super::body::{BodyMode, BodyModes, MAX_BODY_MODES};
 use super::friction::bristle::{BristleParams, SolverStats};
 use super::friction::{AnyFriction, BowInput, FrictionContact, FrictionModel};
+use super::halfband::HalfbandDecimator;
 use super::intonation::{self, MAX_CORRECTION_CENTS};
 use super::resample::Resampler;
 pub use super::strings::FourStrings;
@@ -43,6 +44,10 @@ use super::waveguide::{StringSpec, WaveguideString};
 /// holds at every rate. 48 kHz: the commonest host rate (no resampling there), and twice
 /// the hearing range. Measured in docs/precision.md (issue 16, item 3).
 pub const INTERNAL_RATE_HZ: f64 = 48_000.0;
+
+/// Most times [`INTERNAL_RATE_HZ`] any instrument's point strings run at
+/// ([`InstrumentKind::point_oversampling`]); their delay lines are sized for it.
+pub const MAX_POINT_OVERSAMPLING: usize = 2;
 
 pub const STRINGS: usize = 4;
 /// Highest note above the highest open string (about the end of the fingerboard).
@@ -180,6 +185,21 @@ impl InstrumentKind {
     /// model: [`crate::dsp::thermal_instrument::THERMAL_WEIGHT_REFERENCE_Z0`]).
     pub fn string_weight_for(self, index: usize, reference_z0: f64) -> f64 {
         self.strings()[index.min(STRINGS - 1)].z0_kg_per_s / reference_z0
+    }
+
+    /// How many times [`INTERNAL_RATE_HZ`] the point-bow strings of this instrument run
+    /// at (their bridge force is decimated back to it by a half-band filter,
+    /// [`super::halfband`], before the body). A point bow's slip starts on a sample, so the
+    /// Helmholtz period locks to the sample grid (docs/playing-space.md, "The sample-grid
+    /// lock"): the violin's and viola's top octaves (periods of 18 to 55 samples at
+    /// 48 kHz) play 96 kHz strings, where the lock is half as wide; the cello's highest
+    /// note has 54 samples a period at 48 kHz and stays there (it is the costliest
+    /// instrument's half of the saving).
+    pub fn point_oversampling(self) -> usize {
+        match self {
+            Self::Violin | Self::Viola => 2,
+            Self::Cello => 1,
+        }
     }
 
     /// Output scale: bridge force to a sample value, so that a default note of any
@@ -369,6 +389,13 @@ pub struct WaveguideBank {
     output_scale: f64,
     /// The probed string's last internal sample: velocity at the bow, friction force.
     probe: (f64, f64),
+    /// The strings run at `oversample` times `sample_rate_hz`
+    /// ([`InstrumentKind::point_oversampling`]; 1 for [`Instrument::native`]).
+    oversample: usize,
+    /// Whether the strings may run faster than the bank ([`Instrument::native`]: no).
+    oversampling: bool,
+    /// Brings the bridge force of 2x strings down to the bank's rate.
+    decimator: HalfbandDecimator,
     /// Whether quiet lifted strings sleep (the default; off only to measure the saving).
     skipping: bool,
     /// No string awake and the body rung out: a sample costs nothing.
@@ -381,6 +408,48 @@ pub struct WaveguideBank {
 pub type Instrument = FourStrings<WaveguideBank>;
 
 impl WaveguideBank {
+    /// [`StringBank::sample`] with the strings at twice the bank's rate: every string's
+    /// bow is held over the two string samples, and the bridge force's pair is decimated
+    /// to one bank sample before the body. The probe is the later string sample's.
+    #[inline(never)]
+    fn sample_oversampled(
+        &mut self,
+        probed: usize,
+        mut bow_of: impl FnMut(usize) -> StringBow,
+    ) -> f64 {
+        let skipping = self.skipping;
+        let mut bows = [None; STRINGS];
+        for (i, voice) in self.voices.iter_mut().enumerate() {
+            if !voice.awake && skipping {
+                continue;
+            }
+            let bow = bow_of(i);
+            voice.string.set_bow_position(bow.position_beta);
+            bows[i] = Some(BowInput {
+                velocity_m_per_s: bow.velocity_m_per_s,
+                normal_force_n: bow.force,
+            });
+        }
+        let mut pair = [0.0; 2];
+        for bridge in &mut pair {
+            for (i, voice) in self.voices.iter_mut().enumerate() {
+                let Some(input) = bows[i] else { continue };
+                let out = voice.string.tick(&mut voice.contact, input);
+                *bridge += out.bridge_force_n;
+                if i == probed {
+                    self.probe = (out.bow_point_velocity_m_per_s, out.friction_force_n);
+                }
+            }
+        }
+        let bridge = self.decimator.process(pair[0], pair[1]);
+        super::filters::flush_tiny(self.body.tick(bridge) * self.output_scale)
+    }
+
+    /// The rate the strings run at: the bank's times its oversampling.
+    pub fn string_rate_hz(&self) -> f64 {
+        self.sample_rate_hz * self.oversample as f64
+    }
+
     /// The body `kind` plays: its custom one if set, else the generic one.
     fn body_of(&self, kind: InstrumentKind) -> BodyModes {
         let k = InstrumentKind::ALL.iter().position(|&x| x == kind);
@@ -438,9 +507,12 @@ impl StringBank for WaveguideBank {
     #[inline(never)]
     fn sample(&mut self, probed: usize, mut bow_of: impl FnMut(usize) -> StringBow) -> f64 {
         // `tick` checked that something is awake; sleep changes only between blocks.
-        let mut bridge = 0.0;
         let skipping = self.skipping;
         self.body_asleep = false;
+        if self.oversample > 1 {
+            return self.sample_oversampled(probed, bow_of);
+        }
+        let mut bridge = 0.0;
         for (i, voice) in self.voices.iter_mut().enumerate() {
             if !voice.awake && skipping {
                 continue;
@@ -470,6 +542,7 @@ impl StringBank for WaveguideBank {
         self.body_asleep = self.voices.iter().all(|v| !v.awake) && self.body.is_quiet(BODY_QUIET_N);
         if self.body_asleep {
             self.body.reset();
+            self.decimator.reset();
         }
         for (voice, &lifted) in self.voices.iter_mut().zip(lifted) {
             if voice.awake && lifted && voice.string.energy_j() < SLEEP_ENERGY_J {
@@ -526,6 +599,7 @@ impl StringBank for WaveguideBank {
             voice.awake = false;
         }
         self.body.reset();
+        self.decimator.reset();
         self.probe = (0.0, 0.0);
     }
 
@@ -541,18 +615,25 @@ impl Instrument {
     /// [`INTERNAL_RATE_HZ`], resampled to the host rate (no resampler at 48 kHz).
     /// Allocates everything; instrument changes later do not allocate.
     pub fn new(kind: InstrumentKind, host_rate_hz: f64) -> Self {
-        Self::with_internal_rate(kind, host_rate_hz, INTERNAL_RATE_HZ)
+        Self::with_internal_rate(kind, host_rate_hz, INTERNAL_RATE_HZ, true)
     }
 
     /// Strings and body at the host rate itself, no resampling: paper A's model as the
     /// papers discretise it, for the convergence studies in the rate.
     pub fn native(kind: InstrumentKind, sample_rate_hz: f64) -> Self {
-        Self::with_internal_rate(kind, sample_rate_hz, sample_rate_hz)
+        Self::with_internal_rate(kind, sample_rate_hz, sample_rate_hz, false)
     }
 
-    /// Strings and body at `internal_rate_hz`, resampled to `host_rate_hz`. A rate that is
-    /// not finite and positive is taken as 48 kHz.
-    fn with_internal_rate(kind: InstrumentKind, host_rate_hz: f64, internal_rate_hz: f64) -> Self {
+    /// Strings and body at `internal_rate_hz`, resampled to `host_rate_hz`; with
+    /// `oversampling`, the strings of each instrument at its
+    /// [`InstrumentKind::point_oversampling`] times that. A rate that is not finite and
+    /// positive is taken as 48 kHz.
+    fn with_internal_rate(
+        kind: InstrumentKind,
+        host_rate_hz: f64,
+        internal_rate_hz: f64,
+        oversampling: bool,
+    ) -> Self {
         let usable = |r: f64| {
             if r.is_finite() && r > 0.0 {
                 r
@@ -571,12 +652,28 @@ impl Instrument {
         // reference pitch.
         let lowest_hz = midi_to_hz(36.0 + LOWEST_TUNING_SEMITONES) * 0.99;
         let specs = kind.strings();
+        let oversample = if oversampling {
+            kind.point_oversampling()
+        } else {
+            1
+        };
+        let string_rate_hz = sample_rate_hz * oversample as f64;
+        let max_string_rate_hz = sample_rate_hz * MAX_POINT_OVERSAMPLING as f64;
         let voices = std::array::from_fn(|i| StringVoice {
-            string: WaveguideString::new(specs[i], sample_rate_hz, lowest_hz),
+            string: WaveguideString::with_capacity(
+                specs[i],
+                string_rate_hz,
+                lowest_hz,
+                if oversampling {
+                    max_string_rate_hz
+                } else {
+                    string_rate_hz
+                },
+            ),
             contact: AnyFriction::new(
                 FrictionModel::Hyperbolic,
                 BristleParams::waveguide_string(),
-                sample_rate_hz,
+                string_rate_hz,
             )
             .expect("the built-in bristle parameters are valid"),
             awake: false,
@@ -589,6 +686,9 @@ impl Instrument {
             custom_bodies: [None; 3],
             output_scale: kind.output_scale_per_n(),
             probe: (0.0, 0.0),
+            oversample,
+            oversampling,
+            decimator: HalfbandDecimator::new(),
             skipping: true,
             body_asleep: true,
         };
@@ -609,9 +709,18 @@ impl Instrument {
         self.set_kind_notes(kind);
         let bank = &mut self.bank;
         bank.kind = kind;
+        let oversample = if bank.oversampling {
+            kind.point_oversampling()
+        } else {
+            1
+        };
+        let string_rate_hz = bank.sample_rate_hz * oversample as f64;
+        bank.oversample = oversample;
+        bank.decimator.reset();
         for (voice, spec) in bank.voices.iter_mut().zip(kind.strings()) {
             voice.string.set_spec(spec);
-            voice.contact.reset();
+            voice.string.set_sample_rate(string_rate_hz);
+            voice.contact.set_sample_rate(string_rate_hz);
             voice.awake = false;
         }
         bank.body = bank.body_of(kind);
@@ -685,7 +794,7 @@ impl Instrument {
 
     /// Replaces the bristle parameters of every string (validated; real-time safe).
     pub fn set_bristle_params(&mut self, params: BristleParams) -> Result<(), String> {
-        let rate = self.bank.sample_rate_hz;
+        let rate = self.bank.string_rate_hz();
         for voice in &mut self.bank.voices {
             let model = voice.contact.model();
             voice.contact = AnyFriction::new(model, params, rate)?;

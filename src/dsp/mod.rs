@@ -14,6 +14,7 @@ pub mod engine;
 pub mod filters;
 pub mod fingering;
 pub mod friction;
+pub mod halfband;
 pub mod instrument;
 pub mod intonation;
 pub mod modal;

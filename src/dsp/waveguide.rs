@@ -216,7 +216,18 @@ impl WaveguideString {
     /// Allocates delay lines long enough for any fundamental down to `lowest_hz` at this
     /// sample rate. Call from a non-real-time context.
     pub fn new(spec: StringSpec, sample_rate_hz: f64, lowest_hz: f64) -> Self {
-        let capacity = (sample_rate_hz / lowest_hz / 2.0).ceil() as usize + 4;
+        Self::with_capacity(spec, sample_rate_hz, lowest_hz, sample_rate_hz)
+    }
+
+    /// As [`WaveguideString::new`], with delay lines long enough for `lowest_hz` at rates
+    /// up to `max_rate_hz` too ([`WaveguideString::set_sample_rate`]).
+    pub fn with_capacity(
+        spec: StringSpec,
+        sample_rate_hz: f64,
+        lowest_hz: f64,
+        max_rate_hz: f64,
+    ) -> Self {
+        let capacity = (sample_rate_hz.max(max_rate_hz) / lowest_hz / 2.0).ceil() as usize + 4;
         let mut s = Self {
             spec,
             sample_rate_hz,
@@ -271,6 +282,31 @@ impl WaveguideString {
 
     pub fn spec(&self) -> StringSpec {
         self.spec
+    }
+
+    /// Runs the string at `sample_rate_hz` from now on: refits its filters at its present
+    /// pitch and resets the state. Real-time safe; a rate whose loop does not fit the
+    /// delay lines leaves the string unplayable (see [`WaveguideString::with_capacity`]).
+    pub fn set_sample_rate(&mut self, sample_rate_hz: f64) {
+        if sample_rate_hz == self.sample_rate_hz
+            || !(sample_rate_hz.is_finite() && sample_rate_hz > 0.0)
+        {
+            return;
+        }
+        self.sample_rate_hz = sample_rate_hz;
+        self.design_hair();
+        self.reset();
+        self.torsion.index = usize::MAX;
+        let f1 = if self.fundamental_hz > 0.0 {
+            self.fundamental_hz
+        } else {
+            self.spec.open_hz
+        };
+        self.stop_at(f1);
+    }
+
+    pub fn sample_rate_hz(&self) -> f64 {
+        self.sample_rate_hz
     }
 
     /// Replaces the string (instrument change). Real-time safe; resets the state.

@@ -312,6 +312,15 @@ impl BristleFriction {
         })
     }
 
+    /// Runs the contact at `sample_rate_hz` from now on (real-time safe; the state is
+    /// reset). A rate that is not finite and positive is ignored.
+    pub fn set_sample_rate(&mut self, sample_rate_hz: f64) {
+        if sample_rate_hz.is_finite() && sample_rate_hz > 0.0 {
+            self.half_period_s = 0.5 / sample_rate_hz;
+            self.reset();
+        }
+    }
+
     /// Chooses the time discretisation of the bristle equation (real-time safe; the state
     /// carries over).
     pub fn set_integrator(&mut self, integrator: BristleIntegrator) {

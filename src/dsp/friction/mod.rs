@@ -263,6 +263,13 @@ impl AnyFriction {
         }
     }
 
+    /// Runs the contact at `sample_rate_hz` from now on (the bristle laws' time step; the
+    /// static curves have none). Real-time safe; the state is reset.
+    pub fn set_sample_rate(&mut self, sample_rate_hz: f64) {
+        self.bristle.set_sample_rate(sample_rate_hz);
+        self.reset();
+    }
+
     /// Switches the law, handing over the current force and stick state.
     pub fn set_model(&mut self, model: FrictionModel) {
         if model == self.model {
