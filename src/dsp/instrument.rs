@@ -42,7 +42,8 @@ use super::waveguide::{StringSpec, WaveguideString};
 /// attack falls into changes with any detail of the discretisation) and its pitch then do
 /// not depend on the project's rate, and the intonation table, measured at this rate,
 /// holds at every rate. 48 kHz: the commonest host rate (no resampling there), and twice
-/// the hearing range. Measured in docs/precision.md (issue 16, item 3).
+/// the hearing range. Measured in docs/precision.md (issue 16, item 3). The violin's and
+/// viola's strings run at a multiple of it ([`InstrumentKind::point_oversampling`]).
 pub const INTERNAL_RATE_HZ: f64 = 48_000.0;
 
 /// Most times [`INTERNAL_RATE_HZ`] any instrument's point strings run at
