@@ -32,39 +32,36 @@ use std::f64::consts::PI;
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Allpass1 {
     pub a: f64,
-    x1: f64,
-    y1: f64,
+    /// Transposed-direct-form state `s = x[n-1] - a y[n-1]`: `y = a x + s`.
+    s: f64,
 }
 
 impl Allpass1 {
     pub fn new(a: f64) -> Self {
-        Self {
-            a,
-            x1: 0.0,
-            y1: 0.0,
-        }
+        Self { a, s: 0.0 }
     }
 
+    /// One sample. In transposed direct form the input reaches the output through one
+    /// multiply and one add (`y = a x + s`), so a chain of sections (the string's
+    /// dispersion) is a short dependency chain; the state's update `s = x - a y` runs
+    /// beside the next section.
     #[inline]
     pub fn tick(&mut self, x: f64) -> f64 {
-        let y = self.a * x + self.x1 - self.a * self.y1;
-        self.x1 = x;
-        self.y1 = y;
+        let y = self.a * x + self.s;
+        self.s = x - self.a * y;
         y
     }
 
     pub fn reset(&mut self) {
-        self.x1 = 0.0;
-        self.y1 = 0.0;
+        self.s = 0.0;
     }
 
     /// Energy the section holds, in squared signal units: `s^2 / (1 - a^2)` for its state
-    /// `s = x1 - a y1` (the transposed-direct-form state, `y = a x + s`). The section is
-    /// lossless, and this is exactly what has gone in and not yet come out:
-    /// `S(n+1) - S(n) = x^2 - y^2` on every sample (expand `s' = (1 - a^2) x - a s`).
+    /// `s` (`y = a x + s`). The section is lossless, and this is exactly what has gone in
+    /// and not yet come out: `S(n+1) - S(n) = x^2 - y^2` on every sample (expand
+    /// `s' = x - a y = (1 - a^2) x - a s`).
     pub fn stored_energy(&self) -> f64 {
-        let s = self.x1 - self.a * self.y1;
-        s * s / (1.0 - self.a * self.a)
+        self.s * self.s / (1.0 - self.a * self.a)
     }
 
     /// Phase delay in samples at `w` rad/sample (`w` in (0, pi)).
