@@ -1,0 +1,66 @@
+//! Attacks through the performer, as the plugin plays a note from MIDI at the defaults:
+//! the violin's and viola's range (three octaves from the lowest open string, every third
+//! semitone) at note velocities 0.3, 0.55, 0.8 and 1.0 (the velocity sets the bow's
+//! acceleration, `src/performer/stroke.rs`), every point law, 2.5 s each; the editor's
+//! regime classifier on the contact probe over 1.5-2.5 s. A survey, printed, not
+//! asserted: which limit cycle an attack falls into is chaotic, so it is read as counts.
+//!
+//! 2026-11-26, before and after the violin's and viola's strings went to 96 kHz inside
+//! (attacks in Helmholtz motion, of 52; hyperbolic / static / LuGre / elasto-plastic):
+//! violin 51 / 52 / 49 / 51 -> 49 / 51 / 51 / 52, viola 47 / 52 / 51 / 51 -> 48 / 52 / 51 /
+//! 52. `cargo test --release --test attack_survey -- --ignored --nocapture`.
+use colophony::dsp::friction::FrictionModel;
+use colophony::dsp::instrument::{midi_to_hz, BowControl, InstrumentKind};
+use colophony::editor::live::ContactSample;
+use colophony::editor::regime::{classify_regime, Regime};
+use colophony::performer::{Performer, Setup};
+
+const FS: f64 = 48_000.0;
+
+#[test]
+#[ignore]
+fn attacks_through_the_performer_survey() {
+    for kind in [InstrumentKind::Violin, InstrumentKind::Viola] {
+        for law in FrictionModel::ALL {
+            let (low, high) = kind.note_range();
+            let mut helm = 0;
+            let mut total = 0;
+            let mut line = String::new();
+            for note in (low..=high.min(low + 36)).step_by(3) {
+                for vel in [0.3f32, 0.55, 0.8, 1.0] {
+                    let setup = Setup {
+                        instrument: kind,
+                        point_law: Some(law),
+                        ..Setup::default()
+                    };
+                    let mut p = Performer::new(kind);
+                    p.activate(&setup, FS).unwrap();
+                    p.note_on(note, vel);
+                    let bow = BowControl::default();
+                    let n = (2.5 * FS) as usize;
+                    let mut probe = Vec::with_capacity(n);
+                    for i in 0..n {
+                        if i % 256 == 0 {
+                            p.configure(&setup);
+                        }
+                        let frame = p.tick(bow);
+                        probe.push(ContactSample::new(&frame, &p.bow()));
+                    }
+                    let f0 = midi_to_hz(note as f64);
+                    let r = classify_regime(&probe[(1.5 * FS) as usize..], FS as f32, f0 as f32);
+                    total += 1;
+                    if r == Some(Regime::Helmholtz) {
+                        helm += 1;
+                    } else {
+                        line += &format!(" {note}@{vel}:{r:?}");
+                    }
+                }
+            }
+            println!(
+                "{:?} {}: {helm} of {total} attacks in Helmholtz motion at 1.5-2.5 s;{line}",
+                kind,
+                law.name()
+            );
+        }
+    }
+}
