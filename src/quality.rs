@@ -9,17 +9,22 @@
 //! * the thermal bow's node count N_B (space and time together: the internal rate is
 //!   `c_low N_B / w`).
 //!
-//! The waveguide's host rate is not a quality setting: in the benchmark its pitch sits
-//! within about a cent of the 768 kHz reference at every rate from 22.05 to 384 kHz
-//! without a trend, and its attack does not converge (docs/precision.md), so oversampling
-//! would cost without a measured gain. Every preset runs the waveguide at the host rate,
-//! with the default dispersion filter order (8 sections).
+//! The waveguide's rate is not a quality setting: in the benchmark its pitch sits within
+//! about a cent of the 768 kHz reference at every rate from 22.05 to 384 kHz without a
+//! trend, and its attack does not converge (docs/precision.md). Every preset runs the
+//! point strings at the instrument's internal rate (48 kHz; the violin's and viola's
+//! strings at 96 kHz, [`InstrumentKind::point_oversampling`]), with the default
+//! dispersion filter order (8 sections).
 //!
-//! | preset | Newton tolerance | thermal N_B | measured (docs/precision.md) |
+//! Measured by the full benchmark of 2026-11-26 (docs/precision.csv; cello D3 at 48 kHz,
+//! each tolerance against 1e-13 at the same rate; thermal: paper B's Fig. 6 bow at beta
+//! 0.07 and 0.1 against N_B 120):
+//!
+//! | preset | Newton tolerance | thermal N_B | measured |
 //! |---|---|---|---|
-//! | draft | 1e-2 m/s | 8 | cello D, elasto-plastic: attack waveform -10 dB against 1e-13, 1.7x faster than 1e-10; thermal Fig. 6 bow (beta 0.07 and 0.1): f0 -0.3 to -0.4 cents, harmonics 0.4-0.5 dB, attack -14 to -15 dB, 34x real time (6 nodes double-slip at beta 0.07) |
-//! | good | 1e-4 m/s | 10 | -49 dB (elasto-plastic), -84 dB (LuGre); thermal: f0 -0.2 to -0.4 cents, harmonics 0.2-0.5 dB, attack -16 dB, 26x |
-//! | reference | 1e-10 m/s | 60 | below -260 dB; thermal: f0 -0.02 to -0.04 cents, harmonics 0.02-0.06 dB, attack -31 dB, 5.0x |
+//! | draft | 1e-2 m/s | 8 | attack waveform against 1e-13: LuGre -5.7 dB, elasto-plastic -1.7 dB (the scene sits at a regime boundary: the loose solve lands in Helmholtz motion where the tight one slips 1.9 times a period), the wine glass (elasto-plastic) -83 dB; 1.8x faster than 1e-10; thermal: f0 -0.4 to -0.6 cents, harmonics 0.4-0.9 dB, attack -14 to -17 dB, 32-34x real time |
+//! | good | 1e-4 m/s | 10 | LuGre -81 dB, elasto-plastic -54 dB (f0 3.1 cents off: the same boundary), wine glass -156 dB; 1.3x faster than 1e-10; thermal: f0 -0.3 to -0.4 cents, harmonics 0.3-0.4 dB, attack -16 to -17 dB, 25-26x |
+//! | reference | 1e-10 m/s | 60 | below -200 dB; thermal: f0 -0.03 to -0.05 cents, harmonics 0.04-0.17 dB, attack -29 to -34 dB, 4.3-5.0x |
 //! | auto | 1e-4 m/s | per note: [`auto_nodes`] | good's error at every note and bow position |
 //!
 //! `auto` keeps good's error target where the error grows: a slip lasts `beta / f0`
