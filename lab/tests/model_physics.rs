@@ -392,6 +392,37 @@ fn the_bowed_string_plays_the_same_motion_and_pitch_at_every_host_rate() {
     }
 }
 
+/// The bowed pitch (Hz, over 0.5-1.5 s) of violin `note` with `friction` at 1 N, beta 0.1,
+/// 0.1 m/s: the plugin's model at host rate `fs`, or (`native_rate`) the strings at `fs`.
+fn violin_pitch(
+    note: u8,
+    friction: colophony::dsp::friction::FrictionModel,
+    fs: f64,
+    native_rate: bool,
+) -> f64 {
+    let out = render(&RenderSettings {
+        instrument: InstrumentKind::Violin,
+        note,
+        seconds: 1.5,
+        bow: BowControl {
+            velocity_m_per_s: 0.1,
+            force_n: 1.0,
+            position_beta: 0.1,
+        },
+        sample_rate_hz: fs,
+        friction,
+        native_rate,
+        ..RenderSettings::default()
+    })
+    .unwrap();
+    peak_frequency_hz(
+        window(&out.audio, 0.5, 1.5, fs),
+        fs,
+        midi_to_hz(note as f64),
+        50.0,
+    )
+}
+
 /// The violin's top octave against the same strings at 192 kHz (the refined reference).
 /// A point bow's slip starts on a sample, so the Helmholtz period locks to the strings'
 /// sample grid, by up to half a sample a period (docs/playing-space.md, "The sample-grid
@@ -403,30 +434,11 @@ fn the_bowed_string_plays_the_same_motion_and_pitch_at_every_host_rate() {
 #[test]
 fn the_violins_top_octave_plays_the_refined_models_pitch() {
     use colophony::dsp::friction::FrictionModel;
-    let bow = BowControl {
-        velocity_m_per_s: 0.1,
-        force_n: 1.0,
-        position_beta: 0.1,
-    };
     let mut plugin = Vec::new();
     let mut coarse = Vec::new();
     for friction in FrictionModel::ALL {
         for note in (81..=93).step_by(2) {
-            let f0 = midi_to_hz(note as f64);
-            let pitch = |fs: f64, native_rate: bool| {
-                let out = render(&RenderSettings {
-                    instrument: InstrumentKind::Violin,
-                    note,
-                    seconds: 1.5,
-                    bow,
-                    sample_rate_hz: fs,
-                    friction,
-                    native_rate,
-                    ..RenderSettings::default()
-                })
-                .unwrap();
-                peak_frequency_hz(window(&out.audio, 0.5, 1.5, fs), fs, f0, 50.0)
-            };
+            let pitch = |fs: f64, native_rate: bool| violin_pitch(note, friction, fs, native_rate);
             let reference = pitch(192_000.0, true);
             let p = cents(pitch(48_000.0, false), reference);
             let c = cents(pitch(48_000.0, true), reference);
@@ -471,30 +483,13 @@ fn the_violins_top_octave_plays_the_refined_models_pitch() {
 #[test]
 fn the_violins_oversampled_strings_play_the_native_96_khz_model() {
     use colophony::dsp::friction::FrictionModel;
-    let bow = BowControl {
-        velocity_m_per_s: 0.1,
-        force_n: 1.0,
-        position_beta: 0.1,
-    };
     let mut differences = Vec::new();
     for friction in FrictionModel::ALL {
         for note in [55u8, 62, 69, 76, 81, 86, 93] {
-            let f0 = midi_to_hz(note as f64);
-            let pitch = |fs: f64, native_rate: bool| {
-                let out = render(&RenderSettings {
-                    instrument: InstrumentKind::Violin,
-                    note,
-                    seconds: 1.5,
-                    bow,
-                    sample_rate_hz: fs,
-                    friction,
-                    native_rate,
-                    ..RenderSettings::default()
-                })
-                .unwrap();
-                peak_frequency_hz(window(&out.audio, 0.5, 1.5, fs), fs, f0, 50.0)
-            };
-            let d = cents(pitch(48_000.0, false), pitch(96_000.0, true));
+            let d = cents(
+                violin_pitch(note, friction, 48_000.0, false),
+                violin_pitch(note, friction, 96_000.0, true),
+            );
             println!(
                 "{} violin {note}: {d:+.3} cents from native 96 kHz",
                 friction.name()
