@@ -23,6 +23,7 @@
 //! assert!((y - 1.0).abs() < 1e-9);
 //! ```
 
+use super::filters::Allpass1;
 use std::f64::consts::PI;
 
 /// Allpass coefficients (sections over both chains).
@@ -43,34 +44,27 @@ pub fn design(n: usize, transition: f64) -> Vec<f64> {
     let e4 = e.powi(4);
     let q = e * (1.0 + e4 * (2.0 + e4 * (15.0 + 150.0 * e4)));
     let order = (2 * n + 1) as f64;
+    // Alternating theta-function series of the elliptic filter's pole positions, summed
+    // from index `from` until the terms vanish.
+    let series = |from: f64, term: &dyn Fn(f64) -> f64| {
+        let (mut sum, mut i, mut sign) = (0.0, from, 1.0);
+        loop {
+            let t = term(i) * sign;
+            sum += t;
+            if t.abs() < 1e-100 || i > 200.0 {
+                return sum;
+            }
+            sign = -sign;
+            i += 1.0;
+        }
+    };
     (1..=n)
         .map(|c| {
             let c = c as f64;
-            // Theta-function series of the elliptic filter's pole positions.
-            let mut num = 0.0;
-            let mut i = 0.0f64;
-            let mut sign = 1.0;
-            loop {
-                let term = q.powf(i * (i + 1.0)) * ((2.0 * i + 1.0) * c * PI / order).sin() * sign;
-                num += term;
-                if term.abs() < 1e-100 || i > 200.0 {
-                    break;
-                }
-                sign = -sign;
-                i += 1.0;
-            }
-            let mut den = 0.0;
-            let mut i = 1.0f64;
-            let mut sign = -1.0;
-            loop {
-                let term = q.powf(i * i) * (2.0 * i * c * PI / order).cos() * sign;
-                den += term;
-                if term.abs() < 1e-100 || i > 200.0 {
-                    break;
-                }
-                sign = -sign;
-                i += 1.0;
-            }
+            let num = series(0.0, &|i| {
+                q.powf(i * (i + 1.0)) * ((2.0 * i + 1.0) * c * PI / order).sin()
+            });
+            let den = -series(1.0, &|i| q.powf(i * i) * (2.0 * i * c * PI / order).cos());
             let ww = num * q.powf(0.25) / (den + 0.5);
             let wwsq = ww * ww;
             let x = ((1.0 - wwsq * k) * (1.0 - wwsq / k)).sqrt() / (1.0 + wwsq);
@@ -79,13 +73,12 @@ pub fn design(n: usize, transition: f64) -> Vec<f64> {
         .collect()
 }
 
-/// Two samples in, one out: see the module doc. No allocation after construction.
+/// Two samples in, one out: see the module doc. Each section is a first-order allpass
+/// ([`Allpass1`]) run at the low rate. No allocation after construction.
 #[derive(Debug, Clone)]
 pub struct HalfbandDecimator {
-    coefficients: [f64; COEFFICIENTS],
-    /// Each section's previous input and output (at the low rate).
-    x1: [f64; COEFFICIENTS],
-    y1: [f64; COEFFICIENTS],
+    /// Even indices: the chain fed the later sample of each pair; odd: the earlier.
+    sections: [Allpass1; COEFFICIENTS],
 }
 
 impl Default for HalfbandDecimator {
@@ -98,9 +91,7 @@ impl HalfbandDecimator {
     pub fn new() -> Self {
         let c = design(COEFFICIENTS, TRANSITION);
         Self {
-            coefficients: std::array::from_fn(|i| c[i]),
-            x1: [0.0; COEFFICIENTS],
-            y1: [0.0; COEFFICIENTS],
+            sections: std::array::from_fn(|i| Allpass1::new(c[i])),
         }
     }
 
@@ -108,27 +99,15 @@ impl HalfbandDecimator {
     #[inline]
     pub fn process(&mut self, earlier: f64, later: f64) -> f64 {
         let (mut a, mut b) = (later, earlier);
-        let mut i = 0;
-        while i + 1 < COEFFICIENTS {
-            a = self.section(i, a);
-            b = self.section(i + 1, b);
-            i += 2;
+        for pair in self.sections.chunks_exact_mut(2) {
+            a = pair[0].tick(a);
+            b = pair[1].tick(b);
         }
         0.5 * (a + b)
     }
 
-    /// `y = c (x - y[-1]) + x[-1]`: `(c + z^-1) / (1 + c z^-1)` at the low rate.
-    #[inline(always)]
-    fn section(&mut self, i: usize, x: f64) -> f64 {
-        let y = self.coefficients[i] * (x - self.y1[i]) + self.x1[i];
-        self.x1[i] = x;
-        self.y1[i] = y;
-        y
-    }
-
     pub fn reset(&mut self) {
-        self.x1 = [0.0; COEFFICIENTS];
-        self.y1 = [0.0; COEFFICIENTS];
+        self.sections.iter_mut().for_each(Allpass1::reset);
     }
 }
 

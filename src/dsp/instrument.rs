@@ -194,8 +194,8 @@ impl InstrumentKind {
     /// Helmholtz period locks to the sample grid (docs/playing-space.md, "The sample-grid
     /// lock"): the violin's and viola's top octaves (periods of 18 to 55 samples at
     /// 48 kHz) play 96 kHz strings, where the lock is half as wide; the cello's highest
-    /// note has 54 samples a period at 48 kHz and stays there (it is the costliest
-    /// instrument's half of the saving).
+    /// note has 54 samples a period at 48 kHz, and its strings stay there (at half the
+    /// cost: docs/playing-space.md, "The violin and viola at 96 kHz inside").
     pub fn point_oversampling(self) -> usize {
         match self {
             Self::Violin | Self::Viola => 2,

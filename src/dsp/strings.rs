@@ -73,9 +73,6 @@ pub trait StringBank {
     fn force_divisor(&self) -> f64 {
         1.0
     }
-    /// Whether [`StringBank::force_divisor`] is always 1 (then the bow's force reaches the
-    /// strings without a division a string a sample).
-    const UNIT_FORCE_DIVISOR: bool = true;
     /// What multiplies the resampled output (the bank's own output scale where it is
     /// applied after resampling; 1 where [`StringBank::sample`] already gives audio).
     fn output_gain(&self) -> f64 {
@@ -194,14 +191,9 @@ impl Hands {
                 }
             }
         }
+        let divisor = bank.force_divisor();
         let probed = self.probed;
-        if B::UNIT_FORCE_DIVISOR {
-            // `x / 1.0` is `x`: the same bits, without the division.
-            bank.sample(probed, move |i| self.string_bow(i, bow, 1.0))
-        } else {
-            let divisor = bank.force_divisor();
-            bank.sample(probed, move |i| self.string_bow(i, bow, divisor))
-        }
+        bank.sample(probed, move |i| self.string_bow(i, bow, divisor))
     }
 
     /// String `i`'s bow for this internal sample (its envelope moves one step).

@@ -262,7 +262,6 @@ impl ThermalBank {
 impl StringBank for ThermalBank {
     type Settings = ThermalSettings;
     const WEIGHT_REFERENCE_Z0: f64 = THERMAL_WEIGHT_REFERENCE_Z0;
-    const UNIT_FORCE_DIVISOR: bool = false;
 
     fn internal_rate_hz(&self) -> f64 {
         Self::internal_rate(self.kind, &self.wave_speeds, self.settings)
