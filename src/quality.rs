@@ -13,7 +13,8 @@
 //! about a cent of the 768 kHz reference at every rate from 22.05 to 384 kHz without a
 //! trend, and its attack does not converge (docs/precision.md). Every preset runs the
 //! point strings at the instrument's internal rate (48 kHz; the violin's and viola's
-//! strings at 96 kHz, [`InstrumentKind::point_oversampling`]), with the default
+//! strings and the cello's A string at 96 kHz, [`InstrumentKind::point_oversampling`]),
+//! with the default
 //! dispersion filter order (8 sections).
 //!
 //! Measured by the full benchmark of 2026-11-26 (docs/precision.csv; cello D3 at 48 kHz,

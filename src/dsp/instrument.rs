@@ -188,18 +188,20 @@ impl InstrumentKind {
         self.strings()[index.min(STRINGS - 1)].z0_kg_per_s / reference_z0
     }
 
-    /// How many times [`INTERNAL_RATE_HZ`] the point-bow strings of this instrument run
-    /// at (their bridge force is decimated back to it by a half-band filter,
-    /// [`super::halfband`], before the body). A point bow's slip starts on a sample, so the
-    /// Helmholtz period locks to the sample grid (docs/playing-space.md, "The sample-grid
-    /// lock"): the violin's and viola's top octaves (periods of 18 to 55 samples at
-    /// 48 kHz) play 96 kHz strings, where the lock is half as wide; the cello's highest
-    /// note has 54 samples a period at 48 kHz, and its strings stay there (at half the
-    /// cost: docs/playing-space.md, "The violin and viola at 96 kHz inside").
-    pub fn point_oversampling(self) -> usize {
+    /// How many times [`INTERNAL_RATE_HZ`] each point-bow string of this instrument runs
+    /// at (the bridge force of the faster ones is decimated back to it by a half-band
+    /// filter, [`super::halfband`], before the body). A point bow's slip starts on a
+    /// sample, so the Helmholtz period locks to the sample grid (docs/playing-space.md,
+    /// "The sample-grid lock"): the violin's and viola's top octaves (periods of 18 to 55
+    /// samples at 48 kHz) play 96 kHz strings, where the lock is half as wide, and so does
+    /// the cello's A string (A4 to A5 have 110 to 55 samples a period at 48 kHz, E6 36;
+    /// docs/playing-space.md, "The cello's A string at 96 kHz"). The cello's three lower
+    /// strings, which play the notes below A3 unless a note is asked onto them, run at
+    /// 48 kHz, at half the cost.
+    pub fn point_oversampling(self) -> [usize; STRINGS] {
         match self {
-            Self::Violin | Self::Viola => 2,
-            Self::Cello => 1,
+            Self::Violin | Self::Viola => [2; STRINGS],
+            Self::Cello => [1, 1, 1, 2],
         }
     }
 
@@ -390,9 +392,9 @@ pub struct WaveguideBank {
     output_scale: f64,
     /// The probed string's last internal sample: velocity at the bow, friction force.
     probe: (f64, f64),
-    /// The strings run at `oversample` times `sample_rate_hz`
+    /// Each string runs at its `oversample` times `sample_rate_hz`
     /// ([`InstrumentKind::point_oversampling`]; 1 for [`Instrument::native`]).
-    oversample: usize,
+    oversample: [usize; STRINGS],
     /// Whether the strings may run faster than the bank ([`Instrument::native`]: no).
     oversampling: bool,
     /// Brings the bridge force of 2x strings down to the bank's rate.
@@ -409,46 +411,9 @@ pub struct WaveguideBank {
 pub type Instrument = FourStrings<WaveguideBank>;
 
 impl WaveguideBank {
-    /// [`StringBank::sample`] with the strings at twice the bank's rate: every string's
-    /// bow is held over the two string samples, and the bridge force's pair is decimated
-    /// to one bank sample before the body. The probe is the later string sample's.
-    #[inline(never)]
-    fn sample_oversampled(
-        &mut self,
-        probed: usize,
-        mut bow_of: impl FnMut(usize) -> StringBow,
-    ) -> f64 {
-        let skipping = self.skipping;
-        let mut bows = [None; STRINGS];
-        for (i, voice) in self.voices.iter_mut().enumerate() {
-            if !voice.awake && skipping {
-                continue;
-            }
-            let bow = bow_of(i);
-            voice.string.set_bow_position(bow.position_beta);
-            bows[i] = Some(BowInput {
-                velocity_m_per_s: bow.velocity_m_per_s,
-                normal_force_n: bow.force,
-            });
-        }
-        let mut pair = [0.0; 2];
-        for bridge in &mut pair {
-            for (i, voice) in self.voices.iter_mut().enumerate() {
-                let Some(input) = bows[i] else { continue };
-                let out = voice.string.tick(&mut voice.contact, input);
-                *bridge += out.bridge_force_n;
-                if i == probed {
-                    self.probe = (out.bow_point_velocity_m_per_s, out.friction_force_n);
-                }
-            }
-        }
-        let bridge = self.decimator.process(pair[0], pair[1]);
-        super::filters::flush_tiny(self.body.tick(bridge) * self.output_scale)
-    }
-
-    /// The rate the strings run at: the bank's times its oversampling.
-    pub fn string_rate_hz(&self) -> f64 {
-        self.sample_rate_hz * self.oversample as f64
+    /// The rate string `index` runs at: the bank's times its oversampling.
+    pub fn string_rate_hz(&self, index: usize) -> f64 {
+        self.sample_rate_hz * self.oversample[index.min(STRINGS - 1)] as f64
     }
 
     /// The body `kind` plays: its custom one if set, else the generic one.
@@ -510,10 +475,10 @@ impl StringBank for WaveguideBank {
         // `tick` checked that something is awake; sleep changes only between blocks.
         let skipping = self.skipping;
         self.body_asleep = false;
-        if self.oversample > 1 {
-            return self.sample_oversampled(probed, bow_of);
-        }
         let mut bridge = 0.0;
+        // The bridge force of the strings at twice the bank's rate, a pair a bank sample.
+        let mut fine = [0.0; 2];
+        let mut any_fine = false;
         for (i, voice) in self.voices.iter_mut().enumerate() {
             if !voice.awake && skipping {
                 continue;
@@ -524,11 +489,26 @@ impl StringBank for WaveguideBank {
                 velocity_m_per_s: bow.velocity_m_per_s,
                 normal_force_n: bow.force,
             };
-            let out = voice.string.tick(&mut voice.contact, input);
-            bridge += out.bridge_force_n;
-            if i == probed {
-                self.probe = (out.bow_point_velocity_m_per_s, out.friction_force_n);
+            if self.oversample[i] == 1 {
+                let out = voice.string.tick(&mut voice.contact, input);
+                bridge += out.bridge_force_n;
+                if i == probed {
+                    self.probe = (out.bow_point_velocity_m_per_s, out.friction_force_n);
+                }
+            } else {
+                // The bow is held over the string's two samples; the probe is the later's.
+                any_fine = true;
+                for force in &mut fine {
+                    let out = voice.string.tick(&mut voice.contact, input);
+                    *force += out.bridge_force_n;
+                    if i == probed {
+                        self.probe = (out.bow_point_velocity_m_per_s, out.friction_force_n);
+                    }
+                }
             }
+        }
+        if any_fine {
+            bridge += self.decimator.process(fine[0], fine[1]);
         }
         super::filters::flush_tiny(self.body.tick(bridge) * self.output_scale)
     }
@@ -656,28 +636,30 @@ impl Instrument {
         let oversample = if oversampling {
             kind.point_oversampling()
         } else {
-            1
+            [1; STRINGS]
         };
-        let string_rate_hz = sample_rate_hz * oversample as f64;
         let max_string_rate_hz = sample_rate_hz * MAX_POINT_OVERSAMPLING as f64;
-        let voices = std::array::from_fn(|i| StringVoice {
-            string: WaveguideString::with_capacity(
-                specs[i],
-                string_rate_hz,
-                lowest_hz,
-                if oversampling {
-                    max_string_rate_hz
-                } else {
-                    string_rate_hz
-                },
-            ),
-            contact: AnyFriction::new(
-                FrictionModel::Hyperbolic,
-                BristleParams::waveguide_string(),
-                string_rate_hz,
-            )
-            .expect("the built-in bristle parameters are valid"),
-            awake: false,
+        let voices = std::array::from_fn(|i| {
+            let string_rate_hz = sample_rate_hz * oversample[i] as f64;
+            StringVoice {
+                string: WaveguideString::with_capacity(
+                    specs[i],
+                    string_rate_hz,
+                    lowest_hz,
+                    if oversampling {
+                        max_string_rate_hz
+                    } else {
+                        string_rate_hz
+                    },
+                ),
+                contact: AnyFriction::new(
+                    FrictionModel::Hyperbolic,
+                    BristleParams::waveguide_string(),
+                    string_rate_hz,
+                )
+                .expect("the built-in bristle parameters are valid"),
+                awake: false,
+            }
         });
         let bank = WaveguideBank {
             kind,
@@ -713,12 +695,12 @@ impl Instrument {
         let oversample = if bank.oversampling {
             kind.point_oversampling()
         } else {
-            1
+            [1; STRINGS]
         };
-        let string_rate_hz = bank.sample_rate_hz * oversample as f64;
         bank.oversample = oversample;
         bank.decimator.reset();
-        for (voice, spec) in bank.voices.iter_mut().zip(kind.strings()) {
+        for ((voice, spec), times) in bank.voices.iter_mut().zip(kind.strings()).zip(oversample) {
+            let string_rate_hz = bank.sample_rate_hz * times as f64;
             voice.string.set_spec(spec);
             voice.string.set_sample_rate(string_rate_hz);
             voice.contact.set_sample_rate(string_rate_hz);
@@ -795,8 +777,9 @@ impl Instrument {
 
     /// Replaces the bristle parameters of every string (validated; real-time safe).
     pub fn set_bristle_params(&mut self, params: BristleParams) -> Result<(), String> {
-        let rate = self.bank.string_rate_hz();
-        for voice in &mut self.bank.voices {
+        let bank = &mut self.bank;
+        for (i, voice) in bank.voices.iter_mut().enumerate() {
+            let rate = bank.sample_rate_hz * bank.oversample[i] as f64;
             let model = voice.contact.model();
             voice.contact = AnyFriction::new(model, params, rate)?;
         }
