@@ -14,8 +14,7 @@
 //! trend, and its attack does not converge (docs/precision.md). Every preset runs the
 //! point strings at the instrument's internal rate (48 kHz; the violin's and viola's
 //! strings and the cello's A string at 96 kHz, [`InstrumentKind::point_oversampling`]),
-//! with the default
-//! dispersion filter order (8 sections).
+//! with the default dispersion filter order (8 sections).
 //!
 //! Measured by the full benchmark of 2026-11-26 (docs/precision.csv; cello D3 at 48 kHz,
 //! each tolerance against 1e-13 at the same rate; thermal: paper B's Fig. 6 bow at beta

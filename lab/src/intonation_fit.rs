@@ -251,7 +251,8 @@ pub fn run(
         "# Intonation by the bowed sound (src/dsp/intonation.rs): cents each stopped note is moved\n\
          # from its equal-tempered free-decay pitch so that it sounds in tune bowed at the defaults.\n\
          # Measured by `colophony bench intonation` at a host rate of {rate_hz} Hz (the point strings\n\
-         # run at {internal} Hz inside, the violin's and viola's at twice that), {passes} passes.\n{}",
+         # run at {internal} Hz inside, the violin's and viola's strings and the cello's A string at\n\
+         # twice that), {passes} passes.\n{}",
         merged.to_csv(),
         internal = colophony::dsp::instrument::INTERNAL_RATE_HZ,
     );
