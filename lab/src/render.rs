@@ -56,7 +56,7 @@ impl Default for RenderSettings {
             sample_rate_hz: 48_000.0,
             release_s: None,
             friction: FrictionModel::Hyperbolic,
-            bristle: BristleParams::waveguide_string(),
+            bristle: BristleParams::plugin_string(),
             reference_hz: colophony::dsp::instrument::REFERENCE_HZ_DEFAULT,
             torsion: true,
             bow_hair: true,

@@ -654,7 +654,7 @@ impl Instrument {
                 ),
                 contact: AnyFriction::new(
                     FrictionModel::Hyperbolic,
-                    BristleParams::waveguide_string(),
+                    BristleParams::plugin_string(),
                     string_rate_hz,
                 )
                 .expect("the built-in bristle parameters are valid"),
