@@ -11,7 +11,11 @@
 //! 52. The cello, before and after its A string went to 96 kHz inside (2026-11-26): 50 /
 //! 50 / 49 / 52 of 52 both times, the same attacks failing (D#3 and F#4 at velocity 1.0
 //! hyperbolic, F#2 static, C2, A2 and A3 LuGre: double slips or raucous); the violin and
-//! viola read as above. `cargo test --release --test attack_survey -- --ignored
+//! viola read as above. With the plugin's bristle three times stiffer (`sigma0` 3e5 N/m,
+//! 2026-11-26, later), LuGre / elasto-plastic: violin 51 / 52, viola 51 / 52, cello 49 / 52
+//! -> 52 / 50 (the cello's F#2 at velocities 0.3 and 1.0 raucous with elasto-plastic; the
+//! violin's E6 at 0.8 and the viola's D#5 at 1.0 double-slip with LuGre); the hyperbolic
+//! and static counts as above. `cargo test --release --test attack_survey -- --ignored
 //! --nocapture`.
 use colophony::dsp::friction::FrictionModel;
 use colophony::dsp::instrument::{midi_to_hz, BowControl, InstrumentKind};
