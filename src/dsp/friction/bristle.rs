@@ -490,14 +490,14 @@ impl BristleFriction {
             if bracketing {
                 let (lo, hi) = (bracket.lo, bracket.hi);
                 // Bracketed: a full Newton step where it stays inside the bracket, goes
-                // down `g` and is shorter than half the step before last (the bracket
-                // then shrinks at least as fast as by bisection, as in Numerical Recipes'
-                // `rtsafe`), else a bisection. Newton climbs where `g` increases (the
-                // falling Stribeck slope times `k1` can outweigh the rest of `g'` while
-                // the contact slips) and damped steps there only find a minimum of `|g|`.
-                // Else false position (Illinois), which a wide bracket needs: bisecting
-                // one found by an overshooting first step took up to ten halvings. A
-                // bracket as narrow as the tolerance holds the root.
+                // down `g` and is shorter than half the step before last (Numerical
+                // Recipes' `rtsafe` rule), else false position with the Illinois
+                // weighting. Newton climbs where `g` increases (the falling Stribeck slope
+                // times `k1` can outweigh the rest of `g'` while the contact slips), and
+                // damped steps there only find a minimum of `|g|`. False position, not
+                // bisection: a bracket found by an overshooting first step (at a slip
+                // onset) took up to ten halvings. A bracket as narrow as the tolerance
+                // holds the root.
                 let newton =
                     dg < 0.0 && landed >= lo && landed <= hi && 2.0 * step.abs() <= step_before;
                 let next = if newton {
