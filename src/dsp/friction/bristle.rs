@@ -129,9 +129,9 @@ impl BristleParams {
 
     /// The plugin's string (every instrument, every note): [`Self::waveguide_string`] with
     /// a bristle three times stiffer. Chosen by the playing-space map (docs/playing-space.md,
-    /// "The stiffer bristle, adopted"): every third semitone at 48 kHz, LuGre / elasto-plastic
-    /// nominal cells in tune 12 -> 27 and 25 -> 32 of 96 and window cells in Helmholtz
-    /// motion 105 -> 113 and 109 -> 129 of 576 before the intonation table was re-fitted.
+    /// "The stiffer bristle, adopted"): every third semitone at 48 kHz, with the intonation
+    /// table re-fitted, LuGre / elasto-plastic nominal cells in tune 12 -> 27 and 25 -> 35 of
+    /// 96 and window cells in Helmholtz motion 105 -> 119 and 109 -> 123 of 576.
     /// Its `g` is not monotone while the contact slips, which the solver's bracket handles
     /// (module doc). Paper A's scene keeps 1e5 N/m, its figures and iteration budget.
     pub fn plugin_string() -> Self {
@@ -210,8 +210,8 @@ pub enum BristleLaw {
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct SolverStats {
     /// `histogram[k]`: samples that took `k` iterations (Newton steps, and inside a
-    /// bracket false-position or bisection steps); the last bin, `NEWTON_CAP`, collects
-    /// the samples that went on to the fallback.
+    /// bracket false-position steps); the last bin, `NEWTON_CAP`, collects the samples
+    /// that went on to the fallback.
     pub histogram: [u64; NEWTON_CAP as usize + 1],
     /// Samples solved by the bracketing fallback.
     pub fallbacks: u64,
