@@ -109,9 +109,11 @@ pub trait StringBank {
         &mut self,
         resampler: &mut Resampler,
         out: &mut [f64],
-        mut step: impl FnMut(&mut Self) -> f64,
-    ) {
-        resampler.process(|| step(self), out);
+        mut step: impl InternalStep<Self>,
+    ) where
+        Self: Sized,
+    {
+        resampler.process(|| step.step(self), out);
     }
     /// The probed string's last internal sample: velocity at the bow and friction force.
     fn probe(&self) -> (f64, f64);
@@ -174,6 +176,29 @@ pub(super) struct Hands {
     pub(super) probed: usize,
     /// The bow envelope's step per internal sample.
     ramp_step: f64,
+}
+
+/// One internal sample's work, handed to [`StringBank::render`]: a type with an
+/// always-inlined method rather than a closure, because a closure made outside a bank's
+/// `#[target_feature]` loop is compiled as its own function without the feature (the
+/// thermal instrument's per-sample work ran as baseline SSE2 code that way).
+pub trait InternalStep<B> {
+    /// Sets the bows for one internal sample and computes it.
+    fn step(&mut self, bank: &mut B) -> f64;
+}
+
+/// The player's hands with the bow of this host sample: [`InternalStep`] for
+/// [`FourStrings::tick`].
+struct HandsStep<'a> {
+    hands: &'a mut Hands,
+    bow: BowControl,
+}
+
+impl<B: StringBank> InternalStep<B> for HandsStep<'_> {
+    #[inline(always)]
+    fn step(&mut self, bank: &mut B) -> f64 {
+        self.hands.step(bank, self.bow)
+    }
 }
 
 impl Hands {
@@ -594,10 +619,12 @@ impl<B: StringBank> FourStrings<B> {
             }
             None => self.hands.step(&mut self.bank, bow),
             Some(resampler) => {
-                let hands = &mut self.hands;
                 let mut out = [0.0];
-                self.bank
-                    .render(resampler, &mut out, |bank| hands.step(bank, bow));
+                let step = HandsStep {
+                    hands: &mut self.hands,
+                    bow,
+                };
+                self.bank.render(resampler, &mut out, step);
                 out[0]
             }
         };

@@ -54,7 +54,7 @@ use super::instrument::{
 use super::intonation;
 use super::resample::Resampler;
 pub use super::strings::{FourStrings, RECONFIGURE_FADE_S};
-use super::strings::{StringBank, StringBow};
+use super::strings::{InternalStep, StringBank, StringBow};
 use super::thermal::{
     HairParams, ThermalBowControl, ThermalCapacity, ThermalParams, ThermalString, ThermalStringSpec,
 };
@@ -184,9 +184,9 @@ fn render_avx2(
     bank: &mut ThermalBank,
     resampler: &mut Resampler,
     out: &mut [f64],
-    mut step: impl FnMut(&mut ThermalBank) -> f64,
+    mut step: impl InternalStep<ThermalBank>,
 ) {
-    resampler.process(|| step(bank), out);
+    resampler.process(|| step.step(bank), out);
 }
 
 /// Paper B's strings and modal bridge at the internal rate, with the bow's
@@ -315,7 +315,7 @@ impl StringBank for ThermalBank {
         &mut self,
         resampler: &mut Resampler,
         out: &mut [f64],
-        mut step: impl FnMut(&mut Self) -> f64,
+        mut step: impl InternalStep<Self>,
     ) {
         #[cfg(target_arch = "x86_64")]
         if self.wide_simd {
@@ -323,7 +323,7 @@ impl StringBank for ThermalBank {
             unsafe { render_avx2(self, resampler, out, step) };
             return;
         }
-        resampler.process(|| step(self), out);
+        resampler.process(|| step.step(self), out);
     }
 
     fn probe(&self) -> (f64, f64) {
