@@ -11,6 +11,7 @@ pub mod bridge;
 pub mod bridge_data;
 pub mod delay;
 pub mod engine;
+pub mod fastmath;
 pub mod filters;
 pub mod fingering;
 pub mod friction;

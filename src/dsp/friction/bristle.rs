@@ -22,7 +22,10 @@
 //! `k2 = T/2`, and the scalar equation `g(y) = f_NL(v~ + k1 y, z~ + k2 y) - y = 0`. No
 //! unit delay enters the loop.
 //!
-//! **Solver.** Newton-Raphson from `y(n-1)` with the analytic derivative, each step damped
+//! **Solver.** Newton-Raphson with the analytic derivative, started from the tangent
+//! predictor `y(n-1) - (f_v dv~ + f_z dz~) / g'` (the last root moved along the implicit
+//! function by this sample's change of `v~` and `z~`, with the partials of the last
+//! solve's final evaluation; from `y(n-1)` itself where that `g'` was above -1/2), each step damped
 //! (halved up to [`MAX_DAMPING_HALVINGS`] times) until `|g|` falls. It stops when a full
 //! Newton step is shorter than the tolerance (a damped step's length says nothing about
 //! the distance to the root, so it never stops the iteration), and, where that step
@@ -67,6 +70,12 @@
 //! ```
 
 use super::{BowInput, FrictionContact, LoadLine};
+use crate::dsp::fastmath::{exp_nonpositive, sin_cos_quarter_turn};
+use std::cell::Cell;
+
+/// Partials that turn the tangent predictor off (`g' = 0`): the next solve starts from
+/// `y(n-1)`.
+const NO_TANGENT: [f64; 3] = [0.0, 0.0, 0.0];
 
 /// A solve not converged within `NEWTON_CAP - 1` iterations goes to the bracketing
 /// fallback, and counts in the histogram's last bin, `NEWTON_CAP`.
@@ -251,6 +260,10 @@ pub struct BristleFriction {
     z_m: f64,
     /// `zdot(n-1)`, m/s.
     y_m_per_s: f64,
+    /// The last solve's `v~` and `z~`, and `(df/dv, df/dz, g')` at its last evaluation:
+    /// the next solve starts from the tangent `y(n-1) - (f_v dv~ + f_z dz~) / g'`.
+    last_tilde: (f64, f64),
+    last_partials: [f64; 3],
     /// Relative velocity `v(n-1)`, m/s.
     v_m_per_s: f64,
     /// Newton stops once a step moves `y` by at most this times `max(1, |y|)`, m/s.
@@ -271,11 +284,11 @@ struct Curve {
 
 impl Curve {
     /// `f_NL(v, z)` and its partial derivatives `(f, df/dv, df/dz)`.
-    #[inline]
+    #[inline(always)]
     fn eval(&self, v: f64, z: f64) -> (f64, f64, f64) {
         // Stribeck: h(v) = f_c + (f_s - f_c) e^{-(v/v_s)^2}, |z_ss| = h / sigma0.
         let r = v / self.v_s;
-        let e = (-(r * r)).exp();
+        let e = exp_nonpositive(-(r * r));
         let h = self.f_c + (self.f_s - self.f_c) * e;
         if h <= 0.0 {
             // No normal force: no bristle resistance.
@@ -295,11 +308,11 @@ impl Curve {
         } else {
             let width = zss - self.z_ba;
             let theta = std::f64::consts::PI * (az - 0.5 * (zss + self.z_ba)) / width;
-            let c = theta.cos();
+            let (sin, c) = sin_cos_quarter_turn(theta);
             let dtheta_dabsz = std::f64::consts::PI / width;
             let dtheta_dzss = std::f64::consts::PI * (self.z_ba - az) / (width * width);
             (
-                0.5 * (1.0 + theta.sin()),
+                0.5 * (1.0 + sin),
                 0.5 * c * dtheta_dabsz * z.signum(),
                 0.5 * c * dtheta_dzss * dh / self.sigma0,
             )
@@ -336,6 +349,8 @@ impl BristleFriction {
             integrator: BristleIntegrator::Trapezoid,
             z_m: 0.0,
             y_m_per_s: 0.0,
+            last_tilde: (0.0, 0.0),
+            last_partials: NO_TANGENT,
             v_m_per_s: 0.0,
             newton_tolerance_m_per_s: Y_TOLERANCE_M_PER_S,
             stats: SolverStats::default(),
@@ -411,6 +426,7 @@ impl BristleFriction {
             0.0
         };
         self.y_m_per_s = 0.0;
+        self.last_partials = NO_TANGENT;
     }
 
     fn curve(&self, normal_force_n: f64) -> Curve {
@@ -434,16 +450,16 @@ impl BristleFriction {
         k1: f64,
         z_tilde: f64,
         k2: f64,
+        start: f64,
+        partials: &Cell<[f64; 3]>,
     ) -> (f64, Result<u32, u32>) {
         let g = |y: f64| {
             let (f, dfv, dfz) = curve.eval(v_tilde + k1 * y, z_tilde + k2 * y);
-            (f - y, dfv * k1 + dfz * k2 - 1.0)
+            let dg = dfv * k1 + dfz * k2 - 1.0;
+            partials.set([dfv, dfz, dg]);
+            (f - y, dg)
         };
-        let mut y = if self.y_m_per_s.is_finite() {
-            self.y_m_per_s
-        } else {
-            0.0
-        };
+        let mut y = start;
         let tolerance = |y: f64| self.newton_tolerance_m_per_s * y.abs().max(1.0);
         // Whether a step from `a` to `b` crosses the kink of `g` at `v = 0` (where `|v|`
         // and the adhesion map's sign test change the slope of `f` by up to `2 k1`).
@@ -747,6 +763,7 @@ impl FrictionContact for BristleFriction {
             // Bow off the string: the bristles let go.
             self.z_m = 0.0;
             self.y_m_per_s = 0.0;
+            self.last_partials = NO_TANGENT;
             self.v_m_per_s = if v_free.is_finite() { v_free } else { 0.0 };
             self.stats.last_iterations = 0;
             return 0.0;
@@ -763,7 +780,26 @@ impl FrictionContact for BristleFriction {
         let denominator = 1.0 + admittance * p.sigma2_kg_per_s;
         let v_tilde = (v_free - admittance * p.sigma0_n_per_m * z_tilde) / denominator;
         let k1 = -admittance * (p.sigma0_n_per_m * k2 + p.sigma1_kg_per_s) / denominator;
-        let (y, iterations) = self.solve_y(&curve, v_tilde, k1, z_tilde, k2);
+        // Tangent predictor: the last root moved along the implicit function's slope by
+        // the change of `v~` and `z~` (`g = 0` gives `dy = -(f_v dv~ + f_z dz~) / g'`);
+        // only where `g'` is clearly negative (`g` monotone there), else `y(n-1)`.
+        let [f_v, f_z, slope] = self.last_partials;
+        let previous = if self.y_m_per_s.is_finite() {
+            self.y_m_per_s
+        } else {
+            0.0
+        };
+        let tangent = previous
+            - (f_v * (v_tilde - self.last_tilde.0) + f_z * (z_tilde - self.last_tilde.1)) / slope;
+        let start = if slope < -0.5 && tangent.is_finite() {
+            tangent
+        } else {
+            previous
+        };
+        let partials = Cell::new(NO_TANGENT);
+        let (y, iterations) = self.solve_y(&curve, v_tilde, k1, z_tilde, k2, start, &partials);
+        self.last_partials = partials.get();
+        self.last_tilde = (v_tilde, z_tilde);
         match iterations {
             Ok(k) => {
                 self.stats.histogram[(k as usize).min(NEWTON_CAP as usize)] += 1;
@@ -791,6 +827,7 @@ impl FrictionContact for BristleFriction {
     fn reset(&mut self) {
         self.z_m = 0.0;
         self.y_m_per_s = 0.0;
+        self.last_partials = NO_TANGENT;
         self.v_m_per_s = 0.0;
         self.stats.last_iterations = 0;
     }
