@@ -16,14 +16,15 @@
 //! strings and the cello's A string at 96 kHz, [`InstrumentKind::point_oversampling`]),
 //! with the default dispersion filter order (8 sections).
 //!
-//! Measured by the full benchmark of 2026-11-26 (docs/precision.csv; cello D3 at 48 kHz,
-//! each tolerance against 1e-13 at the same rate; thermal: paper B's Fig. 6 bow at beta
-//! 0.07 and 0.1 against N_B 120):
+//! Measured by the full benchmark of 2026-11-26's sixth stop (docs/precision.csv: the
+//! plugin's stiffer bristle with the tangent predictor; cello D3 at 48 kHz, each
+//! tolerance against 1e-13 at the same rate; thermal: paper B's Fig. 6 bow at beta 0.07
+//! and 0.1 against N_B 120; speed ratios from one run's timings):
 //!
 //! | preset | Newton tolerance | thermal N_B | measured |
 //! |---|---|---|---|
-//! | draft | 1e-2 m/s | 8 | attack waveform against 1e-13: LuGre -5.7 dB, elasto-plastic -1.7 dB (the scene sits at a regime boundary: the loose solve lands in Helmholtz motion where the tight one slips 1.9 times a period), the wine glass (elasto-plastic) -83 dB; 1.8x faster than 1e-10; thermal: f0 -0.4 to -0.6 cents, harmonics 0.4-0.9 dB, attack -14 to -17 dB, 32-34x real time |
-//! | good | 1e-4 m/s | 10 | LuGre -81 dB, elasto-plastic -54 dB (f0 3.1 cents off: the same boundary), wine glass -156 dB; 1.3x faster than 1e-10; thermal: f0 -0.3 to -0.4 cents, harmonics 0.3-0.4 dB, attack -16 to -17 dB, 25-26x |
+//! | draft | 1e-2 m/s | 8 | attack waveform against 1e-13: LuGre -4.6 dB, elasto-plastic -1.7 dB (the scene sits at a regime boundary: the loose solve slips 1.9 times a period where the tight one is in Helmholtz motion), the wine glass (elasto-plastic) -107 dB; LuGre 1.6x faster than 1e-10, elasto-plastic 1.1x (its Newton start, the tangent predictor, leaves little for a loose tolerance to save); thermal: f0 -0.4 to -0.6 cents, harmonics 0.4-0.9 dB, attack -14 to -17 dB, 32-34x real time |
+//! | good | 1e-4 m/s | 10 | LuGre -93 dB, elasto-plastic -5.1 dB (the same steady state, f0 within 0.01 cents and harmonics 0.1 dB, but the attack takes another path at the same boundary), wine glass -152 dB; LuGre 1.5x faster than 1e-10, elasto-plastic 1.1x; thermal: f0 -0.3 to -0.4 cents, harmonics 0.3-0.4 dB, attack -16 to -17 dB, 25-26x |
 //! | reference | 1e-10 m/s | 60 | below -200 dB; thermal: f0 -0.03 to -0.05 cents, harmonics 0.04-0.17 dB, attack -29 to -34 dB, 4.3-5.0x |
 //! | auto | 1e-4 m/s | per note: [`auto_nodes`] | good's error at every note and bow position |
 //!
