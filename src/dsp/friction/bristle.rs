@@ -82,6 +82,9 @@ const NO_TANGENT: [f64; 3] = [0.0, 0.0, 0.0];
 pub const NEWTON_CAP: u32 = 20;
 /// Step halvings per Newton iteration when `|g|` does not fall.
 pub const MAX_DAMPING_HALVINGS: u32 = 8;
+/// Iterations the fallback's bracketed iteration may take (false position shrinks a
+/// bracket of `1e300` to `1e-16` well within it).
+const FALLBACK_CAP: u32 = 200;
 /// Default convergence test: `|dy| <= Y_TOLERANCE_M_PER_S * max(1, |y|)` (see
 /// [`BristleFriction::set_newton_tolerance`]).
 pub const Y_TOLERANCE_M_PER_S: f64 = 1e-10;
@@ -459,129 +462,164 @@ impl BristleFriction {
             partials.set([dfv, dfz, dg]);
             (f - y, dg)
         };
-        let mut y = start;
-        let tolerance = |y: f64| self.newton_tolerance_m_per_s * y.abs().max(1.0);
         // Whether a step from `a` to `b` crosses the kink of `g` at `v = 0` (where `|v|`
         // and the adhesion map's sign test change the slope of `f` by up to `2 k1`).
         let crosses_kink = |a: f64, b: f64| (v_tilde + k1 * a) * (v_tilde + k1 * b) <= 0.0;
         // The bracket kept from every evaluation.
         let mut bracket = Bracket::default();
-        // Set once damped Newton found no descent inside a known bracket.
-        let mut bracketing = false;
-        // The last two steps' lengths inside the bracket.
-        let (mut step_before, mut step_last) = (f64::INFINITY, f64::INFINITY);
-        let (mut gy, mut dg) = g(y);
-        bracket.note(y, gy);
-        for iteration in 1..NEWTON_CAP {
-            if !(gy.is_finite() && dg.is_finite()) {
-                break;
-            }
-            if gy == 0.0 {
-                return (y, Ok(iteration));
-            }
-            if dg == 0.0 {
-                break;
-            }
-            let step = -gy / dg;
-            let landed = y + step;
-            if step.abs() <= tolerance(y) {
-                // Converged: the full step is what the damped loop below accepts here
-                // (near the root `|g|` falls along it), without evaluating `g` there;
-                // unless it crosses the kink, where this side's slope says nothing about
-                // the other's: the root is within the step only if `g` changes sign along
-                // it, else the iteration goes on from the other side.
-                if !crosses_kink(y, landed) {
-                    return (landed, Ok(iteration));
-                }
-                let (gl, dl) = g(landed);
-                if gl == 0.0 || gl.signum() != gy.signum() {
-                    return (landed, Ok(iteration));
-                }
-                bracket.note(landed, gl);
-                y = landed;
-                gy = gl;
-                dg = dl;
-                continue;
-            }
-            if bracketing {
-                let (lo, hi) = (bracket.lo, bracket.hi);
-                // Bracketed: a full Newton step where it stays inside the bracket, goes
-                // down `g` and is shorter than half the step before last (Numerical
-                // Recipes' `rtsafe` rule), else false position with the Illinois
-                // weighting. Newton climbs where `g` increases (the falling Stribeck slope
-                // times `k1` can outweigh the rest of `g'` while the contact slips), and
-                // damped steps there only find a minimum of `|g|`. False position, not
-                // bisection: a bracket found by an overshooting first step (at a slip
-                // onset) took up to ten halvings. A bracket as narrow as the tolerance
-                // holds the root.
-                let newton =
-                    dg < 0.0 && landed >= lo && landed <= hi && 2.0 * step.abs() <= step_before;
-                let next = if newton {
-                    landed
-                } else {
-                    let mid = 0.5 * (lo + hi);
-                    if hi - lo <= tolerance(mid) || mid == lo || mid == hi {
-                        return (mid, Ok(iteration));
-                    }
-                    bracket.false_position()
-                };
-                step_before = step_last;
-                step_last = (next - y).abs();
-                y = next;
-                (gy, dg) = g(y);
-                bracket.note(y, gy);
-                continue;
-            }
-            let mut t = 1.0;
-            let mut accepted = None;
-            for _ in 0..=MAX_DAMPING_HALVINGS {
-                let candidate = y + t * step;
-                let (gc, dc) = g(candidate);
-                if gc.is_finite() {
-                    bracket.note(candidate, gc);
-                    if gc.abs() < gy.abs() {
-                        accepted = Some((candidate, gc, dc));
-                        break;
-                    }
-                }
-                t *= 0.5;
-            }
-            let Some((candidate, gc, dc)) = accepted else {
-                if bracket.known() {
-                    // No descent, but the evaluations so far bracket a root: narrow that
-                    // bracket from here on (below).
-                    bracketing = true;
-                    continue;
-                }
-                // No descent along a Newton step longer than the tolerance, and no
-                // bracket yet: a kink; the bracketing fallback finds the root. (A short
-                // damped step says nothing about the distance to the root: taking it for
-                // convergence let the bristle drift by up to 2^9 tolerances a sample.)
-                break;
-            };
-            let moved = (candidate - y).abs();
-            // A step across the kink along which `g` kept its sign has not bracketed the
-            // root, however short.
-            let settles = gc.signum() != gy.signum() || !crosses_kink(y, candidate);
-            y = candidate;
-            gy = gc;
-            dg = dc;
-            // Only a full Newton step measures the remaining error; after a damped one the
-            // next iteration's step does.
-            if (t == 1.0 && settles && moved <= tolerance(y)) || gy == 0.0 {
-                return (y, Ok(iteration));
-            }
-        }
-        let first_step = gy.abs() / (1.0 - k1).max(1.0);
-        let (root, evaluations) = bracketed_root(
+        let (gy, dg) = g(start);
+        bracket.note(start, gy);
+        let tolerance = self.newton_tolerance_m_per_s;
+        let (y, gy) = match iterate(
             &g,
             &crosses_kink,
-            y,
-            first_step,
-            self.newton_tolerance_m_per_s,
-        );
+            tolerance,
+            &mut bracket,
+            (start, gy, dg),
+            false,
+            NEWTON_CAP,
+        ) {
+            Iterated::Root(y, iterations, _) => return (y, Ok(iterations)),
+            Iterated::Stuck(y, gy, _) => (y, gy),
+        };
+        let first_step = gy.abs() / (1.0 - k1).max(1.0);
+        let (root, evaluations) = bracketed_root(&g, &crosses_kink, y, first_step, tolerance);
         (root, Err(evaluations))
     }
+}
+
+/// How [`iterate`] ended.
+enum Iterated {
+    /// A root, after this many iterations and evaluations of `g`.
+    Root(f64, u32, u32),
+    /// No root within the cap, a step that is not finite, or (outside a bracket) no
+    /// descent and no bracket: the last iterate, `g` there, and the evaluations spent.
+    Stuck(f64, f64, u32),
+}
+
+/// The safeguarded Newton iteration of [`BristleFriction::solve_y`] (see the module doc)
+/// from `(y, g(y), g'(y))`, for at most `cap - 1` iterations, narrowing `bracket` with
+/// every evaluation. With `bracketing` it starts inside a known bracket (the fallback,
+/// [`bracketed_root`]); otherwise it switches to the bracket where damped Newton finds no
+/// descent and a bracket is known.
+#[inline(always)]
+fn iterate(
+    g: &impl Fn(f64) -> (f64, f64),
+    crosses_kink: &impl Fn(f64, f64) -> bool,
+    tolerance_m_per_s: f64,
+    bracket: &mut Bracket,
+    (mut y, mut gy, mut dg): (f64, f64, f64),
+    mut bracketing: bool,
+    cap: u32,
+) -> Iterated {
+    let tolerance = |y: f64| tolerance_m_per_s * y.abs().max(1.0);
+    // The last two steps' lengths inside the bracket.
+    let (mut step_before, mut step_last) = (f64::INFINITY, f64::INFINITY);
+    let mut evaluations = 0;
+    for iteration in 1..cap {
+        if !(gy.is_finite() && dg.is_finite()) {
+            break;
+        }
+        if gy == 0.0 {
+            return Iterated::Root(y, iteration, evaluations);
+        }
+        if dg == 0.0 {
+            break;
+        }
+        let step = -gy / dg;
+        let landed = y + step;
+        if step.abs() <= tolerance(y) {
+            // Converged: the full step is what the damped loop below accepts here
+            // (near the root `|g|` falls along it), without evaluating `g` there;
+            // unless it crosses the kink, where this side's slope says nothing about
+            // the other's: the root is within the step only if `g` changes sign along
+            // it, else the iteration goes on from the other side.
+            if !crosses_kink(y, landed) {
+                return Iterated::Root(landed, iteration, evaluations);
+            }
+            let (gl, dl) = g(landed);
+            evaluations += 1;
+            if gl == 0.0 || gl.signum() != gy.signum() {
+                return Iterated::Root(landed, iteration, evaluations);
+            }
+            bracket.note(landed, gl);
+            y = landed;
+            gy = gl;
+            dg = dl;
+            continue;
+        }
+        if bracketing {
+            let (lo, hi) = (bracket.lo, bracket.hi);
+            // Bracketed: a full Newton step where it stays inside the bracket, goes
+            // down `g` and is shorter than half the step before last (Numerical
+            // Recipes' `rtsafe` rule), else false position with the Illinois
+            // weighting. Newton climbs where `g` increases (the falling Stribeck slope
+            // times `k1` can outweigh the rest of `g'` while the contact slips), and
+            // damped steps there only find a minimum of `|g|`. False position, not
+            // bisection: a bracket found by an overshooting first step (at a slip
+            // onset) took up to ten halvings. A bracket as narrow as the tolerance
+            // holds the root.
+            let newton =
+                dg < 0.0 && landed >= lo && landed <= hi && 2.0 * step.abs() <= step_before;
+            let next = if newton {
+                landed
+            } else {
+                let mid = 0.5 * (lo + hi);
+                if hi - lo <= tolerance(mid) || mid == lo || mid == hi {
+                    return Iterated::Root(mid, iteration, evaluations);
+                }
+                bracket.false_position()
+            };
+            step_before = step_last;
+            step_last = (next - y).abs();
+            y = next;
+            (gy, dg) = g(y);
+            evaluations += 1;
+            bracket.note(y, gy);
+            continue;
+        }
+        let mut t = 1.0;
+        let mut accepted = None;
+        for _ in 0..=MAX_DAMPING_HALVINGS {
+            let candidate = y + t * step;
+            let (gc, dc) = g(candidate);
+            evaluations += 1;
+            if gc.is_finite() {
+                bracket.note(candidate, gc);
+                if gc.abs() < gy.abs() {
+                    accepted = Some((candidate, gc, dc));
+                    break;
+                }
+            }
+            t *= 0.5;
+        }
+        let Some((candidate, gc, dc)) = accepted else {
+            if bracket.known() {
+                // No descent, but the evaluations so far bracket a root: narrow that
+                // bracket from here on (below).
+                bracketing = true;
+                continue;
+            }
+            // No descent along a Newton step longer than the tolerance, and no
+            // bracket yet: a kink; the bracketing fallback finds the root. (A short
+            // damped step says nothing about the distance to the root: taking it for
+            // convergence let the bristle drift by up to 2^9 tolerances a sample.)
+            break;
+        };
+        let moved = (candidate - y).abs();
+        // A step across the kink along which `g` kept its sign has not bracketed the
+        // root, however short.
+        let settles = gc.signum() != gy.signum() || !crosses_kink(y, candidate);
+        y = candidate;
+        gy = gc;
+        dg = dc;
+        // Only a full Newton step measures the remaining error; after a damped one the
+        // next iteration's step does.
+        if (t == 1.0 && settles && moved <= tolerance(y)) || gy == 0.0 {
+            return Iterated::Root(y, iteration, evaluations);
+        }
+    }
+    Iterated::Stuck(y, gy, evaluations)
 }
 
 /// A bracket of a root of `g`: `g(lo) > 0 > g(hi)`, `lo < hi` (infinite until both signs
@@ -649,13 +687,9 @@ impl Bracket {
 /// Bracketing fallback: `g` is positive for very negative `y` and negative for very
 /// positive `y` (see the module doc), so walking from `start` in the direction of the sign
 /// of `g`, in steps that double from `first_step`, finds a bracket `g(lo) > 0 >= g(hi)`.
-/// Inside it a safeguarded Newton iteration (Numerical Recipes' `rtsafe`): a Newton step
-/// where it stays inside the bracket and the bracket would not have halved faster, a
-/// bisection otherwise; every evaluation narrows the bracket. It stops on a step shorter
-/// than the tolerance (`tolerance * max(1, |y|)`, the accuracy Newton's own stop gives;
-/// across the kink at `v = 0` only if `g` changes sign along the step, as in
-/// [`BristleFriction::solve_y`]), on a bracket that narrow, or where rounding cannot
-/// split the bracket. Always returns a finite value; also returns the evaluations of `g`.
+/// Inside it, [`iterate`]'s bracketed iteration (Numerical Recipes' `rtsafe` rule for a
+/// Newton step, else Illinois false position) from the end with the smaller `|g|`. Always
+/// returns a finite value; also returns the evaluations of `g`.
 fn bracketed_root(
     g: &impl Fn(f64) -> (f64, f64),
     crosses_kink: &impl Fn(f64, f64) -> bool,
@@ -698,60 +732,38 @@ fn bracketed_root(
     if g_far == 0.0 {
         return (far, evaluations);
     }
-    // g(lo) > 0 > g(hi); iterate from the end nearer the root by its residual.
-    let (mut lo, mut hi) = if dir > 0.0 { (near, far) } else { (far, near) };
-    let (mut x, mut gx, mut dgx) = if g_near.abs() <= g_far.abs() {
+    // g(lo) > 0 > g(hi): the bracketed iteration from the end nearer the root by its
+    // residual.
+    let (lo, hi, g_lo, g_hi) = if dir > 0.0 {
+        (near, far, g_near, g_far)
+    } else {
+        (far, near, g_far, g_near)
+    };
+    let mut bracket = Bracket {
+        lo,
+        hi,
+        g_lo,
+        g_hi,
+        moved: 0,
+    };
+    let from = if g_near.abs() <= g_far.abs() {
         (near, g_near, d_near)
     } else {
         (far, g_far, d_far)
     };
-    let mut step_before = hi - lo;
-    let mut step_last = step_before;
-    for _ in 0..200 {
-        let scale = tolerance * x.abs().max(1.0);
-        if hi - lo <= scale {
-            break;
-        }
-        let newton = if dgx != 0.0 && dgx.is_finite() {
-            x - gx / dgx
-        } else {
-            f64::NAN
-        };
-        let newton_ok = newton > lo && newton < hi && (gx / dgx).abs() * 2.0 <= step_before.abs();
-        step_before = step_last;
-        let next = if newton_ok {
-            newton
-        } else {
-            let mid = 0.5 * (lo + hi);
-            if mid == lo || mid == hi {
-                break;
-            }
-            mid
-        };
-        step_last = next - x;
-        if newton_ok && step_last.abs() <= scale && !crosses_kink(x, next) {
-            return (next, evaluations);
-        }
-        let (gn, dn) = g(next);
-        evaluations += 1;
-        if !gn.is_finite() {
-            break;
-        }
-        if gn == 0.0 {
-            return (next, evaluations);
-        }
-        if newton_ok && step_last.abs() <= scale && gn.signum() != gx.signum() {
-            // A short step across the kink that brackets the root.
-            return (next, evaluations);
-        }
-        if gn > 0.0 {
-            lo = next;
-        } else {
-            hi = next;
-        }
-        (x, gx, dgx) = (next, gn, dn);
+    match iterate(
+        g,
+        crosses_kink,
+        tolerance,
+        &mut bracket,
+        from,
+        true,
+        FALLBACK_CAP,
+    ) {
+        Iterated::Root(root, _, spent) => (root, evaluations + spent),
+        // Only a step that is not finite ends here: the bracket's middle.
+        Iterated::Stuck(_, _, spent) => (0.5 * (bracket.lo + bracket.hi), evaluations + spent),
     }
-    (0.5 * (lo + hi), evaluations)
 }
 
 impl FrictionContact for BristleFriction {
