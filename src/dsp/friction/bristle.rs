@@ -45,7 +45,8 @@
 //! adhesion map's corners), or a step is not finite, a bracketing fallback takes over: `g`
 //! is positive for very negative `y` and negative for very positive `y` (there `alpha = 0`
 //! and `g ~ (k1 - 1) y`), so a bracket is found by steps doubling from `|g| / (1 - k1)`
-//! and narrowed by `rtsafe` (Newton or bisection). Either way the result is finite.
+//! and narrowed by the same bracketed iteration (`rtsafe`'s Newton rule, else Illinois false
+//! position). Either way the result is finite.
 //! Iterations and fallbacks are counted in [`SolverStats`].
 //!
 //! | symbol | meaning | unit | source |
