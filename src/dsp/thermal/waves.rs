@@ -265,13 +265,32 @@ impl Waves {
         out
     }
 
+    /// Whether polarisation `p`'s waves and filter states hold less than `half_j`:
+    /// [`Self::energies_j`]'s sum, in the same order and compared the same way, stopped as
+    /// soon as it reaches `half_j` (its terms are squares and floating-point sums and
+    /// products of non-negative numbers never fall, so the decision is the same; a
+    /// ringing string is known loud after a few samples instead of a walk of the line).
+    fn holds_less_than(&self, p: usize, half_j: f64, z: f64, fs: f64) -> bool {
+        let mask = self.mask();
+        let mut sum = 0.0;
+        for x in 0..self.m {
+            let a = self.right[p][x.wrapping_sub(self.t) & mask];
+            let b = self.left[p][self.left[p].back(self.t, self.m - 1 - x)];
+            sum += a * a + b * b;
+            if z / fs * sum >= half_j {
+                return false;
+            }
+        }
+        sum += self.loss[p].stored_energy() + self.fraction[p].stored_energy();
+        z / fs * sum < half_j
+    }
+
     /// Puts each polarisation whose waves hold less than `threshold_j / 2` to sleep (see
     /// [`super::ThermalString::sleep_quiet_polarisations`]).
     pub(super) fn sleep_quiet(&mut self, threshold_j: f64, z: f64, fs: f64) {
-        let energies = self.energies_j(z, fs);
         self.wake_sum = 0.5 * threshold_j * fs / z;
-        for (p, energy) in energies.iter().enumerate() {
-            if !self.asleep[p] && *energy < 0.5 * threshold_j {
+        for p in 0..2 {
+            if !self.asleep[p] && self.holds_less_than(p, 0.5 * threshold_j, z, fs) {
                 self.right[p].fill(0.0);
                 self.left[p].fill(0.0);
                 self.loss[p].reset();
