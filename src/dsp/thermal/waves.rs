@@ -247,42 +247,33 @@ impl Waves {
     /// Energy of each polarisation's waves and end filters, `[h, v]`, J, on a string of
     /// impedance `z` at rate `fs`.
     pub(super) fn energies_j(&self, z: f64, fs: f64) -> [f64; 2] {
-        let mask = self.mask();
         let mut out = [0.0; 2];
         for (p, out) in out.iter_mut().enumerate() {
-            if self.asleep[p] {
-                continue;
+            if !self.asleep[p] {
+                *out = self.energy_until(p, z / fs, f64::INFINITY);
             }
-            let mut sum = 0.0;
-            for x in 0..self.m {
-                let a = self.right[p][x.wrapping_sub(self.t) & mask];
-                let b = self.left[p][self.left[p].back(self.t, self.m - 1 - x)];
-                sum += a * a + b * b;
-            }
-            sum += self.loss[p].stored_energy() + self.fraction[p].stored_energy();
-            *out = z / fs * sum;
         }
         out
     }
 
-    /// Whether polarisation `p`'s waves and filter states hold less than `half_j`:
-    /// [`Self::energies_j`]'s sum, in the same order and compared the same way, stopped as
-    /// soon as it reaches `half_j` (its terms are squares and floating-point sums and
-    /// products of non-negative numbers never fall, so the decision is the same; a
-    /// ringing string is known loud after a few samples instead of a walk of the line).
-    fn holds_less_than(&self, p: usize, half_j: f64, z: f64, fs: f64) -> bool {
+    /// Polarisation `p`'s energy, `scale` times the sum of the squares of its waves and
+    /// its filter states, or a partial sum of at least `enough` as soon as the walk along
+    /// the line reaches it (its terms are squares, and floating-point sums and products of
+    /// non-negative numbers never fall: a comparison with `enough` decides as the whole sum
+    /// would; a ringing string is known loud after a few samples).
+    fn energy_until(&self, p: usize, scale: f64, enough: f64) -> f64 {
         let mask = self.mask();
         let mut sum = 0.0;
         for x in 0..self.m {
             let a = self.right[p][x.wrapping_sub(self.t) & mask];
             let b = self.left[p][self.left[p].back(self.t, self.m - 1 - x)];
             sum += a * a + b * b;
-            if z / fs * sum >= half_j {
-                return false;
+            if scale * sum >= enough {
+                return scale * sum;
             }
         }
         sum += self.loss[p].stored_energy() + self.fraction[p].stored_energy();
-        z / fs * sum < half_j
+        scale * sum
     }
 
     /// Puts each polarisation whose waves hold less than `threshold_j / 2` to sleep (see
@@ -290,7 +281,9 @@ impl Waves {
     pub(super) fn sleep_quiet(&mut self, threshold_j: f64, z: f64, fs: f64) {
         self.wake_sum = 0.5 * threshold_j * fs / z;
         for p in 0..2 {
-            if !self.asleep[p] && self.holds_less_than(p, 0.5 * threshold_j, z, fs) {
+            if !self.asleep[p]
+                && self.energy_until(p, z / fs, 0.5 * threshold_j) < 0.5 * threshold_j
+            {
                 self.right[p].fill(0.0);
                 self.left[p].fill(0.0);
                 self.loss[p].reset();
