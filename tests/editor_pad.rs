@@ -556,6 +556,7 @@ fn loading_a_bridge_keeps_it_in_the_project_and_restarts_and_a_bad_file_changes_
         std::process::id()
     ));
     std::fs::write(&broken, "{").unwrap();
+    let broken_path = broken.clone();
     let broken = broken.to_string_lossy().into_owned();
     for (path, loads, error) in [
         ("/no/such/bridge.json", false, "cannot read"),
@@ -597,6 +598,7 @@ fn loading_a_bridge_keeps_it_in_the_project_and_restarts_and_a_bad_file_changes_
             assert!(status.contains(error), "{path}: {status}");
         }
     }
+    std::fs::remove_file(&broken_path).unwrap();
 }
 
 /// The thermal model, as a host would set it (the bridge row shows with the strings).

@@ -162,6 +162,17 @@ pub struct Performance {
 pub fn perform(
     events: &[Timed],
     how: &Performance,
+    progress: impl FnMut(u64, u64),
+) -> Result<Vec<f32>, String> {
+    perform_until(events, how, None, progress)
+}
+
+/// [`perform`], stopped at the first block boundary at or after `limit` samples when
+/// given (the renderer's `--seconds`: the tail past it would be cut anyway).
+pub fn perform_until(
+    events: &[Timed],
+    how: &Performance,
+    limit: Option<u64>,
     mut progress: impl FnMut(u64, u64),
 ) -> Result<Vec<f32>, String> {
     let block = how.block.max(1);
@@ -226,6 +237,9 @@ pub fn perform(
         done += block as u64;
         let status = performer.status(block);
         progress(done, last.max(done));
+        if limit.is_some_and(|n| done >= n) {
+            break;
+        }
         let finished = next >= events.len() && done > last;
         if finished && (status == Status::Normal || quiet >= quiet_needed || done >= hard_end) {
             break;
@@ -273,7 +287,7 @@ pub fn render_events(
     ) {
         bar.set_style(style);
     }
-    let mut audio = perform(events, how, |done, total| {
+    let mut audio = perform_until(events, how, frames.map(|n| n as u64), |done, total| {
         bar.set_length(total);
         bar.set_position(done);
     })?;
