@@ -142,6 +142,12 @@ enum Command {
         /// peers: seconds each process renders (default 300).
         #[arg(long)]
         seconds: Option<f64>,
+        /// playing-space: how each note begins: `landing` (the default: the bow lands at
+        /// the cell's force) or `catch` (at `F_max / 2` until the string slips regularly,
+        /// then lowered to the cell's force by 0.3 s: whether that force holds Helmholtz
+        /// motion).
+        #[arg(long, default_value = "landing")]
+        attack: String,
     },
     /// List the presets: the factory set and the user presets (in the folder the editor
     /// saves to; COLOPHONY_PRESET_DIR overrides it).
@@ -376,6 +382,7 @@ fn main() -> ExitCode {
             instruments,
             passes,
             seconds,
+            attack,
         } => report(match what.as_str() {
             "friction" => colophony_lab::bench::friction_table(),
             "table1" => colophony_lab::bench::table1(),
@@ -390,7 +397,11 @@ fn main() -> ExitCode {
             },
             "playing-space" => match out {
                 Some(dir) => colophony_lab::playing_space::Plan::from_options(quick, &rates, step, &models, &instruments)
-                    .and_then(|plan| colophony_lab::playing_space::run(&dir, &plan)),
+                    .and_then(|mut plan| {
+                        plan.attack = colophony_lab::playing_space::Attack::from_name(&attack)
+                            .ok_or_else(|| format!("unknown attack '{attack}': choose landing or catch"))?;
+                        colophony_lab::playing_space::run(&dir, &plan)
+                    }),
                 None => Err("bench playing-space needs --out DIR".into()),
             },
             "intonation" => match out {

@@ -25,6 +25,13 @@
 //! [`peak_frequency_hz`]) in cents from equal temperament at A4 = 440 Hz. A cell is
 //! **Helmholtz** when the classifier says one slip per period, the slip fraction is within
 //! 15 % of beta and the string sticks at the bow velocity (within 10 %).
+//!
+//! **Attack** (`--attack`). By default the bow lands at the cell's force ([`Attack::Landing`]):
+//! the map asks whether a note bowed there *finds* Helmholtz motion within
+//! [`SETTLE_S`]. With `--attack catch` ([`Attack::Catch`]) the bow lands at `F_max / 2`,
+//! stays there until the probe slips regularly, and is lowered to the cell's force before
+//! [`SETTLE_S`]: the map then asks whether the cell's force *holds* Helmholtz motion
+//! (Schelleng's window is a stability limit). The measurement is the same.
 
 use colophony::analysis::{cents, peak_frequency_hz, slip_stats};
 use colophony::dsp::friction::bristle::BristleIntegrator;
@@ -167,7 +174,48 @@ pub struct Cell {
     pub integrator: BristleIntegrator,
     /// The thermal contact's constants (the plugin's: [`ThermalParams::default`]).
     pub thermal: ThermalParams,
+    /// How the note begins (the map's default: [`Attack::Landing`]).
+    pub attack: Attack,
 }
+
+/// How a cell's note begins.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Attack {
+    /// The bow lands at its speed and the cell's force (over the engine's 20 ms ramp): the
+    /// motion must find Helmholtz motion from there (issue 16, item 2).
+    #[default]
+    Landing,
+    /// The bow lands at `F_max / 2` where the cell's force is below it, is held there
+    /// until the probe shows [`CATCH_REGULAR_SLIPS`] slips in a row one period apart (3 %)
+    /// or for [`CATCH_HOLD_MAX_S`], then lowered geometrically over [`CATCH_FALL_S`] to the
+    /// cell's force, which it has reached by [`SETTLE_S`]: whether the cell's force *holds*
+    /// Helmholtz motion once established (the stability Schelleng's window describes),
+    /// rather than whether a landing there finds it.
+    Catch,
+}
+
+impl Attack {
+    pub fn name(self) -> &'static str {
+        match self {
+            Attack::Landing => "landing",
+            Attack::Catch => "catch",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<Self> {
+        [Attack::Landing, Attack::Catch]
+            .into_iter()
+            .find(|a| a.name().eq_ignore_ascii_case(name))
+    }
+}
+
+/// [`Attack::Catch`]: consecutive regular slips that count as caught.
+pub const CATCH_REGULAR_SLIPS: usize = 4;
+/// [`Attack::Catch`]: the longest the catching force is held, s.
+pub const CATCH_HOLD_MAX_S: f64 = 0.24;
+/// [`Attack::Catch`]: how long the force takes to fall to the cell's, s
+/// (`CATCH_HOLD_MAX_S + CATCH_FALL_S = SETTLE_S`).
+pub const CATCH_FALL_S: f64 = 0.06;
 
 impl Cell {
     pub fn new(
@@ -238,6 +286,7 @@ impl Cell {
             string,
             intonation: Some(intonation::shipped()),
             integrator: BristleIntegrator::Trapezoid,
+            attack: Attack::Landing,
             thermal: ThermalParams::default(),
         }
     }
@@ -291,11 +340,14 @@ pub fn render_cell(cell: &Cell) -> Result<(Vec<f64>, Vec<ContactSample>), String
             engine.set_preferred_string(cell.string);
             engine.set_bristle_integrator(cell.integrator);
             engine.note_on(cell.note);
+            let mut catcher = Catcher::new(cell);
             for i in 0..n {
                 if i % BLOCK == 0 {
                     engine.update_sleep();
                 }
-                push(engine.tick(cell.bow));
+                let frame = engine.tick(catcher.bow(i));
+                catcher.observe(i, frame.bow_point_velocity_m_per_s);
+                push(frame);
             }
         }
         Model::Thermal => {
@@ -314,15 +366,99 @@ pub fn render_cell(cell: &Cell) -> Result<(Vec<f64>, Vec<ContactSample>), String
             engine.set_intonation(cell.intonation);
             engine.set_preferred_string(cell.string);
             engine.note_on(cell.note);
+            let mut catcher = Catcher::new(cell);
             for i in 0..n {
                 if i % BLOCK == 0 {
                     engine.update_sleep();
                 }
-                push(engine.tick(cell.bow));
+                let frame = engine.tick(catcher.bow(i));
+                catcher.observe(i, frame.bow_point_velocity_m_per_s);
+                push(frame);
             }
         }
     }
     Ok((audio, probe))
+}
+
+/// The bow of a cell sample by sample ([`Attack`]).
+struct Catcher {
+    bow: BowControl,
+    /// The catching force, N (0: no catch).
+    catch: f64,
+    /// The note's period, host samples.
+    period: f64,
+    slipping: bool,
+    last_onset: Option<usize>,
+    regular: usize,
+    /// The sample the force starts to fall (`None`: not caught yet).
+    fall_from: Option<usize>,
+    max_hold: usize,
+    fall: f64,
+}
+
+impl Catcher {
+    fn new(cell: &Cell) -> Self {
+        let catch = match cell.attack {
+            Attack::Landing => 0.0,
+            Attack::Catch => 0.5 * cell.f_max_n,
+        };
+        Self {
+            bow: cell.bow,
+            catch,
+            period: cell.rate_hz / cell.nominal_hz(),
+            slipping: false,
+            last_onset: None,
+            regular: 0,
+            fall_from: None,
+            max_hold: (CATCH_HOLD_MAX_S * cell.rate_hz) as usize,
+            fall: CATCH_FALL_S * cell.rate_hz,
+        }
+    }
+
+    /// The bow for sample `i`.
+    fn bow(&self, i: usize) -> BowControl {
+        let target = self.bow.force_n;
+        if self.catch <= target {
+            return self.bow;
+        }
+        let start = self.fall_from.unwrap_or(self.max_hold).min(self.max_hold);
+        let force = if i < start {
+            self.catch
+        } else {
+            let x = ((i - start) as f64 / self.fall).min(1.0);
+            self.catch * (target / self.catch).powf(x)
+        };
+        BowControl {
+            force_n: force,
+            ..self.bow
+        }
+    }
+
+    /// Watches the probe's string velocity `v_s` at sample `i` for regular slips: a slip
+    /// where the string moves against the bow by more than half the Helmholtz jump
+    /// `v_b / beta`.
+    fn observe(&mut self, i: usize, v_s: f64) {
+        if self.catch == 0.0 || self.fall_from.is_some() {
+            return;
+        }
+        let v_b = self.bow.velocity_m_per_s;
+        let slipping = (v_b - v_s) * v_b.signum() > 0.5 * v_b.abs() / self.bow.position_beta;
+        if slipping && !self.slipping {
+            if let Some(last) = self.last_onset {
+                let periods = (i - last) as f64 / self.period;
+                self.regular = if (periods - 1.0).abs() < 0.03 {
+                    self.regular + 1
+                } else {
+                    0
+                };
+            }
+            self.last_onset = Some(i);
+            if self.regular >= CATCH_REGULAR_SLIPS {
+                self.fall_from = Some(i);
+            }
+        }
+        self.slipping = slipping;
+    }
 }
 
 /// The modal bridge the plugin gives each instrument's thermal model.
@@ -387,6 +523,8 @@ pub struct Plan {
     pub bowings: Vec<Bowing>,
     pub rates_hz: Vec<f64>,
     pub seconds: f64,
+    /// How every cell's note begins.
+    pub attack: Attack,
 }
 
 impl Plan {
@@ -399,6 +537,7 @@ impl Plan {
             bowings: Bowing::all(false),
             rates_hz: vec![44_100.0, 48_000.0, 88_200.0, 96_000.0, 176_400.0, 192_000.0],
             seconds: 1.0,
+            attack: Attack::Landing,
         }
     }
 
@@ -469,7 +608,9 @@ impl Plan {
                 for &kind in &self.kinds {
                     for note in notes(kind, self.note_step) {
                         for &bowing in &self.bowings {
-                            cells.push(Cell::new(model, kind, note, rate, bowing, self.seconds));
+                            let mut cell = Cell::new(model, kind, note, rate, bowing, self.seconds);
+                            cell.attack = self.attack;
+                            cells.push(cell);
                         }
                     }
                 }
@@ -582,12 +723,12 @@ fn percent(part: usize, whole: usize) -> f64 {
 /// The CSV of every cell.
 pub fn csv(results: &[(Cell, Measured)]) -> String {
     let mut s = String::from(
-        "model,instrument,note,rate_hz,bowing,velocity_m_per_s,force_n,beta,f_min_n,f_max_n,regime,slips_per_period,slip_fraction,stick_velocity_m_per_s,cents,helmholtz,peak\n",
+        "model,instrument,note,rate_hz,bowing,velocity_m_per_s,force_n,beta,f_min_n,f_max_n,regime,slips_per_period,slip_fraction,stick_velocity_m_per_s,cents,helmholtz,peak,attack\n",
     );
     for (c, m) in results {
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{:.4},{:.5},{},{:.5},{:.5},{},{:.3},{:.4},{:.4},{:.2},{},{:.4}",
+            "{},{},{},{},{},{:.4},{:.5},{},{:.5},{:.5},{},{:.3},{:.4},{:.4},{:.2},{},{:.4},{}",
             c.model.name(),
             c.kind.name(),
             c.note,
@@ -604,7 +745,8 @@ pub fn csv(results: &[(Cell, Measured)]) -> String {
             m.stick_velocity_m_per_s,
             m.cents,
             m.helmholtz,
-            m.peak
+            m.peak,
+            c.attack.name()
         );
     }
     s
@@ -671,11 +813,108 @@ pub fn run(out: &Path, plan: &Plan) -> Result<String, String> {
         pngs.push(path.display().to_string());
     }
     Ok(format!(
-        "{} cells in {:.0} s\n\n{}\nwrote {} and {}",
+        "{} cells in {:.0} s, attack: {}\n\n{}\nwrote {} and {}",
         results.len(),
         t.elapsed().as_secs_f64(),
+        plan.attack.name(),
         summary(&plan, &results),
         csv_path.display(),
         pngs.join(", ")
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cell(attack: Attack) -> Cell {
+        let mut c = Cell::new(
+            Model::Point(FrictionModel::Hyperbolic),
+            InstrumentKind::Cello,
+            50,
+            48_000.0,
+            Bowing::TwiceMin(0.1),
+            1.0,
+        );
+        c.attack = attack;
+        c
+    }
+
+    /// Feeds `catcher` a string velocity sample by sample and returns the force it asked
+    /// for at each.
+    fn forces(catcher: &mut Catcher, n: usize, v_s: impl Fn(usize) -> f64) -> Vec<f64> {
+        (0..n)
+            .map(|i| {
+                let f = catcher.bow(i).force_n;
+                catcher.observe(i, v_s(i));
+                f
+            })
+            .collect()
+    }
+
+    /// The catch holds `F_max / 2` until the probe shows regular slips, then lowers the
+    /// force to the cell's, which it has reached (to rounding) by the time the map starts
+    /// measuring: the map measures the cell's force, whatever the attack.
+    #[test]
+    fn a_caught_attack_is_at_the_cells_force_when_the_map_measures() {
+        let c = cell(Attack::Catch);
+        let target = c.bow.force_n;
+        let catch = 0.5 * c.f_max_n;
+        assert!(catch > 10.0 * target, "2 F_min lies far below F_max / 2");
+        let settle = (SETTLE_S * c.rate_hz) as usize;
+        let period = c.rate_hz / c.nominal_hz();
+        let (v_b, beta) = (c.bow.velocity_m_per_s, c.bow.position_beta);
+        // Ideal Helmholtz motion from the first sample: sticking at v_b, slipping for
+        // beta of each period at v_b - v_b / beta.
+        let helmholtz = |i: usize| {
+            if (i as f64 / period).fract() < beta {
+                v_b - v_b / beta
+            } else {
+                v_b
+            }
+        };
+        let mut catcher = Catcher::new(&c);
+        let f = forces(&mut catcher, settle + 10, helmholtz);
+        let fall = catcher.fall_from.expect("regular slips are caught");
+        // Caught at the fifth onset: four intervals of one period.
+        assert!(
+            (fall as f64 - CATCH_REGULAR_SLIPS as f64 * period).abs() <= 1.0,
+            "fall at {fall}"
+        );
+        assert!(f[..=fall].iter().all(|&x| x == catch));
+        assert!(
+            f[fall..].windows(2).all(|w| w[1] <= w[0]),
+            "the force only falls"
+        );
+        let done = fall + (CATCH_FALL_S * c.rate_hz).ceil() as usize;
+        assert!(f[done..].iter().all(|&x| (x / target - 1.0).abs() < 1e-12));
+
+        // A probe that never slips: held for the longest hold, at the cell's force by the
+        // measurement's start all the same.
+        let mut catcher = Catcher::new(&c);
+        let f = forces(&mut catcher, settle + 10, |_| v_b);
+        assert_eq!(catcher.fall_from, None);
+        let hold = (CATCH_HOLD_MAX_S * c.rate_hz) as usize;
+        assert!(f[..hold].iter().all(|&x| x == catch));
+        assert!(f[settle..]
+            .iter()
+            .all(|&x| (x / target - 1.0).abs() < 1e-12));
+    }
+
+    /// A landing plays the cell's bow from the first sample, and a catch does not touch a
+    /// force already above `F_max / 2`.
+    #[test]
+    fn a_landing_and_a_catch_above_half_f_max_play_the_cells_bow() {
+        let c = cell(Attack::Landing);
+        let mut catcher = Catcher::new(&c);
+        assert!(forces(&mut catcher, 1000, |_| 0.0)
+            .iter()
+            .all(|&f| f == c.bow.force_n));
+        let mut above = cell(Attack::Catch);
+        above.bow.force_n = 0.75 * above.f_max_n;
+        let mut catcher = Catcher::new(&above);
+        assert!(forces(&mut catcher, 1000, |_| 0.0)
+            .iter()
+            .all(|&f| f == above.bow.force_n));
+    }
 }

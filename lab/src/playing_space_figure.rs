@@ -61,7 +61,15 @@ pub fn draw(
     root.fill(&WHITE).map_err(|e| err(&e))?;
     let text = |size: i32| ("sans-serif", size).into_font().color(&BLACK);
     let legend = [
-        format!("Colophony playing space: {}", model.name()),
+        match plan.attack {
+            crate::playing_space::Attack::Landing => {
+                format!("Colophony playing space: {} (the bow lands at each force)", model.name())
+            }
+            crate::playing_space::Attack::Catch => format!(
+                "Colophony playing space: {} (caught at F_max/2, then held at each force)",
+                model.name()
+            ),
+        },
         "green Helmholtz (bowed pitch in cents from equal temperament); pale green one slip but".into(),
         "slip fraction or sticking off; blue multiple slips; red raucous; grey sliding; dark silent".into(),
     ];
