@@ -34,11 +34,10 @@
 //! (Schelleng's window is a stability limit). The measurement is the same.
 
 use colophony::analysis::{cents, peak_frequency_hz, slip_stats};
+use colophony::dsp::engine::Engine;
 use colophony::dsp::friction::bristle::BristleIntegrator;
 use colophony::dsp::friction::FrictionModel;
-use colophony::dsp::instrument::{
-    midi_to_hz, BowControl, Frame, Instrument, InstrumentKind, STRINGS,
-};
+use colophony::dsp::instrument::{midi_to_hz, BowControl, Instrument, InstrumentKind, STRINGS};
 use colophony::dsp::intonation::{self, IntonationTable};
 use colophony::dsp::thermal::ThermalParams;
 use colophony::dsp::thermal_instrument::{
@@ -186,8 +185,8 @@ pub enum Attack {
     #[default]
     Landing,
     /// The bow lands at `F_max / 2` where the cell's force is below it, is held there
-    /// until the probe shows [`CATCH_REGULAR_SLIPS`] slips in a row one period apart (3 %)
-    /// or for [`CATCH_HOLD_MAX_S`], then lowered geometrically over [`CATCH_FALL_S`] to the
+    /// until the editor's classifier calls the probe's last [`CATCH_PERIODS`] periods
+    /// Helmholtz motion (checked once a period) or for [`CATCH_HOLD_MAX_S`], then lowered geometrically over [`CATCH_FALL_S`] to the
     /// cell's force, which it has reached by [`SETTLE_S`]: whether the cell's force *holds*
     /// Helmholtz motion once established (the stability Schelleng's window describes),
     /// rather than whether a landing there finds it.
@@ -209,8 +208,9 @@ impl Attack {
     }
 }
 
-/// [`Attack::Catch`]: consecutive regular slips that count as caught.
-pub const CATCH_REGULAR_SLIPS: usize = 4;
+/// [`Attack::Catch`]: periods of the probe the editor's classifier must call Helmholtz
+/// motion (with half a period more) for the string to count as caught.
+pub const CATCH_PERIODS: usize = 4;
 /// [`Attack::Catch`]: the longest the catching force is held, s.
 pub const CATCH_HOLD_MAX_S: f64 = 0.24;
 /// [`Attack::Catch`]: how long the force takes to fall to the cell's, s
@@ -322,15 +322,6 @@ pub struct Measured {
 /// Renders `cell` through the engine the plugin plays and returns (audio, probe), both at
 /// the host rate.
 pub fn render_cell(cell: &Cell) -> Result<(Vec<f64>, Vec<ContactSample>), String> {
-    let n = (cell.seconds * cell.rate_hz).round() as usize;
-    let mut audio = Vec::with_capacity(n);
-    let mut probe = Vec::with_capacity(n);
-    let mut push = |frame: Frame| {
-        audio.push(frame.audio);
-        probe.push(ContactSample::new(&frame, &cell.bow));
-    };
-    // The plugin calls `update_sleep` at each block; 256-sample blocks here.
-    const BLOCK: usize = 256;
     match cell.model {
         Model::Point(law) => {
             let mut engine = Instrument::new(cell.kind, cell.rate_hz);
@@ -339,16 +330,7 @@ pub fn render_cell(cell: &Cell) -> Result<(Vec<f64>, Vec<ContactSample>), String
             engine.set_intonation(cell.intonation);
             engine.set_preferred_string(cell.string);
             engine.set_bristle_integrator(cell.integrator);
-            engine.note_on(cell.note);
-            let mut catcher = Catcher::new(cell);
-            for i in 0..n {
-                if i % BLOCK == 0 {
-                    engine.update_sleep();
-                }
-                let frame = engine.tick(catcher.bow(i));
-                catcher.observe(i, frame.bow_point_velocity_m_per_s);
-                push(frame);
-            }
+            Ok(play(cell, &mut engine))
         }
         Model::Thermal => {
             let bridge = thermal_bridge(cell.kind);
@@ -365,19 +347,31 @@ pub fn render_cell(cell: &Cell) -> Result<(Vec<f64>, Vec<ContactSample>), String
             )?;
             engine.set_intonation(cell.intonation);
             engine.set_preferred_string(cell.string);
-            engine.note_on(cell.note);
-            let mut catcher = Catcher::new(cell);
-            for i in 0..n {
-                if i % BLOCK == 0 {
-                    engine.update_sleep();
-                }
-                let frame = engine.tick(catcher.bow(i));
-                catcher.observe(i, frame.bow_point_velocity_m_per_s);
-                push(frame);
-            }
+            Ok(play(cell, &mut engine))
         }
     }
-    Ok((audio, probe))
+}
+
+/// Plays `cell`'s note on `engine` with the cell's bow (through its [`Attack`]) and
+/// returns (audio, probe) at the host rate.
+fn play(cell: &Cell, engine: &mut impl Engine) -> (Vec<f64>, Vec<ContactSample>) {
+    let n = (cell.seconds * cell.rate_hz).round() as usize;
+    let mut audio = Vec::with_capacity(n);
+    let mut probe = Vec::with_capacity(n);
+    // The plugin calls `update_sleep` at each block; 256-sample blocks here.
+    const BLOCK: usize = 256;
+    engine.note_on(cell.note);
+    let mut catcher = Catcher::new(cell);
+    for i in 0..n {
+        if i % BLOCK == 0 {
+            engine.update_sleep();
+        }
+        let frame = engine.tick(catcher.bow(i));
+        audio.push(frame.audio);
+        probe.push(ContactSample::new(&frame, &cell.bow));
+        catcher.observe(&probe);
+    }
+    (audio, probe)
 }
 
 /// The bow of a cell sample by sample ([`Attack`]).
@@ -387,9 +381,10 @@ struct Catcher {
     catch: f64,
     /// The note's period, host samples.
     period: f64,
-    slipping: bool,
-    last_onset: Option<usize>,
-    regular: usize,
+    rate_hz: f64,
+    f0_hz: f64,
+    /// The probe's length at which the next check runs.
+    next_check: usize,
     /// The sample the force starts to fall (`None`: not caught yet).
     fall_from: Option<usize>,
     max_hold: usize,
@@ -402,17 +397,23 @@ impl Catcher {
             Attack::Landing => 0.0,
             Attack::Catch => 0.5 * cell.f_max_n,
         };
+        let period = cell.rate_hz / cell.nominal_hz();
         Self {
             bow: cell.bow,
             catch,
-            period: cell.rate_hz / cell.nominal_hz(),
-            slipping: false,
-            last_onset: None,
-            regular: 0,
+            period,
+            rate_hz: cell.rate_hz,
+            f0_hz: cell.nominal_hz(),
+            next_check: Self::window(period),
             fall_from: None,
             max_hold: (CATCH_HOLD_MAX_S * cell.rate_hz) as usize,
             fall: CATCH_FALL_S * cell.rate_hz,
         }
+    }
+
+    /// Samples the classifier reads: [`CATCH_PERIODS`] periods and a half.
+    fn window(period: f64) -> usize {
+        ((CATCH_PERIODS as f64 + 0.5) * period).ceil() as usize
     }
 
     /// The bow for sample `i`.
@@ -434,30 +435,23 @@ impl Catcher {
         }
     }
 
-    /// Watches the probe's string velocity `v_s` at sample `i` for regular slips: a slip
-    /// where the string moves against the bow by more than half the Helmholtz jump
-    /// `v_b / beta`.
-    fn observe(&mut self, i: usize, v_s: f64) {
-        if self.catch == 0.0 || self.fall_from.is_some() {
+    /// Once a period, asks the editor's classifier ([`classify_regime`], the map's own)
+    /// about the probe's last [`CATCH_PERIODS`] and a half periods; Helmholtz motion there
+    /// is caught, and the force starts to fall at the next sample.
+    fn observe(&mut self, probe: &[ContactSample]) {
+        if self.catch <= self.bow.force_n
+            || self.fall_from.is_some()
+            || probe.len() < self.next_check
+        {
             return;
         }
-        let v_b = self.bow.velocity_m_per_s;
-        let slipping = (v_b - v_s) * v_b.signum() > 0.5 * v_b.abs() / self.bow.position_beta;
-        if slipping && !self.slipping {
-            if let Some(last) = self.last_onset {
-                let periods = (i - last) as f64 / self.period;
-                self.regular = if (periods - 1.0).abs() < 0.03 {
-                    self.regular + 1
-                } else {
-                    0
-                };
-            }
-            self.last_onset = Some(i);
-            if self.regular >= CATCH_REGULAR_SLIPS {
-                self.fall_from = Some(i);
-            }
+        self.next_check += self.period.round().max(1.0) as usize;
+        let recent = &probe[probe.len() - Self::window(self.period)..];
+        if classify_regime(recent, self.rate_hz as f32, self.f0_hz as f32)
+            == Some(Regime::Helmholtz)
+        {
+            self.fall_from = Some(probe.len());
         }
-        self.slipping = slipping;
     }
 }
 
@@ -840,14 +834,21 @@ mod tests {
         c
     }
 
-    /// Feeds `catcher` a string velocity sample by sample and returns the force it asked
-    /// for at each.
+    /// Feeds `catcher` a string velocity sample by sample (as the probe of a bow in contact
+    /// at the cell's velocity) and returns the force it asked for at each.
     fn forces(catcher: &mut Catcher, n: usize, v_s: impl Fn(usize) -> f64) -> Vec<f64> {
+        let mut probe = Vec::with_capacity(n);
         (0..n)
             .map(|i| {
-                let f = catcher.bow(i).force_n;
-                catcher.observe(i, v_s(i));
-                f
+                let bow = catcher.bow(i);
+                let frame = colophony::dsp::instrument::Frame {
+                    bow_point_velocity_m_per_s: v_s(i),
+                    friction_force_n: 0.3 * bow.force_n,
+                    ..Default::default()
+                };
+                probe.push(ContactSample::new(&frame, &catcher.bow));
+                catcher.observe(&probe);
+                bow.force_n
             })
             .collect()
     }
@@ -876,11 +877,9 @@ mod tests {
         let mut catcher = Catcher::new(&c);
         let f = forces(&mut catcher, settle + 10, helmholtz);
         let fall = catcher.fall_from.expect("regular slips are caught");
-        // Caught at the fifth onset: four intervals of one period.
-        assert!(
-            (fall as f64 - CATCH_REGULAR_SLIPS as f64 * period).abs() <= 1.0,
-            "fall at {fall}"
-        );
+        // Caught at the first check whose window holds Helmholtz motion: the first, once
+        // the probe spans the classifier's CATCH_PERIODS and a half periods.
+        assert_eq!(fall, Catcher::window(period), "fall at {fall}");
         assert!(f[..=fall].iter().all(|&x| x == catch));
         assert!(
             f[fall..].windows(2).all(|w| w[1] <= w[0]),
