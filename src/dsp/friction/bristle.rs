@@ -86,6 +86,9 @@ pub const MAX_DAMPING_HALVINGS: u32 = 8;
 /// Iterations the fallback's bracketed iteration may take (false position shrinks a
 /// bracket of `1e300` to `1e-16` well within it).
 const FALLBACK_CAP: u32 = 200;
+/// Doublings the fallback's walk may take to find a sign change: from a step of `1e-6`,
+/// 200 doublings pass any finite velocity.
+const WALK_DOUBLINGS: u32 = 200;
 /// Default convergence test: `|dy| <= Y_TOLERANCE_M_PER_S * max(1, |y|)` (see
 /// [`BristleFriction::set_newton_tolerance`]).
 pub const Y_TOLERANCE_M_PER_S: f64 = 1e-10;
@@ -713,7 +716,7 @@ fn bracketed_root(
     };
     let (mut near, mut g_near, mut d_near) = (start, g0, d0);
     let mut far = None;
-    for _ in 0..200 {
+    for _ in 0..WALK_DOUBLINGS {
         let x = start + dir * step;
         let (gx, dx) = g(x);
         evaluations += 1;
