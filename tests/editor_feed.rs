@@ -1,7 +1,9 @@
 //! What the audio thread does for the editor's live views, checked for allocation: the
 //! contact samples into the scope and the thermal bow's nodes into the node ring, as
 //! `Colophony::process` does while an open editor listens. The host tests cannot open an
-//! editor, so this drives the same calls with a counting allocator.
+//! editor, so this drives the same calls inside nice-plug's allocation checker
+//! (`assert_no_alloc`, the global allocator of the test build: Cargo.toml's
+//! dev-dependencies), which aborts the test binary on any allocation.
 
 use colophony::dsp::bridge_data::shipped_cello_bridge;
 use colophony::dsp::instrument::{BowControl, InstrumentKind};
@@ -9,46 +11,19 @@ use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
 use colophony::editor::live::ContactSample;
 use colophony::editor::nodes::NodeProbe;
 use colophony::editor::EditorLink;
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
+use nice_assert_no_alloc::assert_no_alloc;
+use std::process::Command;
 
-/// The system allocator, counting the allocations of threads that ask it to.
-struct Counting;
-
-thread_local! {
-    static COUNTING: Cell<bool> = const { Cell::new(false) };
-    static COUNT: Cell<usize> = const { Cell::new(0) };
-}
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        // `try_with`: a thread being torn down has no locals left, and counts nothing.
-        if COUNTING.try_with(Cell::get).unwrap_or(false) {
-            let _ = COUNT.try_with(|c| c.set(c.get() + 1));
-        }
-        // SAFETY: forwarded unchanged.
-        unsafe { System.alloc(layout) }
-    }
-
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: forwarded unchanged.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-}
-
-#[global_allocator]
-static ALLOCATOR: Counting = Counting;
-
-/// Allocations `f` makes on this thread.
-fn allocations(f: impl FnOnce()) -> usize {
-    COUNT.with(|c| c.set(0));
-    COUNTING.with(|c| c.set(true));
-    f();
-    COUNTING.with(|c| c.set(false));
-    COUNT.with(Cell::get)
-}
+/// Set in the child process of
+/// [`an_allocation_inside_the_checker_aborts_the_test_binary`]: the child allocates inside
+/// the checker.
+const CHILD_ENV: &str = "COLOPHONY_EDITOR_FEED_ALLOCATING_CHILD";
 
 #[test]
+#[cfg_attr(
+    not(debug_assertions),
+    ignore = "the allocation checker needs debug assertions"
+)]
 fn feeding_the_live_and_thermal_views_does_not_allocate() {
     let fs = 48_000.0;
     let bridge = shipped_cello_bridge().modes;
@@ -64,8 +39,8 @@ fn feeding_the_live_and_thermal_views_does_not_allocate() {
     let mut probe = NodeProbe::default();
     cello.note_on(50);
     let bow = BowControl::default();
-    // Allocations, if any, happen on the first uses: count from the first sample.
-    let count = allocations(|| {
+    // Allocations, if any, happen on the first uses: checked from the first sample.
+    assert_no_alloc(|| {
         for i in 0..(fs as usize / 2) {
             if i % 256 == 0 {
                 cello.update_sleep();
@@ -79,10 +54,40 @@ fn feeding_the_live_and_thermal_views_does_not_allocate() {
             );
         }
     });
-    assert_eq!(count, 0);
     // The views were fed: 0.5 s of samples, one node record every 5 ms.
     assert_eq!(link.scope.written(), 24_000);
     assert_eq!(link.nodes.written(), 100);
-    // The counter itself works.
-    assert_eq!(allocations(|| drop(std::hint::black_box(vec![0u8; 16]))), 1);
+}
+
+/// The checker the test above relies on is live in this binary: an allocation inside it
+/// aborts the process (run in a child of this test binary, which must not exit cleanly).
+#[test]
+#[cfg_attr(
+    not(debug_assertions),
+    ignore = "the allocation checker needs debug assertions"
+)]
+fn an_allocation_inside_the_checker_aborts_the_test_binary() {
+    if std::env::var_os(CHILD_ENV).is_some() {
+        // The child: this allocation must abort before the line after it.
+        assert_no_alloc(|| drop(std::hint::black_box(vec![0u8; 16])));
+        println!("allocated inside the checker and went on");
+        return;
+    }
+    let out = Command::new(std::env::current_exe().unwrap())
+        .args([
+            "--exact",
+            "an_allocation_inside_the_checker_aborts_the_test_binary",
+            "--nocapture",
+            "--test-threads",
+            "1",
+        ])
+        .env(CHILD_ENV, "1")
+        .output()
+        .expect("running this test binary again");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        !out.status.success() && !stdout.contains("went on"),
+        "an allocation inside assert_no_alloc did not abort: {:?}\n{stdout}",
+        out.status
+    );
 }

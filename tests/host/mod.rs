@@ -599,16 +599,34 @@ pub fn target_dir() -> PathBuf {
     workspace_root().join("target")
 }
 
-/// Builds the plugin library for the tests, once per process, and returns its path.
+/// The plugin library the tests load, with nice-plug's allocation checker in it: found or
+/// built once per process.
 ///
-/// `cargo test` builds the crate's cdylib without the `assert_process_allocs` feature and
-/// leaves it in `deps/`, so this runs `$CARGO build -p colophony --lib --features
-/// assert_process_allocs` (dev profile, in `target/host-plugin/`) and loads
-/// `target/host-plugin/debug/libcolophony.so`. With debug assertions on, any allocation inside the
-/// plugin's `process` then aborts the test process.
+/// The package lists itself as a dev-dependency with `assert_process_allocs`, so the
+/// workspace's test build (`cargo test`, debug assertions on) compiles the library, cdylib
+/// included, with the checker, and leaves the cdylib in `deps/` beside the test binary:
+/// that one is loaded, with no second build. Where that library lacks the checker (a
+/// release test build, where the checker is compiled out, or `cargo test -p
+/// colophony-lab`, which does not unify the plugin's dev-dependencies), this runs `$CARGO
+/// build -p colophony --lib --features assert_process_allocs` (dev profile, in
+/// `target/host-plugin/`) and loads `target/host-plugin/debug/libcolophony.so`. Either
+/// way, any allocation inside the plugin's `process` aborts the test process.
 pub fn test_plugin_path() -> &'static Path {
     static PATH: OnceLock<PathBuf> = OnceLock::new();
     PATH.get_or_init(|| {
+        let name = format!(
+            "{}colophony{}",
+            std::env::consts::DLL_PREFIX,
+            std::env::consts::DLL_SUFFIX
+        );
+        if cfg!(debug_assertions) {
+            let exe = std::env::current_exe().expect("the test binary's path");
+            if let Some(beside) = exe.parent().map(|deps| deps.join(&name)) {
+                if has_allocation_checker(&beside) {
+                    return beside;
+                }
+            }
+        }
         let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
         let root = workspace_root();
         // A target directory of its own: this feature set's `libcolophony` beside the
@@ -632,26 +650,28 @@ pub fn test_plugin_path() -> &'static Path {
             .status()
             .unwrap_or_else(|e| panic!("running {cargo:?}: {e}"));
         assert!(status.success(), "building the plugin library failed");
-        let name = format!(
-            "{}colophony{}",
-            std::env::consts::DLL_PREFIX,
-            std::env::consts::DLL_SUFFIX
-        );
         let path = target.join("debug").join(name);
         assert!(path.exists(), "{} was not built", path.display());
         // cargo gives this crate's lib and cdylib outputs no hash suffix, so a build of
         // another feature set can overwrite them while leaving this one's fingerprint fresh;
         // make sure the library really contains the allocation checker.
-        let bytes = std::fs::read(&path).unwrap();
-        let needle = b"nice_assert_no_alloc";
         assert!(
-            bytes.windows(needle.len()).any(|w| w == needle),
+            has_allocation_checker(&path),
             "{} was built without assert_process_allocs (a build with other features \
              overwrote it); touch src/lib.rs and run the tests again",
             path.display()
         );
         path
     })
+}
+
+/// Whether the library at `path` exists and carries nice-plug's allocation checker.
+fn has_allocation_checker(path: &Path) -> bool {
+    let Ok(bytes) = std::fs::read(path) else {
+        return false;
+    };
+    let needle = b"nice_assert_no_alloc";
+    bytes.windows(needle.len()).any(|w| w == needle)
 }
 
 /// Writes `channels` as a 32-bit float WAV at `path` (creating its directory).
