@@ -304,7 +304,7 @@ impl Colophony {
                     if let Some(string) = performer.probed_thermal_string() {
                         node_probe.add_from(
                             string.node_temperatures(),
-                            string.slipping(),
+                            string.node_sliding_velocities(),
                             editor_link,
                         );
                     }

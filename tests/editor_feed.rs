@@ -49,7 +49,7 @@ fn feeding_the_live_and_thermal_views_does_not_allocate() {
             link.scope.push(ContactSample::new(&frame, &bow));
             probe.add_from(
                 cello.probed_string().node_temperatures(),
-                cello.probed_string().slipping(),
+                cello.probed_string().node_sliding_velocities(),
                 &link,
             );
         }

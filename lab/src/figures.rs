@@ -268,7 +268,7 @@ pub fn maestre_fig6(out: &Path) -> Result<String, String> {
         vh.push(f.hair_velocity_m_per_s);
         fnn.push(f.normal_force_n);
         if k % every == 0 {
-            slip_map.push(s.slipping().to_vec());
+            slip_map.push(s.slipping().collect::<Vec<_>>());
             temp_map.push(
                 s.node_temperatures()
                     .iter()

@@ -129,7 +129,7 @@ fn temperature_rises_while_slipping_and_diffuses_while_sticking() {
         let before = mean(s.node_temperatures());
         let grid_before = grid(&s);
         s.tick(FIG6_BOW);
-        let slipping = s.slipping();
+        let slipping: Vec<bool> = s.slipping().collect();
         // The sliding nodes' equilibria at this sample's speeds and forces
         // (ThermalParams::sliding_equilibrium_kelvin, eq. 1 without diffusion).
         let equilibria: Vec<f64> = s

@@ -126,9 +126,10 @@ struct Core {
     arriving: [[f64; 2]; STRINGS],
     leaving: [[f64; 2]; STRINGS],
     impedances: [f64; STRINGS],
-    /// The probed string's last internal sample: string velocity at the bow's middle node
-    /// and total friction force.
-    probe: (f64, f64),
+    /// The probed string's last internal sample: string velocity at the bow's middle node,
+    /// and the string whose nodes give the total friction force (summed when asked,
+    /// [`StringBank::probe`]; `None`: lifted and idle, no force).
+    probe: (f64, Option<usize>),
 }
 
 impl Core {
@@ -147,17 +148,17 @@ impl Core {
             if force <= 0.0 && string.contact_idle() && (i != probed || string.is_asleep()) {
                 self.arriving[i] = string.arriving_at_bridge();
                 if i == probed {
-                    self.probe = (0.0, 0.0);
+                    self.probe = (0.0, None);
                 }
                 continue;
             }
-            let f = string.tick_contact(ThermalBowControl {
+            let velocity = string.tick_contact(ThermalBowControl {
                 velocity_m_per_s: bow.velocity_m_per_s,
                 force_per_m: force,
                 position_beta: bow.position_beta,
             });
             if i == probed {
-                self.probe = (f.string_velocity_m_per_s, f.friction_force_n);
+                self.probe = (velocity, Some(i));
             }
             self.arriving[i] = string.arriving_at_bridge();
         }
@@ -327,7 +328,9 @@ impl StringBank for ThermalBank {
     }
 
     fn probe(&self) -> (f64, f64) {
-        self.core.probe
+        let (velocity, string) = self.core.probe;
+        let force = string.map_or(0.0, |i| self.core.strings[i].friction_force_n());
+        (velocity, force)
     }
 
     /// Each polarisation of a lifted string whose waves fall below half of
@@ -350,7 +353,7 @@ impl StringBank for ThermalBank {
                 s.reset();
             }
             self.core.bridge.reset();
-            self.core.probe = (0.0, 0.0);
+            self.core.probe = (0.0, None);
             self.awake = false;
             return true;
         }
@@ -388,7 +391,7 @@ impl StringBank for ThermalBank {
             s.reset();
         }
         self.core.bridge.reset();
-        self.core.probe = (0.0, 0.0);
+        self.core.probe = (0.0, None);
         self.awake = false;
     }
 
@@ -495,7 +498,7 @@ impl ThermalInstrument {
                 arriving: [[0.0; 2]; STRINGS],
                 leaving: [[0.0; 2]; STRINGS],
                 impedances: std::array::from_fn(|i| open[i].z0_kg_per_s),
-                probe: (0.0, 0.0),
+                probe: (0.0, None),
             },
             wave_speeds,
             contact_width_m: settings.width_m,

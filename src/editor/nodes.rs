@@ -104,31 +104,33 @@ impl Default for NodeProbe {
 
 impl NodeProbe {
     /// Audio thread, once per sample while listening to the thermal instrument: adds the
-    /// probed string's node temperatures (K) and slip states, and publishes a record into
-    /// `link.nodes` when one is due.
+    /// probed string's node temperatures (K) and sliding velocities (m/s; a node slips
+    /// where its velocity is not zero), and publishes a record into `link.nodes` when one
+    /// is due.
     #[inline]
-    pub fn add_from<T: Copy + Into<f64>>(
+    pub fn add_from<T: Copy + Into<f64>, V: Copy + Into<f64>>(
         &mut self,
         temperatures: &[T],
-        slipping: &[bool],
+        sliding: &[V],
         link: &super::EditorLink,
     ) {
         let interval = (link.scope.sample_rate() * RECORD_INTERVAL_S).max(1.0) as u32;
-        self.add(temperatures, slipping, interval, &link.nodes);
+        self.add(temperatures, sliding, interval, &link.nodes);
     }
 
-    /// Adds one sample of node temperatures (K) and slip states; after `interval` samples
-    /// publishes their means into `ring` and starts again. A change of node count drops
-    /// the partial sums.
+    /// Adds one sample of node temperatures (K) and sliding velocities (a node slips where
+    /// its velocity is not zero); after `interval` samples publishes their means (the
+    /// temperature, and the share of samples slipping) into `ring` and starts again. A
+    /// change of node count drops the partial sums.
     #[inline]
-    pub fn add<T: Copy + Into<f64>>(
+    pub fn add<T: Copy + Into<f64>, V: Copy + Into<f64>>(
         &mut self,
         temperatures: &[T],
-        slipping: &[bool],
+        sliding: &[V],
         interval: u32,
         ring: &NodeRing,
     ) {
-        let count = temperatures.len().min(slipping.len()).min(MAX_NODES);
+        let count = temperatures.len().min(sliding.len()).min(MAX_NODES);
         if count != self.count {
             *self = Self {
                 count,
@@ -137,7 +139,7 @@ impl NodeProbe {
         }
         for i in 0..count {
             self.temperature_sum[i] += temperatures[i].into();
-            self.slipping[i] += slipping[i] as u32;
+            self.slipping[i] += (sliding[i].into() != 0.0) as u32;
         }
         self.samples += 1;
         if self.samples >= interval {
@@ -399,7 +401,8 @@ mod tests {
         let mut probe = NodeProbe::default();
         // Node 0 slips on every other sample, node 1 never; temperatures 1, 2, 3, 4 K.
         for k in 0..4 {
-            probe.add(&[k as f64 + 1.0, 10.0], &[k % 2 == 0, false], 4, &ring);
+            let slip = if k % 2 == 0 { 0.3 } else { 0.0 };
+            probe.add(&[k as f64 + 1.0, 10.0], &[slip, 0.0], 4, &ring);
         }
         let mut out = Vec::new();
         ring.copy_latest(10, &mut out);
@@ -410,7 +413,7 @@ mod tests {
         assert_eq!(&r.slip_fraction[..2], &[0.5, 0.0]);
         // Three more samples: not yet due.
         for _ in 0..3 {
-            probe.add(&[0.0, 0.0], &[true, true], 4, &ring);
+            probe.add(&[0.0, 0.0], &[-0.1, 0.2], 4, &ring);
         }
         assert_eq!(ring.written(), 1);
     }
@@ -438,7 +441,7 @@ mod tests {
             cello.tick(bow);
             probe.add_from(
                 cello.probed_string().node_temperatures(),
-                cello.probed_string().slipping(),
+                cello.probed_string().node_sliding_velocities(),
                 &link,
             );
         }
@@ -475,9 +478,9 @@ mod tests {
     fn node_probe_starts_again_when_the_node_count_changes() {
         let ring = node_ring();
         let mut probe = NodeProbe::default();
-        probe.add(&[100.0; 3], &[true; 3], 2, &ring);
-        probe.add(&[1.0; 5], &[false; 5], 2, &ring);
-        probe.add(&[3.0; 5], &[true; 5], 2, &ring);
+        probe.add(&[100.0; 3], &[0.1; 3], 2, &ring);
+        probe.add(&[1.0; 5], &[0.0; 5], 2, &ring);
+        probe.add(&[3.0; 5], &[-0.1; 5], 2, &ring);
         let mut out = Vec::new();
         ring.copy_latest(10, &mut out);
         assert_eq!(out.len(), 1);

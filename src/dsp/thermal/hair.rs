@@ -22,7 +22,6 @@ pub(super) struct Nodes {
     pub(super) force: Vec<NodeReal>,
     pub(super) v_delta: Vec<NodeReal>,
     pub(super) normal: Vec<NodeReal>,
-    pub(super) slipping: Vec<bool>,
     /// Incoming horizontal and vertical velocity per node (gathered each sample).
     pub(super) vp: Vec<NodeReal>,
     pub(super) vp_y: Vec<NodeReal>,
@@ -40,7 +39,6 @@ impl Nodes {
             force: v(),
             v_delta: v(),
             normal: v(),
-            slipping: Vec::with_capacity(n),
             vp: v(),
             vp_y: v(),
         }
@@ -63,8 +61,6 @@ impl Nodes {
             v.clear();
             v.resize(n, 0.0);
         }
-        self.slipping.clear();
-        self.slipping.resize(n, false);
     }
 }
 

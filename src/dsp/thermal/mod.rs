@@ -884,11 +884,6 @@ impl ThermalString {
         self.grid.all()
     }
 
-    /// Which nodes slipped on the last sample.
-    pub fn slipping(&self) -> &[bool] {
-        &self.nodes.slipping
-    }
-
     /// Friction force per node on the last sample, N.
     pub fn node_forces(&self) -> &[NodeReal] {
         &self.nodes.force
@@ -900,7 +895,13 @@ impl ThermalString {
         &self.nodes.normal
     }
 
-    /// Sliding velocity per node on the last sample, m/s.
+    /// Which nodes slipped on the last sample (their sliding velocity is not zero).
+    pub fn slipping(&self) -> impl ExactSizeIterator<Item = bool> + '_ {
+        self.nodes.v_delta.iter().map(|v| *v != 0.0)
+    }
+
+    /// Sliding velocity per node on the last sample, m/s: zero where the node sticks (or
+    /// the bow is lifted), so a node slipped where it is not zero.
     pub fn node_sliding_velocities(&self) -> &[NodeReal] {
         &self.nodes.v_delta
     }
@@ -979,16 +980,39 @@ impl ThermalString {
         ] {
             v.fill(0.0);
         }
-        n.slipping.fill(false);
         self.grid.clear();
     }
 
     /// One sample at the internal rate with the string's own (2x2 admittance) bridge. A bow
     /// force of zero lifts the bow (no contact in either plane).
     pub fn tick(&mut self, bow: ThermalBowControl) -> ThermalFrame {
-        let mut frame = self.tick_contact(bow);
+        let mut frame = ThermalFrame {
+            string_velocity_m_per_s: self.tick_contact(bow),
+            ..ThermalFrame::default()
+        };
+        self.contact_sums(&mut frame);
         self.terminate_alone(&mut frame);
         frame
+    }
+
+    /// Total friction force over the bow on the last sample, N (zero with the bow lifted).
+    pub fn friction_force_n(&self) -> f64 {
+        sum_lanes(&self.nodes.force)
+    }
+
+    /// The last sample's sums over the bow's nodes into `frame`: friction and normal
+    /// force, nodes slipping, and the middle node's hair velocity (all zero with the bow
+    /// lifted: the lift clears the nodes). Computed when asked, not every internal sample:
+    /// the instrument reads only the probed string's friction force, once a host sample.
+    pub fn contact_sums(&self, frame: &mut ThermalFrame) {
+        let nodes = &self.nodes;
+        frame.friction_force_n = self.friction_force_n();
+        frame.normal_force_n = sum_lanes(&nodes.normal);
+        frame.slipping_nodes = self.slipping().filter(|s| *s).count();
+        frame.hair_velocity_m_per_s = nodes
+            .hair_v
+            .get(self.nodes_count / 2)
+            .map_or(0.0, |v| f64::from(*v));
     }
 
     /// Whether [`ThermalString::tick_contact`] with the bow lifted would do nothing but
@@ -998,9 +1022,11 @@ impl ThermalString {
         !self.contact_active && !self.thermal_active
     }
 
-    /// The bow contact and thermal update of one sample (no terminations).
+    /// The bow contact and thermal update of one sample (no terminations). Returns the
+    /// horizontal string velocity at the bow's middle node, m/s; the sums over the nodes
+    /// are [`ThermalString::contact_sums`].
     #[inline(always)]
-    pub fn tick_contact(&mut self, bow: ThermalBowControl) -> ThermalFrame {
+    pub fn tick_contact(&mut self, bow: ThermalBowControl) -> f64 {
         let m = self.waves.len();
         let n_b = self.nodes_count;
         // Round half up (beta * m >= 0), without a libm call per sample.
@@ -1015,7 +1041,7 @@ impl ThermalString {
             self.grid
                 .set_load(&self.thermal, bow.force_per_m * self.narrowing);
         }
-        let mut frame = ThermalFrame::default();
+        let mut string_velocity = 0.0;
         let mid = n_b / 2;
         let half_y = self.half_y;
 
@@ -1037,7 +1063,6 @@ impl ThermalString {
                 ] {
                     v.fill(0.0);
                 }
-                nodes.slipping.fill(false);
                 self.contact_active = false;
             }
         } else {
@@ -1052,21 +1077,11 @@ impl ThermalString {
                 ..self.consts
             };
             solve_nodes(self.wide_simd, k, nodes, temps, n_b);
-            let slip_s = &mut nodes.slipping[..n_b];
-            let vd_s = &nodes.v_delta[..n_b];
-            for (slip, vd) in slip_s.iter_mut().zip(vd_s.iter()) {
-                *slip = *vd != 0.0;
-            }
             self.waves.scatter(span, &nodes.force, &nodes.fy, half_y);
-            frame.friction_force_n = sum_lanes(&nodes.force);
-            frame.normal_force_n = sum_lanes(&nodes.normal);
-            frame.slipping_nodes = nodes.slipping.iter().map(|s| *s as usize).sum();
-            frame.string_velocity_m_per_s =
-                f64::from(nodes.vp[mid]) + f64::from(nodes.force[mid]) * half_y;
-            frame.hair_velocity_m_per_s = f64::from(nodes.hair_v[mid]);
+            string_velocity = f64::from(nodes.vp[mid]) + f64::from(nodes.force[mid]) * half_y;
         }
         if !on {
-            frame.string_velocity_m_per_s = self.waves.velocity_h(self.bow_start + mid);
+            string_velocity = self.waves.velocity_h(self.bow_start + mid);
         }
         // The grid idles once the bow is off and the contact has cooled to nothing.
         if on || self.thermal_active {
@@ -1083,7 +1098,7 @@ impl ThermalString {
             self.thermal_active = true;
         }
 
-        frame
+        string_velocity
     }
 
     fn terminate_alone(&mut self, frame: &mut ThermalFrame) {
