@@ -549,8 +549,13 @@ fn bench_peers_compares_with_stk_or_says_how_to_install_it() {
     let stdout = String::from_utf8_lossy(&run.stdout);
     let stderr = String::from_utf8_lossy(&run.stderr);
     if run.status.success() {
-        // Three rows, each with its ratio to STK (STK's own is 1).
-        for row in ["STK Bowed", "hyperbolic string", "elasto-plastic string"] {
+        // Four rows, each with its ratio to STK (STK's own is 1).
+        for row in [
+            "STK Bowed",
+            "hyperbolic string",
+            "elasto-plastic string",
+            "elasto-plastic, plugin tolerance",
+        ] {
             assert!(stdout.contains(row), "{stdout}");
         }
         assert!(stdout.contains("1.00x STK"), "{stdout}");
