@@ -9,6 +9,7 @@ subnormals, in tune and follows the automation. Run by scripts/host-roundtrip.sh
 import math
 import os
 import sys
+import time
 
 import mido
 import numpy as np
@@ -65,9 +66,24 @@ LOG = os.path.abspath(os.path.join(os.path.dirname(BUNDLE) or ".", "host-roundtr
 if os.path.exists(LOG):
     os.remove(LOG)
 os.environ["NICE_LOG"] = LOG
+
+# 0. Loading, as a musician meets it: instantiate, then list the parameters (pedalboard
+#    reads every listed parameter's value strings to learn its range). The wrapper's
+#    hidden MIDI-controller parameters carry JUCE's names, so JUCE-based hosts leave them
+#    out of the list; they stay declared, for the controller mapping of part 3.
+load_start = time.perf_counter()
 plugin = pedalboard.load_plugin(BUNDLE)
-print(f"loaded {plugin.name} through pedalboard {pedalboard.__version__} (JUCE's VST3 host), "
-      f"{len(plugin.parameters)} parameters listed")
+loaded = time.perf_counter()
+listed = plugin.parameters
+listed_at = time.perf_counter()
+print(f"loaded {plugin.name} through pedalboard {pedalboard.__version__} (JUCE's VST3 host) in "
+      f"{loaded - load_start:.3f} s; {len(listed)} parameters listed in {listed_at - loaded:.3f} s "
+      f"(load benchmark: {listed_at - load_start:.3f} s in all)")
+declared = plugin._parameters
+hidden = [p for p in declared if p.name.startswith("MIDI CC ")]
+check(len(hidden) == 16 * 130, f"the 16 x 130 MIDI-controller parameters are declared ({len(hidden)})")
+check(len(listed) == len(declared) - len(hidden) and not any(k.startswith("midi") for k in listed),
+      f"only the instrument's own {len(listed)} parameters are listed")
 
 # 1. The MIDI part: open strings and stopped notes on every string, each its own note.
 parts = {

@@ -30,8 +30,13 @@ fn demo() -> nice_plug_xtask::Result<()> {
     let clap = target.join("bundled").join("Colophony.clap");
     anyhow_ensure(clap.exists(), format!("{} was not bundled", clap.display()))?;
 
+    // Loading: open the bundle, create the instance, list its parameters (the host reads
+    // every parameter's info), activate.
+    let load_start = std::time::Instant::now();
     let mut plugin = HostedPlugin::load(&clap);
     plugin.activate(SAMPLE_RATE, BLOCK);
+    let load_s = load_start.elapsed().as_secs_f64();
+    let listed = plugin.params().len();
     let s = |t: f64| (t * SAMPLE_RATE).round() as u64;
     let cello = plugin.text("Instrument", "Cello");
     let score = Score::new()
@@ -68,6 +73,7 @@ fn demo() -> nice_plug_xtask::Result<()> {
     );
     let peak = out.iter().flatten().fold(0.0f32, |m, x| m.max(x.abs()));
     println!("plugin: {} ({})", plugin.plugin_name, clap.display());
+    println!("loaded, {listed} parameters listed and activated in {load_s:.3} s");
     println!(
         "wrote {} ({:.1} s, {} Hz, peak {:.1} dBFS)",
         path.display(),
