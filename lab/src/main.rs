@@ -87,6 +87,10 @@ enum Command {
         /// With --midi: only this track (0 = the first in the file); default all.
         #[arg(long)]
         track: Option<usize>,
+        /// With --midi: the longest ring-out after the last event, s (0 .. 10; default 10,
+        /// or sooner once the output has stayed below -100 dBFS for a quarter second).
+        #[arg(long)]
+        tail: Option<f64>,
         /// Play the instrument on this bridge (JSON, as `colophony fit-bridge` writes)
         /// instead of the shipped one, through the plugin's performer: the thermal
         /// model on the modal bridge itself, a point law with the bridge's passive
@@ -225,12 +229,13 @@ fn main() -> ExitCode {
             preset,
             midi,
             track,
+            tail,
             bridge,
         } => {
             let rubbed = preset.as_deref().and_then(RubbedPreset::from_name);
             if let (Some(name), None) = (&preset, rubbed) {
                 let score = match midi {
-                    Some(midi) => PresetScore::File(midi, track),
+                    Some(midi) => PresetScore::File(midi, track, tail),
                     None => PresetScore::Note(note, seconds, release),
                 };
                 return report(render_preset(name, score, &out, sample_rate));
@@ -249,7 +254,7 @@ fn main() -> ExitCode {
                 position_beta: bow_position,
             };
             let source = match (midi, bridge.is_some()) {
-                (Some(midi), _) => Some(Score::File(midi, track)),
+                (Some(midi), _) => Some(Score::File(midi, track, tail)),
                 // A note on a chosen bridge plays through the plugin's performer.
                 (None, true) => Some(Score::Note {
                     note,
@@ -447,8 +452,8 @@ fn main() -> ExitCode {
 #[allow(clippy::too_many_arguments)]
 /// What [`render_performed`] plays.
 enum Score {
-    /// A MIDI file, all tracks or one.
-    File(PathBuf, Option<usize>),
+    /// A MIDI file, all tracks or one, and the longest ring-out (s).
+    File(PathBuf, Option<usize>, Option<f64>),
     /// One note held for `seconds` (lifted at `release` if given).
     Note {
         note: u8,
@@ -518,7 +523,9 @@ fn render_performed(
         bridge,
     };
     match score {
-        Score::File(midi, track) => colophony_lab::midi_file::render_file(&midi, track, &how, out),
+        Score::File(midi, track, tail) => {
+            colophony_lab::midi_file::render_file(&midi, track, tail, &how, out)
+        }
         Score::Note {
             note,
             seconds,
@@ -540,7 +547,8 @@ const DEFAULT_NOTE: u8 = 50;
 
 /// What `render --preset` plays.
 enum PresetScore {
-    File(PathBuf, Option<usize>),
+    /// A MIDI file, its track and the longest ring-out (s).
+    File(PathBuf, Option<usize>, Option<f64>),
     /// Note (default the preset's), seconds, release.
     Note(Option<u8>, f64, Option<f64>),
 }
@@ -573,8 +581,8 @@ fn render_preset(
         bridge: None,
     };
     match score {
-        PresetScore::File(midi, track) => {
-            colophony_lab::midi_file::render_file(&midi, track, &how, out)
+        PresetScore::File(midi, track, tail) => {
+            colophony_lab::midi_file::render_file(&midi, track, tail, &how, out)
         }
         PresetScore::Note(note, seconds, release) => {
             let note = note.or(preset.note).unwrap_or(DEFAULT_NOTE);

@@ -250,13 +250,20 @@ pub fn perform_until(
 
 /// `colophony render --midi FILE`: reads `midi`, plays it as [`perform`] (blocks of 512),
 /// with a progress bar on a terminal, and writes `out` as the renderer does (no partial
-/// file on failure).
+/// file on failure). `tail_s` shortens the ring-out after the last event (the renderer's
+/// `--tail`, 0 ..= [`MAX_TAIL_S`]).
 pub fn render_file(
     midi: &std::path::Path,
     track: Option<usize>,
+    tail_s: Option<f64>,
     how: &Performance,
     out: &std::path::Path,
 ) -> Result<String, String> {
+    if let Some(t) = tail_s {
+        if !(t.is_finite() && (0.0..=MAX_TAIL_S).contains(&t)) {
+            return Err(format!("--tail must be within 0..={MAX_TAIL_S} s, got {t}"));
+        }
+    }
     let bytes = std::fs::read(midi).map_err(|e| format!("cannot read {}: {e}", midi.display()))?;
     let events = read_events(&bytes, track, how.sample_rate_hz)
         .map_err(|e| format!("{}: {e}", midi.display()))?;
@@ -264,7 +271,9 @@ pub fn render_file(
         .iter()
         .filter(|e| matches!(e.event, MidiEvent::NoteOn(..)))
         .count();
-    let (seconds, _) = render_events(&events, how, None, out)?;
+    let last = events.last().map_or(0, |e| e.sample);
+    let frames = tail_s.map(|t| (last + (t * how.sample_rate_hz).round() as u64) as usize);
+    let (seconds, _) = render_events(&events, how, frames, out)?;
     Ok(format!(
         "wrote {} ({notes} notes, {seconds:.1} s, from {})",
         out.display(),

@@ -2,7 +2,7 @@
 //! sets, bowed on probe notes of every instrument across its Schelleng window, through the
 //! engine the plugin plays (the four-string thermal instrument with its modal bridge and
 //! resampler, 48 kHz, Good's 10 nodes over 1 cm). Paper B publishes none of the
-//! constants (docs/parameters.md §1.3); this is the measurement the choice rests on
+//! constants (docs/literature-values.md §1.3); this is the measurement the choice rests on
 //! (docs/playing-space.md, "Choosing the thermal constants").
 //!
 //! Per set, note and force: the regime on the contact probe after 0.3 s (`H` Helmholtz by

@@ -1,7 +1,7 @@
 //! A generic instrument body: a few resonant modes driven by the bridge force, plus a
 //! direct path. It colours the radiated sound only and feeds nothing back into the
 //! strings, so it cannot make the loop gain energy. The mode data are generic (violin
-//! signature modes A0, CBR, B1-, B1+ and a bridge hill, docs/parameters.md §2, scaled down for
+//! signature modes A0, CBR, B1-, B1+ and a bridge hill, docs/literature-values.md §2, scaled down for
 //! the larger instruments), not measured.
 //!
 //! ```

@@ -122,7 +122,7 @@ impl InstrumentKind {
         }
     }
 
-    /// String data, low to high (docs/parameters.md §1.4: Desvages/NESS sets; viola G, D, A
+    /// String data, low to high (docs/literature-values.md §1.4: Desvages/NESS sets; viola G, D, A
     /// inharmonicities are not in the table and are chosen between the neighbouring
     /// violin and viola values). Open pitches are equal-tempered from A4 = 440 Hz.
     pub fn strings(self) -> [StringSpec; STRINGS] {
@@ -174,7 +174,7 @@ impl InstrumentKind {
     /// What the bow force is multiplied by on string `index` when the strings are weighted
     /// ([`Instrument::set_string_weighting`]): the string's impedance over
     /// [`WEIGHT_REFERENCE_Z0`]. Schelleng's limits are both proportional to `Z0` (with the
-    /// dashpot bridge `R = 2 Q1 Z0 / pi`, docs/parameters.md), so one force parameter then
+    /// dashpot bridge `R = 2 Q1 Z0 / pi`, docs/literature-values.md), so one force parameter then
     /// keeps the same place in every string's window, as a player leans into the heavy
     /// strings.
     pub fn string_weight(self, index: usize) -> f64 {
@@ -214,7 +214,7 @@ impl InstrumentKind {
     }
 
     /// The string a note goes to, if the instrument can play it.
-    /// Vibrating length of the open strings, m (docs/parameters.md §1.4: violin 0.32,
+    /// Vibrating length of the open strings, m (docs/literature-values.md §1.4: violin 0.32,
     /// viola 0.38, cello 0.69).
     pub fn string_length_m(self) -> f64 {
         match self {
@@ -562,7 +562,7 @@ impl StringBank for WaveguideBank {
             // gain (above its gain at the fundamental): Q about 640 per period here. The
             // estimate takes Q1 5 % high, enough for the default note's tail (the tail
             // test); a loud note's tail can still outlast it. A DC blocker in the loop is
-            // the fix (docs/playing-space.md, "With the bow hair too").
+            // the fix (docs/playing-space.md, "Weighted strings").
             let q = RING_OUT_Q_MARGIN * s.spec().q1;
             longest = longest.max(ring_out_s(s.energy_j(), s.fundamental_hz(), q));
         }

@@ -6,7 +6,7 @@
 //! object (a hinge pin's bending modes, a slate board's plate modes, a wine glass's (n, 0)
 //! bell modes, a brake disc's out-of-plane modes) with decay times typical of the material;
 //! friction parameters start from the Sound Design Toolkit's rubbing preset
-//! (docs/parameters.md §1.1, §1.7) and are adjusted so each preset locks into stick-slip.
+//! (docs/literature-values.md §1.1, §1.7) and are adjusted so each preset locks into stick-slip.
 //!
 //! **Why each preset sings.** Steady sliding at velocity `v` is unstable, so the object
 //! self-excites even when the exciter lands gently, when the friction force falls with
@@ -34,7 +34,7 @@ use super::modal::{Exciter, FrictionPair, ModalObject, ModeSpec, PairOutput};
 /// The built-in rubbed scenes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum RubbedPreset {
-    /// Paper A's modal scenario: the authors' SMAC-03 script (docs/parameters.md §1.7 row 1).
+    /// Paper A's modal scenario: the authors' SMAC-03 script (docs/literature-values.md §1.7 row 1).
     PaperModal,
     DoorHinge,
     Chalk,

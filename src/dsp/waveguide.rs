@@ -16,12 +16,12 @@
 //!
 //! | symbol | meaning | unit | source |
 //! |---|---|---|---|
-//! | `Z0` | characteristic impedance `sqrt(T mu)` | kg/s | docs/parameters.md §1.4 |
+//! | `Z0` | characteristic impedance `sqrt(T mu)` | kg/s | docs/literature-values.md §1.4 |
 //! | `B` | inharmonicity `pi^2 E I / (T L^2)`: `f_n = n F sqrt(1 + B n^2)` | 1 | §1.4 |
 //! | `Q1` | quality factor of the fundamental (paper A: 500) | 1 | §1.4 |
 //! | `Q_hi` | quality factor at ten times the fundamental | 1 | Artifastring decays, §1.4 |
 //! | `beta` | bow distance from the bridge over the vibrating length | 1 | player |
-//! | `Z_t` | torsional impedance at the surface, [`TORSION_IMPEDANCE_RATIO`] `Z0` | kg/s | CLM Stradivarius model (Serafin, Smith), docs/parameters.md §1.4 |
+//! | `Z_t` | torsional impedance at the surface, [`TORSION_IMPEDANCE_RATIO`] `Z0` | kg/s | CLM Stradivarius model (Serafin, Smith), docs/literature-values.md §1.4 |
 //! | `c_t` | torsional wave speed, [`TORSION_SPEED_RATIO`] times the transverse | m/s | same |
 //! | `k_h` | bow hair stiffness in the bowing direction, [`BOW_HAIR_STIFFNESS_N_PER_M`] | N/m | Matusiak et al. lumped hair, §1.5 |
 //! | `d_h` | bow hair damping in the bowing direction, [`BOW_HAIR_DAMPING_KG_PER_S`] | kg/s | same |
@@ -40,7 +40,7 @@
 //! the ribbon yields in the bowing direction, a spring `k_h` with a dashpot `d_h` in
 //! parallel (massless; Matusiak, Chatziioannou and van Walstijn's lumped hair, whose
 //! constants were inverse-fitted to measured monochord transients: 4.83e4 N/m and
-//! 5.77 kg/s, docs/parameters.md §1.5). Its admittance `s / (k_h + d_h s)` is the same
+//! 5.77 kg/s, docs/literature-values.md §1.5). Its admittance `s / (k_h + d_h s)` is the same
 //! high-pass form as the torsion's, with corner `k_h / d_h` (1.3 kHz) and admittance
 //! `1 / d_h` above it, in series with the string at the contact: the friction law sees the
 //! string's surface velocity minus the hair's. While the string sticks the hair holds a
@@ -200,13 +200,13 @@ impl HighPassAdmittance {
 }
 
 /// Stiffness of the bow hair in the bowing direction, N/m (Matusiak, Chatziioannou and van
-/// Walstijn's lumped hair, inverse-fitted to monochord transients: docs/parameters.md §1.5).
+/// Walstijn's lumped hair, inverse-fitted to monochord transients: docs/literature-values.md §1.5).
 pub const BOW_HAIR_STIFFNESS_N_PER_M: f64 = 4.83e4;
 /// Damping of the bow hair in the bowing direction, kg/s (the same source).
 pub const BOW_HAIR_DAMPING_KG_PER_S: f64 = 5.77;
 
 /// Torsional over transverse wave speed (CLM's Stradivarius model after Serafin and Smith,
-/// docs/parameters.md: 5.2).
+/// docs/literature-values.md: 5.2).
 pub const TORSION_SPEED_RATIO: f64 = 5.2;
 /// Torsional over transverse characteristic impedance, both at the string's surface
 /// (the same model: 1.8 against 0.55 kg/s).

@@ -9,7 +9,7 @@
 //! lifted); forces between 0 and [`FORCE_LOG_MIN_N`] all sit on the bottom edge, where a
 //! log scale cannot show them.
 //!
-//! **Schelleng window** (docs/parameters.md §1.6). For a bow at `beta` moving at `v_b` on a
+//! **Schelleng window** (docs/literature-values.md §1.6). For a bow at `beta` moving at `v_b` on a
 //! string of impedance `Z0`, with static and dynamic friction coefficients `mu_s`, `mu_d`,
 //! Helmholtz motion lives between
 //!
@@ -310,7 +310,7 @@ mod tests {
 
     #[test]
     fn schelleng_max_matches_paper_a_cello_d() {
-        // docs/parameters.md §1.6: Z0 0.506, v_b 0.1, beta 0.1, delta mu 0.2 gives about 5.1 N.
+        // docs/literature-values.md §1.6: Z0 0.506, v_b 0.1, beta 0.1, delta mu 0.2 gives about 5.1 N.
         let w = cello_d(0.1);
         assert_eq!(w.z0_kg_per_s, 0.506);
         assert!((w.max_force_n(0.1) - 5.06).abs() < 1e-9);

@@ -1,7 +1,7 @@
 //! Fitting a passive modal bridge admittance to measured data (issue 5), after Maestre,
 //! Scavone & Smith, "Digital modeling of bridge driving-point admittances from
 //! measurements on violin-family instruments" (SMAC 2013), as used by paper B (Maestre,
-//! Spa & Smith, finite-width thermal friction; docs/models.md §B, docs/parameters.md §2).
+//! Spa & Smith, finite-width thermal friction; docs/models.md §B, docs/literature-values.md §2).
 //!
 //! The model is the continuous-time driving-point admittance at the bridge top,
 //!

@@ -1,7 +1,7 @@
 //! Synthetic admittance with known modes: the ground truth of the fit tests, and the
 //! source of the shipped generic bridges (`assets/bridges/`). Generic, not measured: the
 //! mode tables below are plausible values seeded from published signature-mode
-//! frequencies (docs/models.md §B, docs/parameters.md §2), not any instrument's data.
+//! frequencies (docs/models.md §B, docs/literature-values.md §2), not any instrument's data.
 
 use super::bridge::{Admittance, BridgeMode, BridgeModes, C64};
 use super::data::{entry_position, AdmittanceData};

@@ -109,7 +109,7 @@ pub struct BristleParams {
 }
 
 impl BristleParams {
-    /// Paper A's modal scenario (the authors' SMAC-03 script, docs/parameters.md §1.7 row 1).
+    /// Paper A's modal scenario (the authors' SMAC-03 script, docs/literature-values.md §1.7 row 1).
     pub fn modal_scenario() -> Self {
         Self {
             sigma0_n_per_m: 1e4,
@@ -145,7 +145,7 @@ impl BristleParams {
 
     /// The plugin's string (every instrument, every note): [`Self::waveguide_string`] with
     /// a bristle three times stiffer. Chosen by the playing-space map (docs/playing-space.md,
-    /// "The stiffer bristle, adopted"): every third semitone at 48 kHz, with the intonation
+    /// "Bristle stiffness"): every third semitone at 48 kHz, with the intonation
     /// table re-fitted, LuGre / elasto-plastic nominal cells in tune 12 -> 27 and 25 -> 35 of
     /// 96 and window cells in Helmholtz motion 105 -> 119 and 109 -> 123 of 576.
     /// Its `g` is not monotone while the contact slips, which the solver's bracket handles

@@ -125,7 +125,7 @@ pub struct ThermalParams {
 }
 
 impl Default for ThermalParams {
-    /// Paper B publishes none of these (docs/parameters.md §1.3: [NF]). Chosen by
+    /// Paper B publishes none of these (docs/literature-values.md §1.3: [NF]). Chosen by
     /// measurement (`colophony bench thermal-constants`, docs/playing-space.md, "Choosing
     /// the thermal constants") so that the contact sticks across each string's Schelleng
     /// window, the plugin's default 1 N lies inside every string's window, paper B's own
@@ -136,7 +136,7 @@ impl Default for ThermalParams {
     ///   milliseconds, as eq. (1) alone does, slides steadily at every force (its sliding
     ///   equilibrium does not depend on the speed) and, where it sticks, flattens by a
     ///   semitone; cooling rates of 1e4-1e5 /s while sliding are the order of the
-    ///   secondary source in docs/parameters.md §1.3;
+    ///   secondary source in docs/literature-values.md §1.3;
     /// - **heating per unit of real contact area**, referred to paper B's 300 N/m (rosin
     ///   junctions yield plastically, so the real contact area grows with the load: Smith
     ///   and Woodhouse 2000), so the contact's temperature does not grow with the force;
@@ -176,7 +176,7 @@ impl ThermalParams {
     /// 300 N/m (inside the 10-25 K swing reported for rosin) at every sliding speed; a
     /// slip of ~1 ms at ~0.5 m/s relaxes toward it (`C_C |v| ~ 1000 /s`); `mu` 0.8 to 0.3
     /// over 2-14 K. It slides steadily across most of the window (docs/playing-space.md,
-    /// "Why the thermal model slides").
+    /// "Why the thermal model slides with eq. (1) as written").
     pub fn paper_b_eq1() -> Self {
         Self {
             mu_cold: 0.8,
@@ -193,8 +193,8 @@ impl ThermalParams {
     }
 }
 
-/// The thermal constants of the bulk-cooled contact (docs/playing-space.md, "Why the
-/// thermal model slides"): bulk cooling in 0.3 ms, heating per unit of contact area at
+/// The thermal constants of the bulk-cooled contact (docs/playing-space.md, "Choosing the
+/// thermal constants"): bulk cooling in 0.3 ms, heating per unit of contact area at
 /// 300 N/m, `C_C` 5000 /m, `C_H` 1500 K m/J, the rest as [`ThermalParams::paper_b_eq1`].
 /// Measured: it sticks in most of the window's upper two thirds, and flattens steeply
 /// with the force.
@@ -303,7 +303,7 @@ pub struct HairParams {
 
 impl Default for HairParams {
     /// Horizontal: the lumped ribbon of Matusiak's code (k 4.83e4 N/m, d 5.77 kg/s over
-    /// 1 cm; docs/parameters.md §1.5) per metre. Vertical: [NF] in paper B; a ribbon of ~50
+    /// 1 cm; docs/literature-values.md §1.5) per metre. Vertical: [NF] in paper B; a ribbon of ~50
     /// active hairs (0.1 g/m each, so 5 g/m) on the bow's vertical stiffness, chosen at the
     /// same per-metre stiffness and damping as the horizontal hair.
     fn default() -> Self {
@@ -335,7 +335,7 @@ pub struct ThermalStringSpec {
 }
 
 impl ThermalStringSpec {
-    /// The cello's four strings C, G, D, A (Z0 from docs/parameters.md §1.4 and §1.7), 0.69 m.
+    /// The cello's four strings C, G, D, A (Z0 from docs/literature-values.md §1.4 and §1.7), 0.69 m.
     pub fn cello_strings() -> [Self; 4] {
         [
             (65.41, 1.88),
@@ -350,7 +350,7 @@ impl ThermalStringSpec {
         })
     }
 
-    /// Cello open C (docs/parameters.md §1.7: Z0 ~ 1.85-1.91 kg/s, L 0.67-0.69 m).
+    /// Cello open C (docs/literature-values.md §1.7: Z0 ~ 1.85-1.91 kg/s, L 0.67-0.69 m).
     pub fn cello_c() -> Self {
         Self {
             f0_hz: 65.41,
@@ -396,7 +396,7 @@ pub struct ThermalFrame {
 }
 
 /// The float type of the contact: the nodes' state and solve and the thermal grid (the
-/// waves, terminations and bridge stay f64). Chosen by measurement (README, Table 1): on
+/// waves, terminations and bridge stay f64). Chosen by measurement (docs/performance.md, "Paper B's instrument"): on
 /// paper B's Figure 6 bow at N_B 60, f32 renders differ from f64 by -105 dB over the
 /// attack and -93 dB in the steady motion, with the same pitch and harmonics (0.00001
 /// dB), far below the node count's own error (-35 dB against N_B 120), and the node and

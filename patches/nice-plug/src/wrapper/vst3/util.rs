@@ -1,4 +1,3 @@
-use std::cmp;
 #[cfg(feature = "editor")]
 use vst3::Steinberg::FIDString;
 use vst3::Steinberg::Vst::TChar;
