@@ -60,6 +60,15 @@ fn automated_score(clap: &mut HostedPlugin, sample_rate: f64) -> Score {
         );
         score.push(at(t) + 131, clap.plain("Bow Force", 0.9 + 0.1 * i as f64));
     }
+    // A note expression through each format's own event: the brightness moves the bow
+    // position of the note's string (VST3's kBrightnessTypeID, CLAP's brightness).
+    score.push(
+        at(0.3) + 19,
+        Event::Brightness {
+            key: 50,
+            value: 0.8,
+        },
+    );
     score.push(at(1.0), Event::note_off(50));
     score
 }

@@ -95,6 +95,11 @@ pub enum Event {
         key: u8,
         semitones: f64,
     },
+    /// A CLAP note expression: the brightness of `key`'s note, 0 ..= 1.
+    Brightness {
+        key: u8,
+        value: f64,
+    },
     /// A parameter change in CLAP units (see [`HostedPlugin::plain`]).
     Param {
         id: ClapId,
@@ -570,6 +575,12 @@ fn push_event(buffer: &mut EventBuffer, t: u32, event: Event, port: u16, clap_no
             Pckn::new(port, 0u16, key as u16, Match::All),
             NoteExpressionType::Tuning,
             semitones,
+        )),
+        Event::Brightness { key, value } => buffer.push(&NoteExpressionEvent::new(
+            t,
+            Pckn::new(port, 0u16, key as u16, Match::All),
+            NoteExpressionType::Brightness,
+            value,
         )),
     }
 }

@@ -614,24 +614,31 @@ impl Vst3Plugin {
                 }
             }
             Event::Tuning { key, semitones } => {
-                let mut e = VstEvent {
-                    busIndex: 0,
-                    sampleOffset: offset,
-                    ppqPosition: 0.0,
-                    flags: 0,
-                    r#type: EventTypes_::kNoteExpressionValueEvent as u16,
-                    // SAFETY: every union member is plain data.
-                    __field0: unsafe { std::mem::zeroed::<Event__type0>() },
-                };
-                // kTuningTypeID: +-120 semitones over 0..1.
-                e.__field0.noteExpressionValue = NoteExpressionValueEvent {
-                    typeId: 2,
-                    noteId: key as i32,
-                    value: 0.5 + semitones / 240.0,
-                };
-                self.events.events.borrow_mut().push(e);
+                self.note_expression(offset, key, 2, 0.5 + semitones / 240.0)
             }
+            // kBrightnessTypeID, 0..1.
+            Event::Brightness { key, value } => self.note_expression(offset, key, 5, value),
         }
+    }
+
+    /// A VST3 note expression value event: `type_id` (kTuningTypeID 2: +-120 semitones
+    /// over 0..1; kBrightnessTypeID 5) on the note of `key`, at `offset`.
+    fn note_expression(&self, offset: i32, key: u8, type_id: u32, value: f64) {
+        let mut e = VstEvent {
+            busIndex: 0,
+            sampleOffset: offset,
+            ppqPosition: 0.0,
+            flags: 0,
+            r#type: EventTypes_::kNoteExpressionValueEvent as u16,
+            // SAFETY: every union member is plain data.
+            __field0: unsafe { std::mem::zeroed::<Event__type0>() },
+        };
+        e.__field0.noteExpressionValue = NoteExpressionValueEvent {
+            typeId: type_id,
+            noteId: key as i32,
+            value,
+        };
+        self.events.events.borrow_mut().push(e);
     }
 
     /// Renders `frames` frames in blocks of `block` frames, each event of `score` in the
