@@ -36,10 +36,16 @@ fn demos() -> Vec<Demo> {
 }
 
 fn read_wav(path: &Path) -> (Vec<f64>, f64) {
-    let mut reader = hound::WavReader::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut reader =
+        hound::WavReader::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let spec = reader.spec();
     assert_eq!(spec.channels, 1, "{}: the demos are mono", path.display());
-    assert_eq!(spec.bits_per_sample, 16, "{}: the demos are 16-bit", path.display());
+    assert_eq!(
+        spec.bits_per_sample,
+        16,
+        "{}: the demos are 16-bit",
+        path.display()
+    );
     let samples = reader
         .samples::<i16>()
         .map(|s| f64::from(s.expect("sample")) / 32768.0)
@@ -48,7 +54,9 @@ fn read_wav(path: &Path) -> (Vec<f64>, f64) {
 }
 
 fn rms_db(x: &[f64]) -> f64 {
-    10.0 * (x.iter().map(|v| v * v).sum::<f64>() / x.len().max(1) as f64).max(1e-30).log10()
+    10.0 * (x.iter().map(|v| v * v).sum::<f64>() / x.len().max(1) as f64)
+        .max(1e-30)
+        .log10()
 }
 
 /// The fundamental of a window by YIN (de Cheveigne and Kawahara 2002): the first lag
@@ -110,7 +118,12 @@ fn every_demo_command_renders_its_file_with_the_same_length_level_and_pitch() {
             .arg(&fresh)
             .status()
             .expect("run colophony");
-        assert!(status.success(), "{}: `colophony render {}` failed", demo.file, demo.args.join(" "));
+        assert!(
+            status.success(),
+            "{}: `colophony render {}` failed",
+            demo.file,
+            demo.args.join(" ")
+        );
         let (kept, fs) = read_wav(&root().join("assets/demos").join(&demo.file));
         let (now, fs_now) = read_wav(&fresh);
         assert_eq!(fs, fs_now, "{}: sample rate", demo.file);
