@@ -155,6 +155,29 @@ pub struct Performance {
     pub bridge: Option<colophony::dsp::bridge_data::BridgeModes>,
 }
 
+impl Performance {
+    /// The plugin at its default parameters playing `instrument` with `point_law` (`None`:
+    /// paper B's thermal model), unity gain, in blocks of 512 at `sample_rate_hz`.
+    pub fn plugin_defaults(
+        instrument: colophony::dsp::instrument::InstrumentKind,
+        point_law: Option<colophony::dsp::friction::FrictionModel>,
+        sample_rate_hz: f64,
+    ) -> Self {
+        let params = colophony::params::ColophonyParams::default();
+        let mut setup = params.setup();
+        setup.instrument = instrument;
+        setup.point_law = point_law;
+        Self {
+            setup,
+            bow: params.bow(),
+            gain: 1.0,
+            sample_rate_hz,
+            block: 512,
+            bridge: None,
+        }
+    }
+}
+
 /// Plays `events` and returns the output the plugin would give on each channel, through
 /// the last event and the ring-out (until silent or below [`QUIET_LEVEL`] for
 /// [`QUIET_S`], at most [`MAX_TAIL_S`]). `progress` is

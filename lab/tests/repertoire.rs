@@ -110,18 +110,7 @@ fn play(phrase: &Phrase, law: Option<FrictionModel>) -> Vec<(u8, f64)> {
     }
     // Offs before ons at the same sample: legato, one bow.
     events.sort_by_key(|e| (e.sample, matches!(e.event, MidiEvent::NoteOn(..))));
-    let params = colophony::params::ColophonyParams::default();
-    let mut setup = params.setup();
-    setup.instrument = phrase.kind;
-    setup.point_law = law;
-    let how = Performance {
-        setup,
-        bow: params.bow(),
-        gain: 1.0,
-        sample_rate_hz: FS,
-        block: 512,
-        bridge: None,
-    };
+    let how = Performance::plugin_defaults(phrase.kind, law, FS);
     let audio: Vec<f64> = perform(&events, &how, |_, _| {})
         .expect("the phrase plays")
         .into_iter()

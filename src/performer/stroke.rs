@@ -9,9 +9,16 @@
 //! string.
 //!
 //! The note velocity sets the attack: how fast the bow reaches its speed (geometrically
-//! from [`ATTACK_SLOWEST_S`] at velocity 0 to [`ATTACK_FASTEST_S`] at 127) and a landing
+//! from [`ATTACK_SLOWEST_S`] at velocity 0 to [`ATTACK_FASTEST_S`] at 127), a landing
 //! accent (extra force, up to [`ACCENT_MAX`] of the bow force at velocity 127, none at
-//! 64 and below, decaying over [`ACCENT_S`]: the bite of a martelé). Guettler's attack diagram
+//! 64 and below, decaying over [`ACCENT_S`]: the bite of a martelé), and below 64 a gentle
+//! start: a soft note sets out with a slower and lighter bow, both rising to the asked
+//! bow over [`ONSET_RISE_S`], as a player's piano entry. Speed and force rise together, so
+//! the bow keeps its place in Schelleng's window (both of its limits are proportional to
+//! the bow speed) while the level follows the speed (Helmholtz amplitude `v_b / beta`).
+//! The bow only ever speeds up toward the asked bow: a bow that slows down under a string
+//! still carrying a louder motion makes extra slips, so a hard note gets its bite from
+//! the landing accent and the fast ramp, never from a speed above the asked one. Guettler's attack diagram
 //! (bow force against bow acceleration from rest) marks which pairs give Helmholtz motion
 //! from the first slip. Measured on this model (cello D3, hyperbolic law, beta 0.1,
 //! 0.1 m/s, forces 0.2-4.5 N, accelerations 0.25-32 m/s^2 and a bow landing at speed,
@@ -56,6 +63,12 @@ pub const ATTACK_SLOWEST_S: f64 = 0.12;
 pub const ACCENT_MAX: f64 = 0.5;
 /// Decay time of the landing accent, s.
 pub const ACCENT_S: f64 = 0.04;
+/// The gentle start's depth: a note of velocity `v` (0..=1) below 64/127 sets out at
+/// `2^(ONSET_OCTAVES_PER_VELOCITY (v - 64/127))` of the asked bow speed and force: x0.25
+/// (-12.1 dB) at velocity 0, x0.48 (-6.4 dB) at 30, x1 from 64 up.
+pub const ONSET_OCTAVES_PER_VELOCITY: f64 = 4.0;
+/// Time constant of the gentle start's rise to the asked bow, s.
+pub const ONSET_RISE_S: f64 = 0.2;
 
 /// The note velocity as a MIDI 7-bit step, 0..=1: the plugin receives velocities as f32
 /// from CLAP, VST3 and MIDI files; stepping them makes every path play the same attack.
@@ -79,6 +92,10 @@ pub struct Stroke {
     /// Extra force, a fraction of the bow force, and its decay per sample.
     accent: f64,
     accent_decay: f64,
+    /// The gentle start's departure from 1 (on bow speed and force alike; 0 or below), and
+    /// its decay per sample.
+    onset: f64,
+    onset_decay: f64,
     /// Whether a stroke has started since activation (the first is down).
     started: bool,
 }
@@ -94,6 +111,8 @@ impl Stroke {
             step: 0.0,
             accent: 0.0,
             accent_decay: (-1.0 / (ACCENT_S * fs)).exp(),
+            onset: 0.0,
+            onset_decay: (-1.0 / (ONSET_RISE_S * fs)).exp(),
             started: false,
         }
     }
@@ -113,6 +132,7 @@ impl Stroke {
         self.speed = 0.0;
         let mezzo = 64.0 / 127.0;
         self.accent = ACCENT_MAX * ((v - mezzo) / (1.0 - mezzo)).max(0.0);
+        self.onset = (ONSET_OCTAVES_PER_VELOCITY * (v - mezzo)).min(0.0).exp2() - 1.0;
     }
 
     /// The bow direction of the stroke in progress (+1 down, -1 up).
@@ -121,9 +141,27 @@ impl Stroke {
     }
 
     /// Advances one sample; returns (the factor on the asked bow velocity, the factor on
-    /// the asked force). Two comparisons once the attack is over.
+    /// the asked force). Three comparisons once the attack is over.
     #[inline]
     pub fn tick(&mut self) -> (f64, f64) {
+        let (speed, force) = self.tick_ramp();
+        if self.onset == 0.0 {
+            return (speed, force);
+        }
+        self.onset *= self.onset_decay;
+        // A thousandth of the bow (0.01 dB): done, after at most 1.32 s, and this sample
+        // already plays the asked bow (the settled stroke's factors, exactly).
+        if self.onset.abs() < 1e-3 {
+            self.onset = 0.0;
+            return (speed, force);
+        }
+        let level = 1.0 + self.onset;
+        (speed * level, force * level)
+    }
+
+    /// The ramp to full speed and the landing accent, one sample.
+    #[inline]
+    fn tick_ramp(&mut self) -> (f64, f64) {
         let target = self.direction;
         if self.speed != target {
             self.speed = if target > 0.0 {
@@ -146,7 +184,7 @@ impl Stroke {
     /// [`Stroke::tick`] would return `(direction, 1)` and change nothing.
     #[inline]
     pub fn is_settled(&self) -> bool {
-        self.speed == self.direction && self.accent == 0.0
+        self.speed == self.direction && self.accent == 0.0 && self.onset == 0.0
     }
 }
 
@@ -177,12 +215,13 @@ mod tests {
     #[test]
     fn a_harder_note_reaches_full_speed_sooner_and_lands_with_more_force() {
         // Samples to full speed and the first sample's force factor, per velocity.
+        // The ramp alone (the onset level is the next test's).
         let attack = |velocity: f64| {
             let mut s = Stroke::new(FS);
             s.start(StrokeMode::Down, velocity);
-            let force = s.tick().1;
+            let force = s.tick_ramp().1;
             let mut n = 1;
-            while s.tick().0 < 1.0 {
+            while s.tick_ramp().0 < 1.0 {
                 n += 1;
             }
             (n as f64 / FS, force)
@@ -196,6 +235,55 @@ mod tests {
         assert!(slow > mid && mid > fast);
         assert_eq!((soft, mid_force), (1.0, 1.0));
         assert!((hard - (1.0 + ACCENT_MAX)).abs() < 0.01, "{hard}");
+    }
+
+    #[test]
+    fn a_soft_note_starts_slower_and_lighter_together_then_rises_and_never_overshoots() {
+        // The stroke's factors `t` seconds after the landing, and the same stroke's without
+        // its gentle start (the ramp and the accent alone).
+        let at = |velocity: f64, t: f64| {
+            let mut s = Stroke::new(FS);
+            s.start(StrokeMode::Down, velocity);
+            let mut plain = s;
+            plain.onset = 0.0;
+            let (mut out, mut without) = ((0.0, 0.0), (0.0, 0.0));
+            for _ in 0..(t * FS) as usize {
+                out = s.tick();
+                without = plain.tick();
+            }
+            (out, without)
+        };
+        for velocity in [0.0, 30.0 / 127.0, 64.0 / 127.0, 120.0 / 127.0, 1.0] {
+            for t in [0.005, 0.02, 0.08, 0.3] {
+                let ((speed, force), (ramp, landing)) = at(velocity, t);
+                // Speed and force carry the same level, so the bow keeps its place in
+                // Schelleng's window (1e-12: rounding of two products) ...
+                assert!((speed / ramp - force / landing).abs() < 1e-12, "{velocity} at {t} s");
+                // ... and the bow never runs faster than the ramp asks.
+                assert!(speed <= ramp, "{velocity} at {t} s");
+            }
+        }
+        // At 0.15 s every ramp is over; the level is the gentle start's, risen by
+        // exp(-0.15 s / ONSET_RISE_S) of its depth.
+        let level = |velocity: f64| at(velocity, 0.15).0 .0;
+        let left = (-0.15 / ONSET_RISE_S).exp();
+        for velocity in [0.0, 30.0 / 127.0] {
+            let depth = (ONSET_OCTAVES_PER_VELOCITY * (velocity - 64.0 / 127.0)).exp2() - 1.0;
+            // 1e-3: the rise is applied per sample; a sample's offset is 0.01 % of it.
+            assert!((level(velocity) - (1.0 + depth * left)).abs() < 1e-3, "{velocity}");
+        }
+        assert!(level(30.0 / 127.0) < level(50.0 / 127.0));
+        assert_eq!(level(64.0 / 127.0), 1.0);
+        assert_eq!(level(1.0), 1.0);
+        // Risen: after 1.4 s (velocity 0's depth falls under a thousandth after
+        // ONSET_RISE_S ln(753), 1.32 s) the stroke plays the asked bow exactly.
+        let mut s = Stroke::new(FS);
+        s.start(StrokeMode::Down, 0.0);
+        for _ in 0..(1.4 * FS) as usize {
+            s.tick();
+        }
+        assert!(s.is_settled());
+        assert_eq!(s.tick(), (1.0, 1.0));
     }
 
     #[test]

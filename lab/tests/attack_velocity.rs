@@ -1,0 +1,128 @@
+//! Note velocity shapes the attack, through the performer at the plugin's defaults: a
+//! separate note at velocity 120 starts audibly louder than one at velocity 30 (the stroke's
+//! onset level: a faster and heavier bow, scaled together so the bow keeps its place in
+//! Schelleng's window), and both still speak, at the note's pitch, soon after they land.
+
+use colophony::analysis::{cents, peak_frequency_hz};
+use colophony::dsp::friction::FrictionModel;
+use colophony::dsp::instrument::InstrumentKind;
+use colophony_lab::midi_file::{perform, MidiEvent, Performance, Timed};
+
+const FS: f64 = 48_000.0;
+
+/// One separate note at `velocity` (1..=127), held 1 s: the audio.
+fn play(kind: InstrumentKind, law: Option<FrictionModel>, note: u8, velocity: u8) -> Vec<f64> {
+    let events = [
+        Timed {
+            sample: 0,
+            channel: 0,
+            event: MidiEvent::NoteOn(note, velocity),
+        },
+        Timed {
+            sample: FS as u64,
+            channel: 0,
+            event: MidiEvent::NoteOff(note),
+        },
+    ];
+    let how = Performance::plugin_defaults(kind, law, FS);
+    perform(&events, &how, |_, _| {})
+        .expect("the note plays")
+        .into_iter()
+        .map(f64::from)
+        .take(FS as usize)
+        .collect()
+}
+
+/// The peak level, dB: the largest RMS over 10 ms windows (hop 2.5 ms), the level a
+/// listener hears, not one sample of a transient's spike.
+fn peak_db(x: &[f64]) -> f64 {
+    let (w, hop) = ((0.01 * FS) as usize, (0.0025 * FS) as usize);
+    let mut best = 0.0f64;
+    let mut i = 0;
+    while i + w <= x.len() {
+        let ms = x[i..i + w].iter().map(|v| v * v).sum::<f64>() / w as f64;
+        best = best.max(ms);
+        i += hop;
+    }
+    10.0 * best.max(1e-24).log10()
+}
+
+/// Spectral centroid, Hz, of `x` (Hann window, a plain DFT up to 8 kHz in 10 Hz steps:
+/// the attack's brightness).
+fn centroid_hz(x: &[f64]) -> f64 {
+    let n = x.len();
+    let w: Vec<f64> = x
+        .iter()
+        .enumerate()
+        .map(|(i, v)| v * (0.5 - 0.5 * (2.0 * std::f64::consts::PI * i as f64 / n as f64).cos()))
+        .collect();
+    let (mut num, mut den) = (0.0, 0.0);
+    for k in 1..800 {
+        let f = 10.0 * k as f64;
+        let step = 2.0 * std::f64::consts::PI * f / FS;
+        let (mut re, mut im) = (0.0, 0.0);
+        for (i, v) in w.iter().enumerate() {
+            re += v * (step * i as f64).cos();
+            im -= v * (step * i as f64).sin();
+        }
+        let mag = (re * re + im * im).sqrt();
+        num += f * mag;
+        den += mag;
+    }
+    num / den.max(1e-30)
+}
+
+fn hz(note: u8) -> f64 {
+    440.0 * 2f64.powf((note as f64 - 69.0) / 12.0)
+}
+
+#[test]
+fn a_harder_note_velocity_starts_louder_and_both_speak_at_the_notes_pitch() {
+    let laws = [
+        Some(FrictionModel::Hyperbolic),
+        Some(FrictionModel::Stribeck),
+        Some(FrictionModel::LuGre),
+        Some(FrictionModel::ElastoPlastic),
+        None,
+    ];
+    let mut report = Vec::new();
+    let mut failures = Vec::new();
+    for kind in InstrumentKind::ALL {
+        let (low, high) = kind.note_range();
+        // The open strings' span and an octave above: every string, stopped and open.
+        for note in (low..=(high - 19).min(low + 31)).step_by(7) {
+            for law in laws {
+                let soft = play(kind, law, note, 30);
+                let hard = play(kind, law, note, 120);
+                let first = (0.08 * FS) as usize;
+                let louder = peak_db(&hard[..first]) - peak_db(&soft[..first]);
+                let brighter = centroid_hz(&hard[..first]) / centroid_hz(&soft[..first]);
+                // At the note's pitch once sounding: 0.6-0.9 s (20 periods of the lowest
+                // note), within 15 cents (the repertoire criterion for a sustained note).
+                let pitch = |x: &[f64]| {
+                    let w = &x[(0.6 * FS) as usize..(0.9 * FS) as usize];
+                    cents(peak_frequency_hz(w, FS, hz(note), 80.0), hz(note))
+                };
+                let (c_soft, c_hard) = (pitch(&soft), pitch(&hard));
+                let name = law.map_or("thermal", |l| l.name());
+                report.push(format!(
+                    "{:>6} {note:>3} {name:>14}: first 80 ms {louder:+5.2} dB, centroid x{brighter:4.2}; pitch at 0.6-0.9 s {c_soft:+6.1} / {c_hard:+6.1} cents",
+                    kind.name()
+                ));
+                // The audible difference between velocities 30 and 120: 3 dB in the
+                // first 80 ms' peak, or 20 % in their spectral centroid.
+                if louder < 3.0 && brighter < 1.2 {
+                    failures.push(format!("{} {note} {name}: {louder:+.2} dB, x{brighter:.2}", kind.name()));
+                }
+                if c_soft.abs() > 15.0 || c_hard.abs() > 15.0 {
+                    failures.push(format!(
+                        "{} {note} {name}: off its pitch ({c_soft:+.1} / {c_hard:+.1} cents)",
+                        kind.name()
+                    ));
+                }
+            }
+        }
+    }
+    println!("{}", report.join("\n"));
+    assert!(failures.is_empty(), "{} failures:\n{}", failures.len(), failures.join("\n"));
+}
