@@ -793,6 +793,13 @@ impl Performer {
         // The 7-bit value of a data byte.
         let byte = (v * 127.0).round() as u8;
         match cc {
+            // The sustain pedal: released notes keep their fingers down and ring on at
+            // their stopped pitch until it is let go (still routed through the map).
+            64 => {
+                for engine in self.engines() {
+                    engine.set_fingers_held(byte >= 64);
+                }
+            }
             101 => return self.gesture.rpn.0 = byte,
             100 => return self.gesture.rpn.1 = byte,
             6 | 38 if self.gesture.rpn == (0, 0) => {

@@ -42,8 +42,11 @@ fn bow_then_lift(
 ) -> Vec<f64> {
     let fs = plugin.sample_rate();
     let instrument = plugin.text("Instrument", &instrument_text(kind));
+    // The sustain pedal down: the note-off lifts the bow only and the stopped string
+    // rings on at its pitch (its free decay).
     let score = Score::new()
         .at(0, instrument)
+        .at(0, Event::Controller { cc: 64, value: 127 })
         .at(0, Event::note_on(note))
         .at(secs(bow_s, fs), Event::note_off(note));
     let out = plugin.render(secs(total_s, fs) as usize, BLOCK, &score);
@@ -754,8 +757,11 @@ fn quality_and_string_switches_during_notes_keep_sounding_in_tune_without_clicks
             plugin.text("String", "IV (lowest)"),
             plugin.text("Quality", "Auto"),
         ];
+        // The sustain pedal down: the last note's free decay is measured after its
+        // note-off, at its stopped pitch.
         let mut score = Score::new()
             .at(0, plugin.text("Friction Model", model))
+            .at(0, Event::Controller { cc: 64, value: 127 })
             .at(0, Event::note_on(57));
         for (at, event) in switch_at.iter().zip(events) {
             score.push(*at, event);

@@ -239,6 +239,9 @@ pub fn render_frames(
             instrument.update_sleep();
         }
         if Some(i) == release {
+            // `--release` lifts the bow only: the finger stays down and the stopped string
+            // rings on at its pitch (its free decay, which the tools measure).
+            instrument.set_fingers_held(true);
             instrument.note_off(settings.note);
         }
         each(&instrument.tick(settings.bow))?;

@@ -26,9 +26,12 @@ pub trait Engine {
     fn note_on_gliding(&mut self, note: u8, _glide_s: f64) -> Option<usize> {
         self.note_on(note)
     }
-    /// Lifts the bow from `note`.
+    /// Lifts the bow from `note` (and, on strings, the finger that stops it).
     fn note_off(&mut self, note: u8);
     fn all_notes_off(&mut self);
+    /// Whether released notes keep their fingers down (the sustain pedal): their strings
+    /// ring on at the stopped pitch until it is let go (engines without fingers ignore it).
+    fn set_fingers_held(&mut self, _held: bool) {}
     /// Pitch bend, semitones (engines without pitch ignore it).
     fn set_pitch_bend(&mut self, _semitones: f64) {}
     /// String `string`'s note's own expression (engines without strings ignore it).
@@ -71,6 +74,9 @@ impl<B: StringBank> Engine for FourStrings<B> {
     }
     fn all_notes_off(&mut self) {
         FourStrings::all_notes_off(self)
+    }
+    fn set_fingers_held(&mut self, held: bool) {
+        FourStrings::set_fingers_held(self, held)
     }
     fn set_pitch_bend(&mut self, semitones: f64) {
         FourStrings::set_pitch_bend(self, semitones)

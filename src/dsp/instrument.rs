@@ -446,6 +446,16 @@ impl StringBank for WaveguideBank {
         string.is_playable()
     }
 
+    fn release_finger(&mut self, i: usize, hz: f64) -> bool {
+        let string = &mut self.voices[i].string;
+        string.release_to(hz);
+        string.is_playable()
+    }
+
+    fn set_finger_reflection(&mut self, i: usize, reflection: f64) {
+        self.voices[i].string.set_finger_reflection(reflection);
+    }
+
     fn wake(&mut self, i: usize) {
         let voice = &mut self.voices[i];
         voice.awake = voice.string.is_playable();
@@ -915,6 +925,8 @@ mod tests {
             for _ in 0..(0.2 * fs) as usize {
                 cello.tick(bow);
             }
+            // The finger stays down: the free decay of the stopped string.
+            cello.set_fingers_held(true);
             cello.note_off(note);
             for _ in 0..(0.1 * fs) as usize {
                 cello.tick(bow);

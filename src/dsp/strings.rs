@@ -84,6 +84,12 @@ pub trait StringBank {
     /// Moves string `i`'s sounding note to `hz` (a bend, a glide, a new reference); false
     /// if the string cannot follow (its bow is then lifted).
     fn bend(&mut self, i: usize, hz: f64) -> bool;
+    /// The stopping finger has left string `i`: it sounds `hz` (its open pitch), the part
+    /// between the old stopping point and the nut at rest; false as [`StringBank::stop`].
+    fn release_finger(&mut self, i: usize, hz: f64) -> bool;
+    /// The stopping finger's reflection on string `i`, 0..=1 (1: pressed; less while it
+    /// leaves the string). Only takes energy out.
+    fn set_finger_reflection(&mut self, i: usize, reflection: f64);
     /// A bow landed on string `i`: it is computed from the next sample.
     fn wake(&mut self, i: usize);
     /// Whether string `i` is being computed (bowed, or ringing on).
@@ -176,6 +182,16 @@ pub(super) struct Hands {
     pub(super) probed: usize,
     /// The bow envelope's step per internal sample.
     ramp_step: f64,
+    /// Internal samples left of each string's finger lift (0: none under way).
+    lifts: [u32; STRINGS],
+    /// Whether any finger is lifting (one test a sample otherwise).
+    lifting: bool,
+    /// A finger lift's length in internal samples ([`FINGER_LIFT_S`]).
+    lift_samples: u32,
+    /// Each string's open note.
+    open_notes: [u8; STRINGS],
+    /// Whether released notes keep their fingers down ([`FourStrings::set_fingers_held`]).
+    fingers_held: bool,
 }
 
 /// One internal sample's work, handed to [`StringBank::render`]: a type with an
@@ -207,6 +223,9 @@ impl Hands {
     /// the weighting and the note's expression on the shared bow).
     #[inline(always)]
     fn step<B: StringBank>(&mut self, bank: &mut B, bow: BowControl) -> f64 {
+        if self.lifting {
+            self.lift_tick(bank);
+        }
         if let Some(retune) = self.fingering.glide_tick() {
             for (i, hz) in retune.into_iter().enumerate() {
                 if let Some(hz) = hz {
@@ -219,6 +238,54 @@ impl Hands {
         let divisor = bank.force_divisor();
         let probed = self.probed;
         bank.sample(probed, move |i| self.string_bow(i, bow, divisor))
+    }
+
+    /// One internal sample of the lifting fingers: each one's reflection dips to
+    /// [`FINGER_LIFT_MIN_REFLECTION`] and comes back over [`FINGER_LIFT_S`] (half a sine);
+    /// then the finger is off and the string sounds open.
+    #[cold]
+    fn lift_tick<B: StringBank>(&mut self, bank: &mut B) {
+        let mut any = false;
+        for i in 0..STRINGS {
+            let left = self.lifts[i];
+            if left == 0 {
+                continue;
+            }
+            let left = left - 1;
+            self.lifts[i] = left;
+            if left == 0 {
+                bank.set_finger_reflection(i, 1.0);
+                self.fingering.start(i, self.open_notes[i]);
+                self.expressive[i] = false;
+                if !bank.release_finger(i, self.fingering.tuned_hz(i)) {
+                    self.bows[i].bowed = false;
+                }
+            } else {
+                any = true;
+                let progress = 1.0 - left as f64 / self.lift_samples as f64;
+                let dip = (std::f64::consts::PI * progress).sin();
+                bank.set_finger_reflection(i, 1.0 - (1.0 - FINGER_LIFT_MIN_REFLECTION) * dip);
+            }
+        }
+        self.lifting = any;
+    }
+
+    /// Starts lifting the finger from string `i` if a released stopped note holds it.
+    fn lift_finger(&mut self, i: usize) {
+        let stopped = matches!(self.fingering.note(i), Some(n) if n != self.open_notes[i]);
+        if stopped && !self.bows[i].bowed && self.lifts[i] == 0 {
+            self.lifts[i] = self.lift_samples;
+            self.lifting = true;
+        }
+    }
+
+    /// Ends a finger lift under way on string `i` (a new note stops the string there):
+    /// the finger presses again.
+    fn keep_finger<B: StringBank>(&mut self, bank: &mut B, i: usize) {
+        if self.lifts[i] != 0 {
+            self.lifts[i] = 0;
+            bank.set_finger_reflection(i, 1.0);
+        }
     }
 
     /// String `i`'s bow for this internal sample (its envelope moves one step).
@@ -258,6 +325,17 @@ fn ramp_step(rate_hz: f64) -> f64 {
     1.0 / (BOW_RAMP_S * rate_hz).max(1.0)
 }
 
+/// How long a stopping finger takes to leave the string when its note is released, s.
+pub const FINGER_LIFT_S: f64 = 0.04;
+/// The lowest reflection of a leaving finger, halfway through its lift: its pad, no
+/// longer pressed to the fingerboard, damps the string instead of stopping it.
+pub const FINGER_LIFT_MIN_REFLECTION: f64 = 0.1;
+
+/// A finger lift's length in internal samples at `rate_hz` (at least 2).
+fn lift_samples(rate_hz: f64) -> u32 {
+    (FINGER_LIFT_S * rate_hz).round().clamp(2.0, u32::MAX as f64) as u32
+}
+
 impl<B: StringBank> FourStrings<B> {
     /// `bank` played at `host_rate_hz` (finite and positive: the constructors check),
     /// through `resampler` where the rates differ. `intonation_row`: the shipped
@@ -281,6 +359,11 @@ impl<B: StringBank> FourStrings<B> {
                 weighted: false,
                 probed: 0,
                 ramp_step: ramp_step(internal_rate_hz),
+                lifts: [0; STRINGS],
+                lifting: false,
+                lift_samples: lift_samples(internal_rate_hz),
+                open_notes: kind.open_notes(),
+                fingers_held: false,
             },
             resampler,
             host_rate_hz,
@@ -334,12 +417,23 @@ impl<B: StringBank> FourStrings<B> {
         self.hands.expressive = [false; STRINGS];
         self.hands.weights =
             std::array::from_fn(|i| kind.string_weight_for(i, B::WEIGHT_REFERENCE_Z0));
+        self.hands.open_notes = kind.open_notes();
+        self.press_every_finger();
+    }
+
+    /// Ends every finger lift under way.
+    fn press_every_finger(&mut self) {
+        for i in 0..STRINGS {
+            self.hands.keep_finger(&mut self.bank, i);
+        }
+        self.hands.lifting = false;
     }
 
     /// Stops the string for `note` and lands the bow on it. Returns the string, or `None`
     /// if no string can play the note (it is then ignored).
     pub fn note_on(&mut self, note: u8) -> Option<usize> {
         let index = self.hands.fingering.string_for_note_on(note)?;
+        self.hands.keep_finger(&mut self.bank, index);
         let before = (
             self.hands.fingering.note(index),
             self.hands.fingering.expression(index),
@@ -364,6 +458,7 @@ impl<B: StringBank> FourStrings<B> {
     /// `glide_s` not positive, as [`FourStrings::note_on`].
     pub fn note_on_gliding(&mut self, note: u8, glide_s: f64) -> Option<usize> {
         let index = self.hands.fingering.string_for_note_on(note)?;
+        self.hands.keep_finger(&mut self.bank, index);
         let from = match self.hands.fingering.note(index) {
             Some(old)
                 if self.hands.bows[index].bowed
@@ -389,11 +484,31 @@ impl<B: StringBank> FourStrings<B> {
         Some(index)
     }
 
-    /// Lifts the bow from the string playing `note`, if any (the string rings on).
+    /// Lifts the bow from the string playing `note`, if any, and the finger that stops it
+    /// (an open string rings on; a stopped one is damped by the leaving finger, then rings
+    /// open and quiet: [`FINGER_LIFT_S`]). A new note on the string during the lift keeps
+    /// the finger down.
     pub fn note_off(&mut self, note: u8) {
-        for (i, bow) in self.hands.bows.iter_mut().enumerate() {
-            if self.hands.fingering.note(i) == Some(note) {
-                bow.bowed = false;
+        let hands = &mut self.hands;
+        for i in 0..STRINGS {
+            if hands.fingering.note(i) == Some(note) {
+                hands.bows[i].bowed = false;
+                if !hands.fingers_held {
+                    hands.lift_finger(i);
+                }
+            }
+        }
+    }
+
+    /// Whether released notes keep their fingers down (the sustain pedal, and how the
+    /// free decay of a stopped note is measured): held, a note-off lifts only the bow
+    /// and the string rings on at its stopped pitch; let go, the fingers of the released
+    /// notes lift.
+    pub fn set_fingers_held(&mut self, held: bool) {
+        let was = std::mem::replace(&mut self.hands.fingers_held, held);
+        if was && !held {
+            for i in 0..STRINGS {
+                self.hands.lift_finger(i);
             }
         }
     }
@@ -528,6 +643,7 @@ impl<B: StringBank> FourStrings<B> {
         self.hands.bows = [BowEnvelope::default(); STRINGS];
         self.hands.expressive = [false; STRINGS];
         self.hands.fingering.clear();
+        self.press_every_finger();
         if let Some(r) = &mut self.resampler {
             r.reset();
         }
@@ -569,6 +685,7 @@ impl<B: StringBank> FourStrings<B> {
     pub(super) fn apply_settings(&mut self, settings: B::Settings) -> Result<(), String> {
         self.bank.configure(settings)?;
         self.hands.ramp_step = ramp_step(self.bank.internal_rate_hz());
+        self.hands.lift_samples = lift_samples(self.bank.internal_rate_hz());
         if let Some(r) = &mut self.resampler {
             // Within its capacity: the bank's rates are bounded at construction.
             let _ = r.set_input_rate(self.bank.internal_rate_hz());
@@ -665,5 +782,90 @@ impl<B: StringBank> FourStrings<B> {
         for sample in out {
             *sample = self.tick(bow).audio;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dsp::instrument::Instrument;
+
+    const FS: f64 = 48_000.0;
+
+    fn bowed(cello: &mut Instrument, seconds: f64) {
+        for _ in 0..(seconds * FS) as usize {
+            cello.tick(BowControl::default());
+        }
+    }
+
+    #[test]
+    fn a_released_stopped_note_lifts_its_finger_and_the_string_then_sounds_open() {
+        let mut cello = Instrument::new(InstrumentKind::Cello, FS);
+        let string = cello.note_on(46).unwrap(); // Bb2 on the G string
+        bowed(&mut cello, 0.5);
+        cello.note_off(46);
+        assert!(cello.hands.lifting && cello.hands.lifts[string] == cello.hands.lift_samples);
+        // The lift takes FINGER_LIFT_S; then the string's note is its open one.
+        bowed(&mut cello, FINGER_LIFT_S + 0.001);
+        assert!(!cello.hands.lifting);
+        let open = InstrumentKind::Cello.open_notes()[string];
+        assert_eq!(cello.hands.fingering.note(string), Some(open));
+    }
+
+    #[test]
+    fn the_next_note_on_the_same_string_keeps_the_finger_down() {
+        // Released and restopped at the same instant (detache on one string), and legato
+        // (the next note before the release): no lift either way.
+        let mut cello = Instrument::new(InstrumentKind::Cello, FS);
+        let string = cello.note_on(46).unwrap();
+        bowed(&mut cello, 0.3);
+        cello.note_off(46);
+        assert_eq!(cello.note_on(47), Some(string));
+        assert_eq!(cello.hands.lifts[string], 0);
+        bowed(&mut cello, 0.3);
+        assert_eq!(cello.note_on(48), Some(string));
+        cello.note_off(47);
+        assert_eq!(cello.hands.lifts[string], 0);
+        assert!(!cello.hands.lifting);
+    }
+
+    #[test]
+    fn a_released_open_string_has_no_finger_to_lift() {
+        let mut cello = Instrument::new(InstrumentKind::Cello, FS);
+        cello.note_on(50).unwrap(); // the open D
+        bowed(&mut cello, 0.3);
+        cello.note_off(50);
+        assert!(!cello.hands.lifting);
+    }
+
+    #[test]
+    fn the_leaving_finger_only_takes_energy_out() {
+        // With the bow lifted the strings' energy may only fall through the lift (it
+        // scales the reflected wave by at most 1), and the lift takes most of it.
+        let mut cello = Instrument::new(InstrumentKind::Cello, FS);
+        cello.note_on(46).unwrap();
+        bowed(&mut cello, 0.5);
+        cello.note_off(46);
+        // The bow's 20 ms release ramp first (the bow still on the string).
+        bowed(&mut cello, 0.021);
+        let start = cello.energy_j();
+        let mut last = start;
+        while cello.hands.lifting {
+            cello.tick(BowControl::default());
+            let e = cello.energy_j();
+            if cello.hands.lifting {
+                // 1e-12 relative: rounding of the energy sum.
+                assert!(e <= last * (1.0 + 1e-12), "{e} after {last}");
+            } else {
+                // The finger is off and the string refitted for its open length: the loss
+                // and dispersion filters' stored energy is counted with their new
+                // coefficients (1 %: that bookkeeping, not a gain; the waves keep theirs
+                // and the new part of the string starts at rest).
+                assert!(e <= last * 1.01, "{e} after {last} at the release");
+            }
+            last = e;
+        }
+        // What the lift took: at least 90 % of the string's energy (10 dB) over its 40 ms.
+        assert!(last < 0.1 * start, "{last} of {start}");
     }
 }

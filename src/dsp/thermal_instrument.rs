@@ -285,6 +285,15 @@ impl StringBank for ThermalBank {
         self.tune(i, hz)
     }
 
+    fn release_finger(&mut self, i: usize, hz: f64) -> bool {
+        let delay = self.bridge_delay(i, hz);
+        self.core.strings[i].release_to_with_delay(hz, delay)
+    }
+
+    fn set_finger_reflection(&mut self, i: usize, reflection: f64) {
+        self.core.strings[i].set_finger_reflection(reflection);
+    }
+
     fn wake(&mut self, _i: usize) {
         self.awake = true;
     }

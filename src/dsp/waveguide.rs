@@ -140,6 +140,9 @@ pub struct WaveguideString {
     hair: HighPassAdmittance,
     /// Whether the bow hair yields (the default; off: paper A's rigid point contact).
     hair_enabled: bool,
+    /// The stopping finger's share of the nut reflection: 1 while it presses, less while
+    /// it leaves the string ([`WaveguideString::set_finger_reflection`]).
+    finger_reflection: f64,
     /// The bow position `bow_index` was computed for (NaN: recompute).
     bow_beta: f64,
 }
@@ -252,6 +255,7 @@ impl WaveguideString {
             },
             hair: HighPassAdmittance::default(),
             hair_enabled: true,
+            finger_reflection: 1.0,
             bow_beta: f64::NAN,
         };
         s.design_hair();
@@ -376,6 +380,28 @@ impl WaveguideString {
     /// Dispersion allpass sections in use.
     pub fn dispersion_stages(&self) -> usize {
         self.dispersion_stages
+    }
+
+    /// The stopping finger has left: the string sounds `f1_hz` (its open pitch), longer,
+    /// the part between the old stopping point and the nut at rest (as
+    /// [`WaveguideString::stop_at`] otherwise).
+    pub fn release_to(&mut self, f1_hz: f64) {
+        let old_m = self.m;
+        self.stop_at(f1_hz);
+        if self.playable {
+            for x in old_m..self.m {
+                let i = self.right.back(self.t, x);
+                self.right[i] = 0.0;
+                let i = self.left.back(self.t, x);
+                self.left[i] = 0.0;
+            }
+        }
+    }
+
+    /// The stopping finger's reflection, 0..=1: 1 while it presses the string, less while
+    /// it leaves ([`crate::dsp::strings`]'s finger lift). Only takes energy out.
+    pub fn set_finger_reflection(&mut self, reflection: f64) {
+        self.finger_reflection = reflection.clamp(0.0, 1.0);
     }
 
     /// Retunes the loop to `f1_hz` keeping the loss and dispersion filters (pitch bend,
@@ -545,7 +571,7 @@ impl WaveguideString {
         for ap in &mut self.dispersion[..self.dispersion_stages] {
             reflected = ap.tick(reflected);
         }
-        reflected = -self.loss.tick(reflected);
+        reflected = -self.loss.tick(reflected) * self.finger_reflection;
 
         self.t = (self.t + 1) & mask;
         self.right[self.t] = flush(-at_bridge);

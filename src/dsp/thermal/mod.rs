@@ -779,6 +779,25 @@ impl ThermalString {
         self.set_fundamental_with_delay(f0_hz, 0.0)
     }
 
+    /// The stopping finger's reflection, 0..=1: 1 while it presses the string (the nut's
+    /// own reflection), less while it leaves ([`crate::dsp::strings`]'s finger lift). Only
+    /// takes energy out.
+    pub fn set_finger_reflection(&mut self, reflection: f64) {
+        self.waves.set_finger(reflection);
+    }
+
+    /// The stopping finger has left: the string sounds `f0_hz` (its open pitch), longer,
+    /// the part between the old stopping point and the nut at rest (as
+    /// [`ThermalString::set_fundamental_with_delay`] otherwise).
+    pub fn release_to_with_delay(&mut self, f0_hz: f64, extra_delay: f64) -> bool {
+        let old_m = self.waves.len();
+        let ok = self.set_fundamental_with_delay(f0_hz, extra_delay);
+        if ok {
+            self.waves.rest_beyond(old_m);
+        }
+        ok
+    }
+
     /// [`ThermalString::set_fundamental`] on an end whose reflection delays the
     /// fundamental by `extra_delay` samples more than the string's own terminations (a
     /// modal bridge's phase delay at `f0`): the loop is shortened by it.

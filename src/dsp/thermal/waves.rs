@@ -35,6 +35,9 @@ pub(super) struct Waves {
     /// Energy of dropped waves that wakes a sleeping polarisation, in the same units
     /// (`threshold fs / Z`).
     wake_sum: f64,
+    /// The stopping finger's share of the nut's reflection: 1 while it presses, less while
+    /// it leaves the string (`ThermalString::set_finger_reflection`).
+    finger: f64,
 }
 
 /// Where the bow's `n` nodes sit in the rings this sample.
@@ -67,6 +70,7 @@ impl Waves {
             asleep: [false; 2],
             dropped: [0.0; 2],
             wake_sum: f64::INFINITY,
+            finger: 1.0,
         }
     }
 
@@ -101,6 +105,24 @@ impl Waves {
 
     pub(super) fn nut_reflection(&self) -> [[f64; 2]; 2] {
         self.nut_reflection
+    }
+
+    /// The string grew from `old_m` samples to its present length (the finger left it):
+    /// the new part, between the old stopping point and the nut, starts at rest.
+    pub(super) fn rest_beyond(&mut self, old_m: usize) {
+        let mask = self.mask();
+        for p in 0..2 {
+            for x in old_m..self.m {
+                self.right[p][x.wrapping_sub(self.t) & mask] = 0.0;
+                let i = self.left[p].back(self.t, x);
+                self.left[p][i] = 0.0;
+            }
+        }
+    }
+
+    /// The stopping finger's share of the nut's reflection, 0..=1.
+    pub(super) fn set_finger(&mut self, reflection: f64) {
+        self.finger = reflection.clamp(0.0, 1.0);
     }
 
     pub(super) fn bridge_reflection(&self) -> [[f64; 2]; 2] {
@@ -228,7 +250,8 @@ impl Waves {
         let bridge_end = 0usize.wrapping_sub(next) & self.mask();
         for p in 0..2 {
             let from_bridge = flush_tiny(leaving_bridge[p]);
-            let from_nut = flush_tiny(rn[p][0] * at_nut[0] + rn[p][1] * at_nut[1]);
+            let from_nut =
+                flush_tiny((rn[p][0] * at_nut[0] + rn[p][1] * at_nut[1]) * self.finger);
             if self.asleep[p] {
                 // Dropped (the lines stay zero) until the dropped waves add up to the
                 // wake threshold; this sample's waves then go in.
