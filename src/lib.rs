@@ -14,6 +14,7 @@ pub mod analysis;
 pub mod dsp;
 pub mod editor;
 pub mod editor_state;
+pub mod measure;
 pub mod midi_learn;
 pub mod params;
 pub mod performer;
@@ -299,7 +300,7 @@ impl Colophony {
             || next_controls(params),
             |k, gain, frame, played, performer| {
                 if live {
-                    let contact = editor::live::ContactSample::new(frame, played);
+                    let contact = measure::contact::ContactSample::new(frame, played);
                     editor_link.scope.push(contact);
                     if let Some(string) = performer.probed_thermal_string() {
                         node_probe.add_from(

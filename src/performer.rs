@@ -1319,8 +1319,8 @@ impl Performer {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::editor::live::ContactSample;
-    use crate::editor::regime::{classify_regime, Regime};
+    use crate::measure::contact::ContactSample;
+    use crate::measure::regime::{classify_regime, Regime};
 
     const FS: f64 = 48_000.0;
 

@@ -8,9 +8,9 @@
 use colophony::dsp::bridge_data::shipped_cello_bridge;
 use colophony::dsp::instrument::{BowControl, InstrumentKind};
 use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
-use colophony::editor::live::ContactSample;
 use colophony::editor::nodes::NodeProbe;
 use colophony::editor::EditorLink;
+use colophony::measure::contact::ContactSample;
 use nice_assert_no_alloc::assert_no_alloc;
 use std::process::Command;
 

@@ -3,13 +3,13 @@
 //! begin/set/end call and applies the values to the parameters as a host would.
 
 use colophony::editor::bridge::{BRIDGE_FILE_LABEL, LOAD_BRIDGE_LABEL, SHIPPED_BRIDGE_LABEL};
-use colophony::editor::live::ContactSample;
 use colophony::editor::mapping::PadMapping;
 use colophony::editor::nodes::NodeRecord;
 use colophony::editor::pad::{pad_value_text, PAD_LABEL};
 use colophony::editor::presets::{PRESET_LABEL, PRESET_NAME_LABEL, SAVE_LABEL};
 use colophony::editor::view::THERMAL_LABEL;
 use colophony::editor::{EditorLink, EditorUi};
+use colophony::measure::contact::ContactSample;
 use colophony::params::{
     ColophonyParams, FrictionChoice, InstrumentChoice, QualityChoice, StringChoice,
 };

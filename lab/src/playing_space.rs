@@ -43,9 +43,9 @@ use colophony::dsp::thermal::ThermalParams;
 use colophony::dsp::thermal_instrument::{
     ThermalInstrument, ThermalSettings, THERMAL_WEIGHT_REFERENCE_Z0,
 };
-use colophony::editor::live::ContactSample;
-use colophony::editor::mapping::SchellengWindow;
-use colophony::editor::regime::{classify_regime, Regime};
+use colophony::measure::contact::ContactSample;
+use colophony::measure::regime::{classify_regime, Regime};
+use colophony::measure::window::SchellengWindow;
 use colophony::quality::{Quality, GOOD_NODES};
 use rayon::prelude::*;
 use std::fmt::Write as _;

@@ -4,7 +4,7 @@
 //! probe showed, with the bowed pitch in cents printed where the motion is Helmholtz.
 
 use crate::playing_space::{notes, Cell, Measured, Model, Plan};
-use colophony::editor::regime::Regime;
+use colophony::measure::regime::Regime;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;

@@ -16,8 +16,8 @@
 use crate::playing_space::{measure, Bowing, Cell, Model};
 use colophony::dsp::instrument::InstrumentKind;
 use colophony::dsp::thermal::{bulk_cooled, ThermalParams};
-use colophony::editor::mapping::SchellengWindow;
-use colophony::editor::regime::Regime;
+use colophony::measure::regime::Regime;
+use colophony::measure::window::SchellengWindow;
 use rayon::prelude::*;
 use std::fmt::Write as _;
 

@@ -19,8 +19,8 @@
 //! --nocapture`.
 use colophony::dsp::friction::FrictionModel;
 use colophony::dsp::instrument::{midi_to_hz, BowControl, InstrumentKind};
-use colophony::editor::live::ContactSample;
-use colophony::editor::regime::{classify_regime, Regime};
+use colophony::measure::contact::ContactSample;
+use colophony::measure::regime::{classify_regime, Regime};
 use colophony::performer::{Performer, Setup};
 
 const FS: f64 = 48_000.0;

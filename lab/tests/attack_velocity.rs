@@ -112,7 +112,10 @@ fn a_harder_note_velocity_starts_louder_and_both_speak_at_the_notes_pitch() {
                 // The audible difference between velocities 30 and 120: 3 dB in the
                 // first 80 ms' peak, or 20 % in their spectral centroid.
                 if louder < 3.0 && brighter < 1.2 {
-                    failures.push(format!("{} {note} {name}: {louder:+.2} dB, x{brighter:.2}", kind.name()));
+                    failures.push(format!(
+                        "{} {note} {name}: {louder:+.2} dB, x{brighter:.2}",
+                        kind.name()
+                    ));
                 }
                 if c_soft.abs() > 15.0 || c_hard.abs() > 15.0 {
                     failures.push(format!(
@@ -124,5 +127,10 @@ fn a_harder_note_velocity_starts_louder_and_both_speak_at_the_notes_pitch() {
         }
     }
     println!("{}", report.join("\n"));
-    assert!(failures.is_empty(), "{} failures:\n{}", failures.len(), failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "{} failures:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
 }

@@ -49,7 +49,9 @@ fn play(
 }
 
 fn rms_db(x: &[f64]) -> f64 {
-    10.0 * (x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64).max(1e-30).log10()
+    10.0 * (x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64)
+        .max(1e-30)
+        .log10()
 }
 
 const LAWS: [Option<FrictionModel>; 5] = [
@@ -65,10 +67,10 @@ fn a_released_stopped_note_falls_12_db_under_the_next_note_on_another_string_wit
     // (instrument, released stopped note, next note on the neighbouring string), the next
     // note landing as the first is released (legato across strings, as in a phrase).
     let cases = [
-        (InstrumentKind::Cello, 46, 53),  // Bb2 on G, then F3 on D (the example)
-        (InstrumentKind::Cello, 40, 47),  // E2 on C, then B2 on G
-        (InstrumentKind::Cello, 52, 59),  // E3 on D, then B3 on A
-        (InstrumentKind::Viola, 51, 58),  // Eb3 on C, then Bb3 on G
+        (InstrumentKind::Cello, 46, 53), // Bb2 on G, then F3 on D (the example)
+        (InstrumentKind::Cello, 40, 47), // E2 on C, then B2 on G
+        (InstrumentKind::Cello, 52, 59), // E3 on D, then B3 on A
+        (InstrumentKind::Viola, 51, 58), // Eb3 on C, then Bb3 on G
         (InstrumentKind::Violin, 60, 66), // C4 on G, then F#4 on D
         (InstrumentKind::Violin, 71, 78), // B4 on A, then F#5 on E
     ];
@@ -94,7 +96,11 @@ fn a_released_stopped_note_falls_12_db_under_the_next_note_on_another_string_wit
             );
             // The criterion: 12 dB under the new note within 50 ms.
             if left > new - 12.0 {
-                failures.push(format!("{} {first} -> {next} {name}: {:+.1} dB", kind.name(), left - new));
+                failures.push(format!(
+                    "{} {first} -> {next} {name}: {:+.1} dB",
+                    kind.name(),
+                    left - new
+                ));
             }
         }
     }

@@ -3,7 +3,7 @@
 //! 44.1 and 96 kHz, through the engines the plugin plays (`colophony_lab::playing_space`).
 
 use colophony::dsp::instrument::InstrumentKind;
-use colophony::editor::regime::Regime;
+use colophony::measure::regime::Regime;
 use colophony_lab::playing_space::{
     measure, notes, regime_name, run_plan, Bowing, Cell, Measured, Model, Plan,
 };

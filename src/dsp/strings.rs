@@ -333,7 +333,9 @@ pub const FINGER_LIFT_MIN_REFLECTION: f64 = 0.1;
 
 /// A finger lift's length in internal samples at `rate_hz` (at least 2).
 fn lift_samples(rate_hz: f64) -> u32 {
-    (FINGER_LIFT_S * rate_hz).round().clamp(2.0, u32::MAX as f64) as u32
+    (FINGER_LIFT_S * rate_hz)
+        .round()
+        .clamp(2.0, u32::MAX as f64) as u32
 }
 
 impl<B: StringBank> FourStrings<B> {

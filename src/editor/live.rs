@@ -9,41 +9,13 @@
 //! the newest samples out and drops any the writer overwrote during the copy, so both sides
 //! are wait-free.
 
-use crate::dsp::instrument::{BowControl, Frame};
+use crate::measure::contact::ContactSample;
 use crate::telemetry::{Record, Ring};
 use egui::{pos2, vec2, Align2, Color32, FontId, Rect, Shape, Stroke, Ui};
 use std::sync::atomic::{AtomicU32, Ordering};
 
 /// Ring length, samples (a power of two): three periods of cello C at 96 kHz fit.
 pub const SCOPE_LEN: usize = 1 << 13;
-
-/// One sample of the probed string's contact.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct ContactSample {
-    /// String velocity at the bow point, m/s.
-    pub string_velocity: f32,
-    /// String velocity minus bow velocity, m/s.
-    pub relative_velocity: f32,
-    /// Friction force over bow force.
-    pub mu: f32,
-}
-
-impl ContactSample {
-    /// From one instrument tick and the bow that drove it (`mu` is 0 with the bow lifted).
-    #[inline]
-    pub fn new(frame: &Frame, bow: &BowControl) -> Self {
-        let mu = if bow.force_n > 1e-9 {
-            frame.friction_force_n / bow.force_n
-        } else {
-            0.0
-        };
-        Self {
-            string_velocity: frame.bow_point_velocity_m_per_s as f32,
-            relative_velocity: (frame.bow_point_velocity_m_per_s - bow.velocity_m_per_s) as f32,
-            mu: mu as f32,
-        }
-    }
-}
 
 impl Record for ContactSample {
     const WORDS: usize = 3;
@@ -273,6 +245,7 @@ pub fn paint_friction_loop(ui: &Ui, rect: Rect, samples: &[ContactSample]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::dsp::instrument::{BowControl, Frame};
 
     fn sample(x: f32) -> ContactSample {
         ContactSample {

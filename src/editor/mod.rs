@@ -30,7 +30,6 @@ pub mod midi_map_page;
 pub mod nodes;
 pub mod pad;
 pub mod presets;
-pub mod regime;
 pub mod view;
 
 pub use crate::editor_state::{EditorSize, EditorState};

@@ -13,7 +13,8 @@
 //! values, so host automation and other controls move it. While dragged it sits where the
 //! pointer put it (a CLAP host applies a GUI change only at its next flush).
 
-use super::mapping::{PadMapping, SchellengWindow};
+use super::mapping::PadMapping;
+use crate::measure::window::SchellengWindow;
 use egui::{
     pos2, vec2, Align2, Color32, FontId, Mesh, Rect, Response, Sense, Shape, Stroke, Ui, Vec2,
 };

@@ -4,16 +4,17 @@
 //! tests drive it without a window.
 
 use super::bridge::BridgeBar;
-use super::live::{paint_friction_loop, paint_velocity_trace, ContactSample, SCOPE_LEN};
-use super::mapping::SchellengWindow;
+use super::live::{paint_friction_loop, paint_velocity_trace, SCOPE_LEN};
 use super::midi_map_page::MidiMapPage;
 use super::nodes::{paint_slip_image, paint_temperature_profile, NodeRecord, RING_LEN};
 use super::pad::{format_force, format_velocity, XyPad, MAX_FORCE_COLOUR, MIN_FORCE_COLOUR};
 use super::presets::PresetBar;
-use super::regime::{classify_regime, Regime};
 use super::{EditorLink, EditorSize};
 use crate::dsp::instrument::{midi_to_hz, InstrumentKind};
 use crate::dsp::thermal_instrument::THERMAL_WEIGHT_REFERENCE_Z0;
+use crate::measure::contact::ContactSample;
+use crate::measure::regime::{classify_regime, Regime};
+use crate::measure::window::SchellengWindow;
 use crate::params::{ColophonyParams, FrictionChoice, QualityChoice, ResonatorChoice};
 use egui::{vec2, Color32, Layout, RichText, Ui};
 use nice_plug::context::gui::GuiContext;

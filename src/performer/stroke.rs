@@ -258,7 +258,10 @@ mod tests {
                 let ((speed, force), (ramp, landing)) = at(velocity, t);
                 // Speed and force carry the same level, so the bow keeps its place in
                 // Schelleng's window (1e-12: rounding of two products) ...
-                assert!((speed / ramp - force / landing).abs() < 1e-12, "{velocity} at {t} s");
+                assert!(
+                    (speed / ramp - force / landing).abs() < 1e-12,
+                    "{velocity} at {t} s"
+                );
                 // ... and the bow never runs faster than the ramp asks.
                 assert!(speed <= ramp, "{velocity} at {t} s");
             }
@@ -270,7 +273,10 @@ mod tests {
         for velocity in [0.0, 30.0 / 127.0] {
             let depth = (ONSET_OCTAVES_PER_VELOCITY * (velocity - 64.0 / 127.0)).exp2() - 1.0;
             // 1e-3: the rise is applied per sample; a sample's offset is 0.01 % of it.
-            assert!((level(velocity) - (1.0 + depth * left)).abs() < 1e-3, "{velocity}");
+            assert!(
+                (level(velocity) - (1.0 + depth * left)).abs() < 1e-3,
+                "{velocity}"
+            );
         }
         assert!(level(30.0 / 127.0) < level(50.0 / 127.0));
         assert_eq!(level(64.0 / 127.0), 1.0);

@@ -250,8 +250,7 @@ impl Waves {
         let bridge_end = 0usize.wrapping_sub(next) & self.mask();
         for p in 0..2 {
             let from_bridge = flush_tiny(leaving_bridge[p]);
-            let from_nut =
-                flush_tiny((rn[p][0] * at_nut[0] + rn[p][1] * at_nut[1]) * self.finger);
+            let from_nut = flush_tiny((rn[p][0] * at_nut[0] + rn[p][1] * at_nut[1]) * self.finger);
             if self.asleep[p] {
                 // Dropped (the lines stay zero) until the dropped waves add up to the
                 // wake threshold; this sample's waves then go in.

@@ -31,13 +31,13 @@
 //! above is raucous.
 //!
 //! ```
-//! use colophony::editor::live::ContactSample;
-//! use colophony::editor::regime::{classify_regime, Regime};
+//! use colophony::measure::contact::ContactSample;
+//! use colophony::measure::regime::{classify_regime, Regime};
 //! let silence = vec![ContactSample::default(); 4096];
 //! assert_eq!(classify_regime(&silence, 48_000.0, 146.8), Some(Regime::Silent));
 //! ```
 
-use super::live::ContactSample;
+use super::contact::ContactSample;
 use crate::dsp::instrument::INTERNAL_RATE_HZ;
 
 /// A sample slips where the relative velocity exceeds this fraction of the bow velocity.
