@@ -207,6 +207,28 @@ impl QualityChoice {
     }
 }
 
+/// The version of the plugin state this build writes.
+pub const STATE_VERSION: u32 = 2;
+/// The persisted field that holds it.
+pub const STATE_VERSION_FIELD: &str = "state-version";
+
+/// The persisted `state-version` field: always saves [`STATE_VERSION`] (the state this
+/// build writes, whatever version it loaded), and ignores what it loads (read by
+/// [`crate::presets::migrate_state`] before the values are loaded).
+#[derive(Debug, Default)]
+pub struct StateVersion;
+
+impl<'a> nice_plug::params::persist::PersistentField<'a, u32> for StateVersion {
+    fn set(&self, _loaded: u32) {}
+
+    fn map<F, R>(&self, f: F) -> R
+    where
+        F: Fn(&u32) -> R,
+    {
+        f(&STATE_VERSION)
+    }
+}
+
 #[derive(Params)]
 pub struct ColophonyParams {
     #[id = "bow_velocity"]
@@ -255,7 +277,7 @@ pub struct ColophonyParams {
     pub user_bridges: crate::user_bridges::UserBridges,
     /// The state's version, for migrations ([`crate::presets::migrate_state`]).
     #[persist = "state-version"]
-    pub state_version: crate::presets::StateVersion,
+    pub state_version: StateVersion,
     /// Which controller moves what, saved with the project ([`crate::midi_learn`]; not a
     /// parameter). The editor's mapping page edits it.
     #[persist = "midi-map"]
@@ -399,7 +421,7 @@ impl Default for ColophonyParams {
             string_weight: BoolParam::new("String Weight", true),
             editor_state: Default::default(),
             user_bridges: Default::default(),
-            state_version: crate::presets::StateVersion,
+            state_version: StateVersion,
             midi_map: Default::default(),
             last_controller: Default::default(),
         }

@@ -37,34 +37,13 @@
 //! ```
 
 use crate::params::ColophonyParams;
+use crate::params::{STATE_VERSION, STATE_VERSION_FIELD};
 use nice_plug::params::InternalParamMut;
 use nice_plug::plugin::{ParamValue, PluginState};
 use nice_plug::prelude::{Param, ParamPtr, Params};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-
-/// The version of the plugin state this build writes.
-pub const STATE_VERSION: u32 = 2;
-/// The persisted field that holds it.
-pub const STATE_VERSION_FIELD: &str = "state-version";
-
-/// The persisted `state-version` field: always saves [`STATE_VERSION`] (the state this
-/// build writes, whatever version it loaded), and ignores what it loads (read by
-/// [`migrate_state`] before the values are loaded).
-#[derive(Debug, Default)]
-pub struct StateVersion;
-
-impl<'a> nice_plug::params::persist::PersistentField<'a, u32> for StateVersion {
-    fn set(&self, _loaded: u32) {}
-
-    fn map<F, R>(&self, f: F) -> R
-    where
-        F: Fn(&u32) -> R,
-    {
-        f(&STATE_VERSION)
-    }
-}
 
 /// A named set of parameter values (see the module doc for the file format).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

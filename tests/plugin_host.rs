@@ -893,7 +893,7 @@ fn states_saved_by_every_version_load_with_their_values() {
     let dir = workspace_root().join("tests/fixtures/state");
     let v1 = dir.join("v1.state");
     // Each recorded once, by the build that introduced its version; never re-recorded.
-    let current = dir.join(format!("v{}.state", colophony::presets::STATE_VERSION));
+    let current = dir.join(format!("v{}.state", colophony::params::STATE_VERSION));
     if std::env::var_os("COLOPHONY_RECORD_STATE").is_some() && !current.exists() {
         let mut plugin = active_plugin(FS, BLOCK);
         let score = fixture_values(&mut plugin);
@@ -934,7 +934,7 @@ fn states_saved_by_every_version_load_with_their_values() {
         assert!(rms(&channel_f64(&out, 0)) > 1e-3, "{fixture}: silent");
         // Saved again, it carries this build's version (the JSON after the 8-byte length).
         let resaved = String::from_utf8(plugin.save_state()[8..].to_vec()).unwrap();
-        let version = format!(r#""state-version":"{}""#, colophony::presets::STATE_VERSION);
+        let version = format!(r#""state-version":"{}""#, colophony::params::STATE_VERSION);
         assert!(resaved.contains(&version), "{resaved}");
     }
     // A damaged state (a value far outside its range): loads, clamped to the range's end.

@@ -4,7 +4,7 @@
 //! - [`render`]: one bowed note on an engine, to a WAV file (`colophony render`);
 //! - [`midi_file`]: a standard MIDI file through the plugin's performer
 //!   (`colophony render --midi`);
-//! - [`figures`], [`playing_space_figure`]: the papers' figures and the maps, as PNG;
+//! - [`figures`], [`playing_space::figure`]: the papers' figures and the maps, as PNG;
 //! - [`bench`], [`precision`], [`playing_space`], [`intonation_fit`]: real-time ratios, the
 //!   work-precision benchmark, the playing-space map and the intonation table;
 //! - [`admittance_fit`]: fitting a passive modal bridge to measured admittance.
@@ -15,7 +15,6 @@ pub mod figures;
 pub mod intonation_fit;
 pub mod midi_file;
 pub mod playing_space;
-pub mod playing_space_figure;
 pub mod precision;
 pub mod render;
 pub mod thermal_constants;

@@ -33,6 +33,8 @@
 //! [`SETTLE_S`]: the map then asks whether the cell's force *holds* Helmholtz motion
 //! (Schelleng's window is a stability limit). The measurement is the same.
 
+pub mod figure;
+
 use colophony::analysis::{cents, peak_frequency_hz, slip_stats};
 use colophony::dsp::engine::Engine;
 use colophony::dsp::friction::bristle::BristleIntegrator;
@@ -803,7 +805,7 @@ pub fn run(out: &Path, plan: &Plan) -> Result<String, String> {
     let mut pngs = Vec::new();
     for &model in &plan.models {
         let path = out.join(format!("playing-space-{}.png", model.name()));
-        crate::playing_space_figure::draw(&plan, &results, model, &path)?;
+        figure::draw(&plan, &results, model, &path)?;
         pngs.push(path.display().to_string());
     }
     Ok(format!(

@@ -20,10 +20,10 @@
 //! assert_eq!(bow.advance(0.5), 0.5);
 //! ```
 
-use super::instrument::{
+use super::intonation::{self, IntonationTable};
+use super::vocabulary::{
     reference_semitones, InstrumentKind, NoteExpression, MAX_BEND_RANGE_SEMITONES, STRINGS,
 };
-use super::intonation::{self, IntonationTable};
 
 /// The bow on one string: whether it is down, and how far it rests on the string, 0
 /// (lifted) to 1 (full force), ramping between.

@@ -28,12 +28,8 @@
 //! assert!(c.abs() < 50.0);
 //! ```
 
-use super::instrument::{InstrumentKind, MAX_STOP_SEMITONES, STRINGS};
+use super::vocabulary::{InstrumentKind, MAX_CORRECTION_CENTS, MAX_STOP_SEMITONES, STRINGS};
 use std::sync::OnceLock;
-
-/// Largest correction the table may hold, cents (the tuning margins of the instruments'
-/// buffers include it).
-pub const MAX_CORRECTION_CENTS: f64 = 50.0;
 
 /// Semitones per string in the table: 0 (open) ..= [`MAX_STOP_SEMITONES`].
 const SEMITONES: usize = MAX_STOP_SEMITONES as usize + 1;
@@ -61,13 +57,13 @@ pub fn tuned_hz(
     // A bend slides the finger as far as the string reaches: down to a detuned open string,
     // up past the end of the fingerboard by as much (the delay lines and the thermal rate
     // floor are sized for these ends).
-    let margin = super::instrument::PITCH_BEND_SEMITONES;
+    let margin = super::vocabulary::PITCH_BEND_SEMITONES;
     let top = open + MAX_STOP_SEMITONES as f64;
     let played = (note as f64 + bend).clamp(open - margin, top + margin);
     let correction = table.map_or(0.0, |t| {
         t.correction_cents(row, kind, string, played - open)
     });
-    super::instrument::midi_to_hz(played + reference - correction / 100.0)
+    super::vocabulary::midi_to_hz(played + reference - correction / 100.0)
 }
 
 /// The table row of a model named as [`MODEL_NAMES`] (the friction models' `name()`, and

@@ -4,7 +4,8 @@
 //! bow ([`instrument`]); paper B's finite-width thermal bow ([`thermal`]) and its
 //! four-string instrument at the modal bridge ([`thermal_instrument`]). Both instruments
 //! are one [`strings::FourStrings`] (notes, fingers, the bow on each string, sleep,
-//! resampling) over their own [`strings::StringBank`].
+//! resampling) over their own [`strings::StringBank`]. The types and constants they all
+//! speak in are [`vocabulary`]'s.
 
 pub mod body;
 pub mod bridge;
@@ -24,6 +25,7 @@ pub mod rubbed;
 pub mod strings;
 pub mod thermal;
 pub mod thermal_instrument;
+pub mod vocabulary;
 pub mod waveguide;
 
 /// Whether this CPU runs the vector paths (AVX2, detected at run time; the thermal

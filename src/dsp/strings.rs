@@ -33,12 +33,12 @@
 
 use super::filters::flush_tiny;
 use super::fingering::{BowEnvelope, Fingering};
-use super::instrument::{
+use super::intonation::IntonationTable;
+use super::resample::Resampler;
+use super::vocabulary::{
     BowControl, Frame, InstrumentKind, NoteExpression, BOW_RAMP_S, MAX_NOTE_BETA,
     MAX_WEIGHTED_FORCE_N, MIN_NOTE_BETA, STRINGS,
 };
-use super::intonation::IntonationTable;
-use super::resample::Resampler;
 
 /// The bow on one string for one host sample, as the bank takes it.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -67,7 +67,7 @@ pub trait StringBank {
     /// The impedance of the string the force parameter is the force on when the strings
     /// are weighted ([`FourStrings::set_string_weighting`]), kg/s: string `i` is bowed
     /// with the force times its `Z0` over this.
-    const WEIGHT_REFERENCE_Z0: f64 = crate::dsp::instrument::WEIGHT_REFERENCE_Z0;
+    const WEIGHT_REFERENCE_Z0: f64 = crate::dsp::vocabulary::WEIGHT_REFERENCE_Z0;
     /// The bow force in newtons is divided by this before it reaches the strings (1 for a
     /// point bow; the bow's width for a bow whose force is per metre).
     fn force_divisor(&self) -> f64 {
@@ -183,11 +183,11 @@ pub(super) struct Hands {
     /// The bow envelope's step per internal sample.
     ramp_step: f64,
     /// Internal samples left of each string's finger lift (0: none under way).
-    lifts: [u32; STRINGS],
+    pub(super) lifts: [u32; STRINGS],
     /// Whether any finger is lifting (one test a sample otherwise).
-    lifting: bool,
+    pub(super) lifting: bool,
     /// A finger lift's length in internal samples ([`FINGER_LIFT_S`]).
-    lift_samples: u32,
+    pub(super) lift_samples: u32,
     /// Each string's open note.
     open_notes: [u8; STRINGS],
     /// Whether released notes keep their fingers down ([`FourStrings::set_fingers_held`]).
@@ -784,90 +784,5 @@ impl<B: StringBank> FourStrings<B> {
         for sample in out {
             *sample = self.tick(bow).audio;
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::dsp::instrument::Instrument;
-
-    const FS: f64 = 48_000.0;
-
-    fn bowed(cello: &mut Instrument, seconds: f64) {
-        for _ in 0..(seconds * FS) as usize {
-            cello.tick(BowControl::default());
-        }
-    }
-
-    #[test]
-    fn a_released_stopped_note_lifts_its_finger_and_the_string_then_sounds_open() {
-        let mut cello = Instrument::new(InstrumentKind::Cello, FS);
-        let string = cello.note_on(46).unwrap(); // Bb2 on the G string
-        bowed(&mut cello, 0.5);
-        cello.note_off(46);
-        assert!(cello.hands.lifting && cello.hands.lifts[string] == cello.hands.lift_samples);
-        // The lift takes FINGER_LIFT_S; then the string's note is its open one.
-        bowed(&mut cello, FINGER_LIFT_S + 0.001);
-        assert!(!cello.hands.lifting);
-        let open = InstrumentKind::Cello.open_notes()[string];
-        assert_eq!(cello.hands.fingering.note(string), Some(open));
-    }
-
-    #[test]
-    fn the_next_note_on_the_same_string_keeps_the_finger_down() {
-        // Released and restopped at the same instant (detache on one string), and legato
-        // (the next note before the release): no lift either way.
-        let mut cello = Instrument::new(InstrumentKind::Cello, FS);
-        let string = cello.note_on(46).unwrap();
-        bowed(&mut cello, 0.3);
-        cello.note_off(46);
-        assert_eq!(cello.note_on(47), Some(string));
-        assert_eq!(cello.hands.lifts[string], 0);
-        bowed(&mut cello, 0.3);
-        assert_eq!(cello.note_on(48), Some(string));
-        cello.note_off(47);
-        assert_eq!(cello.hands.lifts[string], 0);
-        assert!(!cello.hands.lifting);
-    }
-
-    #[test]
-    fn a_released_open_string_has_no_finger_to_lift() {
-        let mut cello = Instrument::new(InstrumentKind::Cello, FS);
-        cello.note_on(50).unwrap(); // the open D
-        bowed(&mut cello, 0.3);
-        cello.note_off(50);
-        assert!(!cello.hands.lifting);
-    }
-
-    #[test]
-    fn the_leaving_finger_only_takes_energy_out() {
-        // With the bow lifted the strings' energy may only fall through the lift (it
-        // scales the reflected wave by at most 1), and the lift takes most of it.
-        let mut cello = Instrument::new(InstrumentKind::Cello, FS);
-        cello.note_on(46).unwrap();
-        bowed(&mut cello, 0.5);
-        cello.note_off(46);
-        // The bow's 20 ms release ramp first (the bow still on the string).
-        bowed(&mut cello, 0.021);
-        let start = cello.energy_j();
-        let mut last = start;
-        while cello.hands.lifting {
-            cello.tick(BowControl::default());
-            let e = cello.energy_j();
-            if cello.hands.lifting {
-                // 1e-12 relative: rounding of the energy sum.
-                assert!(e <= last * (1.0 + 1e-12), "{e} after {last}");
-            } else {
-                // The finger is off and the string refitted for its open length: the loss
-                // and dispersion filters' stored energy is counted with their new
-                // coefficients (1 %: that bookkeeping, not a gain; the waves keep theirs
-                // and the new part of the string starts at rest).
-                assert!(e <= last * 1.01, "{e} after {last} at the release");
-            }
-            last = e;
-        }
-        // What the lift took: at least 90 % of the string's energy (10 dB) over its 40 ms.
-        assert!(last < 0.1 * start, "{last} of {start}");
     }
 }

@@ -3,7 +3,7 @@
 //! grid at `2 F_min`, the middle and `F_max / 2`), each cell coloured by the regime the
 //! probe showed, with the bowed pitch in cents printed where the motion is Helmholtz.
 
-use crate::playing_space::{notes, Cell, Measured, Model, Plan};
+use super::{notes, Cell, Measured, Model, Plan};
 use colophony::measure::regime::Regime;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -62,10 +62,10 @@ pub fn draw(
     let text = |size: i32| ("sans-serif", size).into_font().color(&BLACK);
     let legend = [
         match plan.attack {
-            crate::playing_space::Attack::Landing => {
+            super::Attack::Landing => {
                 format!("Colophony playing space: {} (the bow lands at each force)", model.name())
             }
-            crate::playing_space::Attack::Catch => format!(
+            super::Attack::Catch => format!(
                 "Colophony playing space: {} (caught at F_max/2, then held at each force)",
                 model.name()
             ),

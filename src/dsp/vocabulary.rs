@@ -1,0 +1,337 @@
+//! The DSP's shared vocabulary: the instruments and their data ([`InstrumentKind`]), the
+//! bow as the performer hands it to an engine ([`BowControl`]), what an engine gives back
+//! each sample ([`Frame`]), a note's own expression ([`NoteExpression`]), and the tuning
+//! and range constants. A leaf: it imports only the string and body data types it is
+//! made of, never an engine.
+
+use super::body::BodyMode;
+use super::waveguide::StringSpec;
+
+/// Largest correction the intonation table may hold, cents (the tuning margins of the
+/// instruments' buffers include it).
+pub const MAX_CORRECTION_CENTS: f64 = 50.0;
+
+/// The rate the point-bow strings and their body run at, whatever the host's: the output
+/// is resampled to the host rate ([`Resampler`]). The bowed string's regime (Helmholtz
+/// motion or a double slip: both are stable over much of the window, and which one an
+/// attack falls into changes with any detail of the discretisation) and its pitch then do
+/// not depend on the project's rate, and the intonation table, measured at this rate,
+/// holds at every rate. 48 kHz: the commonest host rate (no resampling there), and twice
+/// the hearing range. Measured in docs/precision.md (issue 16, item 3). The violin's and
+/// viola's strings run at a multiple of it ([`InstrumentKind::point_oversampling`]).
+pub const INTERNAL_RATE_HZ: f64 = 48_000.0;
+
+/// Most times [`INTERNAL_RATE_HZ`] any instrument's point strings run at
+/// ([`InstrumentKind::point_oversampling`]); their delay lines are sized for it.
+pub const MAX_POINT_OVERSAMPLING: usize = 2;
+
+pub const STRINGS: usize = 4;
+/// Highest note above the highest open string (about the end of the fingerboard).
+pub const MAX_STOP_SEMITONES: u8 = 31;
+/// Bow landing and lifting time, s.
+pub const BOW_RAMP_S: f64 = 0.02;
+/// Default pitch-bend range, semitones either way; also how far a bend may take a note
+/// below its open string or above the highest note (the tuning margins below).
+pub const PITCH_BEND_SEMITONES: f64 = 2.0;
+/// Widest pitch-bend range, semitones either way (the finger slides; a bend still stops
+/// at [`PITCH_BEND_SEMITONES`] below the open string and above the highest note).
+pub const MAX_BEND_RANGE_SEMITONES: f64 = 12.0;
+/// Reference pitch A4, Hz: lowest (baroque pitch), default and highest (Venetian high
+/// pitch). Every note, open strings included, is tuned from it.
+pub const REFERENCE_HZ_MIN: f64 = 415.0;
+pub const REFERENCE_HZ_DEFAULT: f64 = 440.0;
+pub const REFERENCE_HZ_MAX: f64 = 466.0;
+/// Semitones the tuning can move every note (the reference pitch, then the bend) below
+/// and above its equal-tempered pitch at A4 = 440 Hz: the strings' delay lines and the
+/// thermal instrument's rate floor are sized for them.
+pub const LOWEST_TUNING_SEMITONES: f64 =
+    -PITCH_BEND_SEMITONES - 1.013 - MAX_CORRECTION_CENTS / 100.0; // 12 log2(415/440)
+pub const HIGHEST_TUNING_SEMITONES: f64 =
+    PITCH_BEND_SEMITONES + 0.993 + MAX_CORRECTION_CENTS / 100.0; // 12 log2(466/440)
+
+/// Semitones from A4 = 440 Hz to the reference `a4_hz` (clamped to
+/// [`REFERENCE_HZ_MIN`]..=[`REFERENCE_HZ_MAX`]; a NaN is the default).
+pub fn reference_semitones(a4_hz: f64) -> f64 {
+    if a4_hz.is_nan() {
+        return 0.0;
+    }
+    12.0 * (a4_hz.clamp(REFERENCE_HZ_MIN, REFERENCE_HZ_MAX) / REFERENCE_HZ_DEFAULT).log2()
+}
+/// A lifted string whose wave energy is below this sleeps (about -130 dB below a
+/// default bowed note's few millijoules).
+pub const SLEEP_ENERGY_J: f64 = 1e-16;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InstrumentKind {
+    Violin,
+    Viola,
+    Cello,
+}
+
+impl InstrumentKind {
+    pub const ALL: [InstrumentKind; 3] = [Self::Violin, Self::Viola, Self::Cello];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Violin => "violin",
+            Self::Viola => "viola",
+            Self::Cello => "cello",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL
+            .into_iter()
+            .find(|k| k.name().eq_ignore_ascii_case(name))
+    }
+
+    /// MIDI notes of the open strings, low to high.
+    pub fn open_notes(self) -> [u8; STRINGS] {
+        match self {
+            Self::Violin => [55, 62, 69, 76],
+            Self::Viola => [48, 55, 62, 69],
+            Self::Cello => [36, 43, 50, 57],
+        }
+    }
+
+    /// String data, low to high (docs/literature-values.md §1.4: Desvages/NESS sets; viola G, D, A
+    /// inharmonicities are not in the table and are chosen between the neighbouring
+    /// violin and viola values). Open pitches are equal-tempered from A4 = 440 Hz.
+    pub fn strings(self) -> [StringSpec; STRINGS] {
+        let (z0, b): ([f64; 4], [f64; 4]) = match self {
+            Self::Violin => (
+                [0.350, 0.303, 0.203, 0.173],
+                [2.7e-4, 2.3e-4, 2.1e-4, 4.8e-5],
+            ),
+            Self::Viola => (
+                [0.484, 0.323, 0.281, 0.274],
+                [3.4e-4, 2.7e-4, 2.3e-4, 2.1e-4],
+            ),
+            Self::Cello => (
+                [1.91, 0.833, 0.506, 0.504],
+                [5.7e-4, 1.7e-4, 1.5e-4, 5.3e-5],
+            ),
+        };
+        let notes = self.open_notes();
+        std::array::from_fn(|i| StringSpec {
+            open_hz: midi_to_hz(notes[i] as f64),
+            z0_kg_per_s: z0[i],
+            inharmonicity_open: b[i],
+            q1: 500.0,
+            q_hi: 250.0,
+        })
+    }
+
+    /// Generic body modes (see [`super::body`]).
+    pub(crate) fn body_modes(self) -> [BodyMode; 5] {
+        let scale = match self {
+            Self::Violin => 1.0,
+            Self::Viola => 0.8,
+            Self::Cello => 0.42,
+        };
+        [
+            (275.0, 12.0, 0.8),
+            (405.0, 15.0, 0.5),
+            (470.0, 18.0, 1.0),
+            (540.0, 18.0, 1.0),
+            (2500.0, 2.5, 0.6),
+        ]
+        .map(|(f, q, gain)| BodyMode {
+            freq_hz: f * scale,
+            q,
+            gain,
+        })
+    }
+
+    /// What the bow force is multiplied by on string `index` when the strings are weighted
+    /// ([`Instrument::set_string_weighting`]): the string's impedance over
+    /// [`WEIGHT_REFERENCE_Z0`]. Schelleng's limits are both proportional to `Z0` (with the
+    /// dashpot bridge `R = 2 Q1 Z0 / pi`, docs/literature-values.md), so one force parameter then
+    /// keeps the same place in every string's window, as a player leans into the heavy
+    /// strings.
+    pub fn string_weight(self, index: usize) -> f64 {
+        self.string_weight_for(index, WEIGHT_REFERENCE_Z0)
+    }
+
+    /// String `index`'s impedance over `reference_z0` (kg/s): its weight for a model whose
+    /// force parameter is the force on a string of that impedance (paper B's thermal
+    /// model: [`crate::dsp::thermal_instrument::THERMAL_WEIGHT_REFERENCE_Z0`]).
+    pub fn string_weight_for(self, index: usize, reference_z0: f64) -> f64 {
+        self.strings()[index.min(STRINGS - 1)].z0_kg_per_s / reference_z0
+    }
+
+    /// How many times [`INTERNAL_RATE_HZ`] each point-bow string of this instrument runs
+    /// at (the bridge force of the faster ones is decimated back to it by a half-band
+    /// filter, [`super::halfband`], before the body). A point bow's slip starts on a
+    /// sample, so the Helmholtz period locks to the sample grid (docs/playing-space.md,
+    /// "The sample-grid lock"): the violin's and viola's top octaves (periods of 18 to 55
+    /// samples at 48 kHz) play 96 kHz strings, where the lock is half as wide, and so does
+    /// the cello's A string (A4 to A5 have 110 to 55 samples a period at 48 kHz, E6 36;
+    /// docs/playing-space.md, "The cello's A string at 96 kHz"). The cello's three lower
+    /// strings, which play the notes below A3 unless a note is asked onto them, run at
+    /// 48 kHz, at half the cost.
+    pub fn point_oversampling(self) -> [usize; STRINGS] {
+        match self {
+            Self::Violin | Self::Viola => [2; STRINGS],
+            Self::Cello => [1, 1, 1, 2],
+        }
+    }
+
+    /// Output scale: bridge force to a sample value, so that a default note of any
+    /// instrument peaks near -12 dBFS.
+    pub fn output_scale_per_n(self) -> f64 {
+        let mean_z0: f64 =
+            self.strings().iter().map(|s| s.z0_kg_per_s).sum::<f64>() / STRINGS as f64;
+        0.1 / mean_z0
+    }
+
+    /// The string a note goes to, if the instrument can play it.
+    /// Vibrating length of the open strings, m (docs/literature-values.md §1.4: violin 0.32,
+    /// viola 0.38, cello 0.69).
+    pub fn string_length_m(self) -> f64 {
+        match self {
+            Self::Violin => 0.32,
+            Self::Viola => 0.38,
+            Self::Cello => 0.69,
+        }
+    }
+
+    pub fn string_for_note(self, note: u8) -> Option<usize> {
+        let open = self.open_notes();
+        if note < open[0] || note > open[STRINGS - 1] + MAX_STOP_SEMITONES {
+            return None;
+        }
+        open.iter().rposition(|&o| o <= note)
+    }
+
+    /// The string a note goes to when the player asks for string `preferred` (0 = the
+    /// lowest): that string if it can play the note (at or above its open pitch, at most
+    /// [`MAX_STOP_SEMITONES`] above), else the usual choice of [`Self::string_for_note`].
+    pub fn string_for_note_on(self, note: u8, preferred: Option<usize>) -> Option<usize> {
+        if let Some(p) = preferred.filter(|&p| p < STRINGS) {
+            let open = self.open_notes()[p];
+            if note >= open && note <= open + MAX_STOP_SEMITONES {
+                return Some(p);
+            }
+        }
+        self.string_for_note(note)
+    }
+
+    /// Playable notes, inclusive.
+    pub fn note_range(self) -> (u8, u8) {
+        let open = self.open_notes();
+        (open[0], open[STRINGS - 1] + MAX_STOP_SEMITONES)
+    }
+}
+
+/// Seconds for a string's energy to fall from `energy_j` to [`SLEEP_ENERGY_J`] at its
+/// fundamental's decay rate: amplitude falls as `exp(-pi f0 t / Q1)`, energy twice as fast,
+/// so `t = Q1 ln(E / E_sleep) / (2 pi f0)` (0 below the threshold or for absurd inputs).
+pub fn ring_out_s(energy_j: f64, f0_hz: f64, q1: f64) -> f64 {
+    let t = q1 * (energy_j / SLEEP_ENERGY_J).ln() / (2.0 * std::f64::consts::PI * f0_hz);
+    if t.is_finite() && t > 0.0 {
+        t
+    } else {
+        0.0
+    }
+}
+
+pub fn midi_to_hz(note: f64) -> f64 {
+    440.0 * 2f64.powf((note - 69.0) / 12.0)
+}
+
+/// The player's bow, shared by every bowed string.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BowControl {
+    /// Signed: the sign is the bow direction.
+    pub velocity_m_per_s: f64,
+    pub force_n: f64,
+    /// Distance from the bridge over the vibrating length.
+    pub position_beta: f64,
+}
+
+impl Default for BowControl {
+    fn default() -> Self {
+        Self {
+            velocity_m_per_s: 0.1,
+            force_n: 1.0,
+            position_beta: 0.1,
+        }
+    }
+}
+
+/// One sample of output with the probed string's contact signals.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Frame {
+    pub audio: f64,
+    /// String velocity at the bow point of the last string that got a note, m/s.
+    pub bow_point_velocity_m_per_s: f64,
+    /// Friction force on that string, N.
+    pub friction_force_n: f64,
+}
+
+/// One note's own expression on top of the shared controls (MPE's per-channel bend,
+/// pressure and timbre; CLAP's note expressions): its finger's bend, how hard the bow
+/// presses on its string, and where on its string the bow plays.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NoteExpression {
+    /// Added to the shared pitch bend, semitones (the string's reach still limits it).
+    pub bend_semitones: f64,
+    /// Multiplies the bow force on this string (0..=[`MAX_NOTE_FORCE_SCALE`]).
+    pub force_scale: f64,
+    /// Multiplies the bow position beta on this string (the result within
+    /// [`MIN_NOTE_BETA`]..=[`MAX_NOTE_BETA`]).
+    pub position_scale: f64,
+}
+
+impl NoteExpression {
+    /// No expression of its own: the shared bow and bend.
+    pub const NEUTRAL: Self = Self {
+        bend_semitones: 0.0,
+        force_scale: 1.0,
+        position_scale: 1.0,
+    };
+
+    /// Takes `new` (sanitized) in place of this one; whether the bend changed (the
+    /// string must be retuned).
+    pub fn replace(&mut self, new: NoteExpression) -> bool {
+        let new = new.sanitized();
+        let bent = new.bend_semitones != self.bend_semitones;
+        *self = new;
+        bent
+    }
+
+    /// Finite and within the ranges above (a non-finite part stays neutral).
+    pub fn sanitized(self) -> Self {
+        let or = |x: f64, neutral: f64| if x.is_finite() { x } else { neutral };
+        Self {
+            bend_semitones: or(self.bend_semitones, 0.0)
+                .clamp(-MAX_NOTE_BEND_SEMITONES, MAX_NOTE_BEND_SEMITONES),
+            force_scale: or(self.force_scale, 1.0).clamp(0.0, MAX_NOTE_FORCE_SCALE),
+            position_scale: or(self.position_scale, 1.0).clamp(0.0, MAX_NOTE_BETA / MIN_NOTE_BETA),
+        }
+    }
+}
+
+/// The widest per-note bend, semitones: MPE's default member-channel range.
+pub const MAX_NOTE_BEND_SEMITONES: f64 = 48.0;
+/// The impedance of the string the force parameter is the force on when the strings are
+/// weighted, kg/s: about the violin's A string (0.203), so the default 1 N is 1 N there.
+/// Chosen by measurement (docs/playing-space.md, "Weighted strings"): from 0.5 down to
+/// 0.15 kg/s, the lower the reference (the more force on every string), the more notes
+/// settle into Helmholtz motion at the defaults; 0.2 doubles them against no weighting
+/// while keeping the violin's strings near the forces players use (0.9-1.8 N).
+pub const WEIGHT_REFERENCE_Z0: f64 = 0.2;
+
+/// The most force String Weight bows a string with, N: the Bow Force parameter's top.
+/// Without the cap the parameter's 10 N would bow the cello's C string with 95 N (five
+/// times its `F_max` at 0.1 m/s), raucous and up to 14 dB over full scale (measured,
+/// every point law, 44.1 kHz); at 10 N it peaks at 0.2-0.7 of full scale. The defaults
+/// stay under it on every string (the cello's C string: 9.55 N).
+pub const MAX_WEIGHTED_FORCE_N: f64 = 10.0;
+
+/// The most a note's pressure may multiply its string's bow force.
+pub const MAX_NOTE_FORCE_SCALE: f64 = 4.0;
+/// A note's own bow position stays within the Bow Position parameter's range.
+pub const MIN_NOTE_BETA: f64 = 0.02;
+pub const MAX_NOTE_BETA: f64 = 0.5;
