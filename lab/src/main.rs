@@ -65,10 +65,12 @@ enum Command {
         nodes: usize,
         /// Solver preset from the work-precision benchmark: draft, good, reference or auto
         /// (sets the Newton tolerance and the thermal node count; see src/quality.rs).
-        /// Without it: --nodes, and the reference's tolerance.
+        /// Without it: --nodes, and the reference's tolerance for one bare note; the
+        /// plugin's own (good's) through the performer (--midi, --bridge).
         #[arg(long, value_parser = parse_quality)]
         quality: Option<Quality>,
-        /// Thermal bow: width of the hair ribbon, m (the force is spread over it).
+        /// Thermal bow: width of the hair ribbon, m (the force is spread over it; the
+        /// plugin's Bow Width is the same in mm).
         #[arg(long, default_value_t = 0.01)]
         bow_width: f64,
         /// Play a preset through the plugin's performer: a factory preset's id or name,
@@ -79,9 +81,9 @@ enum Command {
         /// wine-glass and brake-squeal rub that object alone at its own bow.
         #[arg(long)]
         preset: Option<String>,
-        /// Play a standard MIDI file (notes and pitch bend, with its tempo map) through the
-        /// plugin's performer at the plugin's defaults and the bow given; --note,
-        /// --seconds and --release are then unused.
+        /// Play a standard MIDI file (notes, pitch bend, controllers and channel pressure,
+        /// with its tempo map) through the plugin's performer at the plugin's defaults and
+        /// the bow given; --note, --seconds and --release are then unused.
         #[arg(long)]
         midi: Option<PathBuf>,
         /// With --midi: only this track (0 = the first in the file); default all.
@@ -116,7 +118,10 @@ enum Command {
     /// refined references beside the cost, and the STK and Faust peers) to DIR; `peers
     /// [--seconds S] [--out DIR]` times whole processes rendering cello D3 against STK's
     /// Bowed (needs libstk-dev and g++); `thermal-constants` bows paper B's contact with
-    /// candidate constant sets on probe notes across the window.
+    /// candidate constant sets on probe notes across the window; `scenes` times what
+    /// skipping silent strings saves; `playing-space --out DIR` maps Helmholtz motion over
+    /// the bowing window (see its options); `intonation --out FILE` measures the bowed
+    /// intonation table.
     Bench {
         what: String,
         /// Output directory (precision).
