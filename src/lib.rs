@@ -23,7 +23,7 @@ pub mod quality;
 pub mod telemetry;
 pub mod user_bridges;
 
-use dsp::instrument::{BowControl, InstrumentKind};
+use dsp::vocabulary::{BowControl, InstrumentKind};
 use nice_plug::midi::Key;
 use nice_plug::prelude::*;
 use params::ColophonyParams;

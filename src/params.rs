@@ -18,8 +18,8 @@
 //! | `string_weight` | String Weight | - | off, on (each string bowed with the force times its impedance over 0.2 kg/s; paper B's thermal model over 1 kg/s) | on |
 
 use crate::dsp::friction::FrictionModel;
-use crate::dsp::instrument::InstrumentKind;
 use crate::dsp::rubbed::RubbedPreset;
+use crate::dsp::vocabulary::InstrumentKind;
 use crate::quality::Quality;
 use nice_plug::prelude::*;
 
@@ -317,8 +317,8 @@ pub fn bow_width_mm_range() -> FloatRange {
 
 pub fn reference_pitch_range() -> FloatRange {
     FloatRange::Linear {
-        min: crate::dsp::instrument::REFERENCE_HZ_MIN as f32,
-        max: crate::dsp::instrument::REFERENCE_HZ_MAX as f32,
+        min: crate::dsp::vocabulary::REFERENCE_HZ_MIN as f32,
+        max: crate::dsp::vocabulary::REFERENCE_HZ_MAX as f32,
     }
 }
 
@@ -372,7 +372,7 @@ impl Default for ColophonyParams {
             // Not smoothed: a change retunes the sounding notes at the next block.
             reference_pitch: FloatParam::new(
                 "Reference Pitch",
-                crate::dsp::instrument::REFERENCE_HZ_DEFAULT as f32,
+                crate::dsp::vocabulary::REFERENCE_HZ_DEFAULT as f32,
                 reference_pitch_range(),
             )
             .with_unit(" Hz")
@@ -382,10 +382,10 @@ impl Default for ColophonyParams {
             // Not smoothed: a change re-bends the sounding notes at the next block.
             bend_range: FloatParam::new(
                 "Pitch Bend Range",
-                crate::dsp::instrument::PITCH_BEND_SEMITONES as f32,
+                crate::dsp::vocabulary::PITCH_BEND_SEMITONES as f32,
                 FloatRange::Linear {
                     min: 0.0,
-                    max: crate::dsp::instrument::MAX_BEND_RANGE_SEMITONES as f32,
+                    max: crate::dsp::vocabulary::MAX_BEND_RANGE_SEMITONES as f32,
                 },
             )
             .with_unit(" st")
@@ -463,8 +463,8 @@ impl ColophonyParams {
     }
 
     /// The bow the parameters set (their values, not their smoothed ramps).
-    pub fn bow(&self) -> crate::dsp::instrument::BowControl {
-        crate::dsp::instrument::BowControl {
+    pub fn bow(&self) -> crate::dsp::vocabulary::BowControl {
+        crate::dsp::vocabulary::BowControl {
             velocity_m_per_s: self.bow_velocity.value() as f64,
             force_n: self.bow_force.value() as f64,
             position_beta: self.bow_position.value() as f64,

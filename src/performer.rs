@@ -12,7 +12,7 @@
 //! - the tail the host hears about ([`Status`]).
 //!
 //! ```
-//! use colophony::dsp::instrument::{BowControl, InstrumentKind};
+//! use colophony::dsp::vocabulary::{BowControl, InstrumentKind};
 //! use colophony::performer::{Performer, Setup};
 //! let setup = Setup::default();
 //! let mut performer = Performer::new(InstrumentKind::Cello);
@@ -32,13 +32,14 @@ pub mod stroke;
 use crate::dsp::bridge_data::{self, BridgeModes};
 use crate::dsp::engine::Engine;
 use crate::dsp::friction::FrictionModel;
-use crate::dsp::instrument::{
-    midi_to_hz, BowControl, Frame, Instrument, InstrumentKind, MAX_BEND_RANGE_SEMITONES,
-    MAX_NOTE_BETA, MIN_NOTE_BETA, PITCH_BEND_SEMITONES,
-};
+use crate::dsp::instrument::Instrument;
 use crate::dsp::rubbed::{RubbedInstrument, RubbedPreset};
 use crate::dsp::thermal::ThermalString;
 use crate::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
+use crate::dsp::vocabulary::{
+    midi_to_hz, BowControl, Frame, InstrumentKind, MAX_BEND_RANGE_SEMITONES, MAX_NOTE_BETA,
+    MIN_NOTE_BETA, PITCH_BEND_SEMITONES,
+};
 use crate::quality::{self, Quality};
 use direct::DirectBow;
 use midi_map::{MidiMap, Target};
@@ -164,7 +165,7 @@ pub struct Setup {
     /// parameters' force presses a slow bow too hard (raucous).
     pub dynamics_guard: bool,
     /// The strings weighted (on by default): the point-bow strings are bowed with the
-    /// force times their impedance over [`crate::dsp::instrument::WEIGHT_REFERENCE_Z0`],
+    /// force times their impedance over [`crate::dsp::vocabulary::WEIGHT_REFERENCE_Z0`],
     /// so one force keeps its place in every string's window. Off, every string gets the
     /// force as set. Paper B's thermal model is weighted against its own reference
     /// ([`crate::dsp::thermal_instrument::THERMAL_WEIGHT_REFERENCE_Z0`]); the rubbed
@@ -179,7 +180,7 @@ impl Default for Setup {
             point_law: Some(FrictionModel::Hyperbolic),
             rubbed: None,
             newton_tolerance_m_per_s: Quality::Good.newton_tolerance_m_per_s(),
-            reference_hz: crate::dsp::instrument::REFERENCE_HZ_DEFAULT,
+            reference_hz: crate::dsp::vocabulary::REFERENCE_HZ_DEFAULT,
             preferred_string: None,
             thermal_nodes: ThermalNodes::Fixed(quality::GOOD_NODES),
             bow_width_m: 0.01,

@@ -38,8 +38,8 @@
 //! beta 0.1, 1 cm: about 138), within 3..=[`MAX_NODES`]. This is a rule calibrated on one
 //! measured point of the front, not a measurement at every note.
 
-use crate::dsp::instrument::InstrumentKind;
 use crate::dsp::thermal_instrument::MAX_NODES;
+use crate::dsp::vocabulary::InstrumentKind;
 
 /// A preset; `Auto` depends on the note and the bow.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -11,7 +11,7 @@
 //! a saved bridge that no longer parses (a damaged state) plays the shipped one.
 
 use crate::dsp::bridge_data::{parse_bridge, BridgeModes};
-use crate::dsp::instrument::InstrumentKind;
+use crate::dsp::vocabulary::InstrumentKind;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::Path;

@@ -6,8 +6,8 @@
 //! dev-dependencies), which aborts the test binary on any allocation.
 
 use colophony::dsp::bridge_data::shipped_cello_bridge;
-use colophony::dsp::instrument::{BowControl, InstrumentKind};
 use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
+use colophony::dsp::vocabulary::{BowControl, InstrumentKind};
 use colophony::editor::nodes::NodeProbe;
 use colophony::editor::EditorLink;
 use colophony::measure::contact::ContactSample;

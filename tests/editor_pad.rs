@@ -549,7 +549,7 @@ fn saving_a_preset_writes_the_current_values_to_the_user_folder() {
 
 #[test]
 fn loading_a_bridge_keeps_it_in_the_project_and_restarts_and_a_bad_file_changes_nothing() {
-    let cello = colophony::dsp::instrument::InstrumentKind::Cello;
+    let cello = colophony::dsp::vocabulary::InstrumentKind::Cello;
     let fitted = workspace_file("assets/bridges/violin-generic.json");
     let broken = std::env::temp_dir().join(format!(
         "colophony-broken-bridge-{}.json",
@@ -746,7 +746,7 @@ fn the_bridge_picker_lists_a_folders_bridges_and_chooses_one() {
         .bridge_mut()
         .path()
         .ends_with("violin-generic.json"));
-    let cello = colophony::dsp::instrument::InstrumentKind::Cello;
+    let cello = colophony::dsp::vocabulary::InstrumentKind::Cello;
     assert_eq!(
         colophony::user_bridges::chosen_name(&f.params.user_bridges, cello).as_deref(),
         Some("violin-generic.json")

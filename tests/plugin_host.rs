@@ -8,7 +8,7 @@
 mod host;
 
 use colophony::analysis::{cents, peak_frequency_hz, rms};
-use colophony::dsp::instrument::{midi_to_hz, InstrumentKind, BOW_RAMP_S};
+use colophony::dsp::vocabulary::{midi_to_hz, InstrumentKind, BOW_RAMP_S};
 use host::{
     channel_f64, clap_state, first_unsafe_sample, workspace_root, write_wav, Event, HostedPlugin,
     Score,
@@ -1084,7 +1084,8 @@ fn a_bridge_saved_with_the_project_plays_and_a_damaged_one_plays_the_shipped_bri
 /// that the output is shifted by exactly that), rounded, and a fraction of a millisecond.
 #[test]
 fn the_reported_latency_is_the_resamplers_delay_at_every_rate() {
-    use colophony::dsp::instrument::{Instrument, InstrumentKind};
+    use colophony::dsp::instrument::Instrument;
+    use colophony::dsp::vocabulary::InstrumentKind;
     for sample_rate in [22_050.0, 44_100.0, 48_000.0, 96_000.0, 192_000.0] {
         let mut plugin = active_plugin(sample_rate, BLOCK);
         let reported = plugin.latency();

@@ -45,11 +45,12 @@ mod host;
 use colophony::dsp::friction::bristle::{SolverStats, NEWTON_CAP};
 use colophony::dsp::friction::BowInput;
 use colophony::dsp::friction::FrictionModel;
-use colophony::dsp::instrument::{BowControl, Instrument, InstrumentKind, BOW_RAMP_S, STRINGS};
+use colophony::dsp::instrument::Instrument;
 use colophony::dsp::rubbed::{RubbedPreset, RubbedScene};
 use colophony::dsp::thermal_instrument::{
     ThermalInstrument, ThermalSettings, MAX_NODES, RECONFIGURE_FADE_S,
 };
+use colophony::dsp::vocabulary::{BowControl, InstrumentKind, BOW_RAMP_S, STRINGS};
 use colophony::params::{bow_force_range, bow_position_range, bow_velocity_range};
 use colophony::performer::{Performer, Setup, ThermalNodes};
 use colophony::quality::Quality;

@@ -12,10 +12,10 @@ use colophony::dsp::friction::stribeck::StribeckFriction;
 use colophony::dsp::friction::{
     AnyFriction, BowInput, FrictionContact, FrictionModel, HyperbolicFriction, LoadLine,
 };
-use colophony::dsp::instrument::InstrumentKind;
 use colophony::dsp::thermal::{
     HairParams, ThermalBowControl, ThermalParams, ThermalString, ThermalStringSpec,
 };
+use colophony::dsp::vocabulary::InstrumentKind;
 use colophony::dsp::waveguide::WaveguideString;
 use colophony_lab::admittance_fit::shipped_cello_bridge;
 use criterion::{criterion_group, criterion_main, Criterion};
@@ -92,7 +92,8 @@ fn waveguide_tick(c: &mut Criterion) {
 }
 
 fn performer_tick(c: &mut Criterion) {
-    use colophony::dsp::instrument::{BowControl, Instrument};
+    use colophony::dsp::instrument::Instrument;
+    use colophony::dsp::vocabulary::BowControl;
     use colophony::performer::{Performer, Setup};
     let bow = BowControl::default();
     let mut group = c.benchmark_group("cello D3 bowed, one sample");

@@ -4,8 +4,8 @@
 
 use crate::render::{render, render_rubbed, RenderSettings};
 use colophony::dsp::friction::FrictionModel;
-use colophony::dsp::instrument::{BowControl, InstrumentKind};
 use colophony::dsp::rubbed::RubbedPreset;
+use colophony::dsp::vocabulary::{BowControl, InstrumentKind};
 use std::time::Instant;
 
 const SECONDS: f64 = 10.0;
@@ -67,7 +67,7 @@ pub fn friction_table() -> Result<String, String> {
         // The violin's strings run at twice the internal rate
         // (`InstrumentKind::point_oversampling`): its A string, the same bowing.
         let violin = RenderSettings {
-            instrument: colophony::dsp::instrument::InstrumentKind::Violin,
+            instrument: colophony::dsp::vocabulary::InstrumentKind::Violin,
             note: 69,
             ..settings.clone()
         };
@@ -114,7 +114,7 @@ fn host_rate_rows() -> Result<Vec<String>, String> {
     let mut lines = vec![
         format!(
             "| host rate (kHz) | plugin ({} kHz inside, resampled): x real time | strings at the host rate: x real time |",
-            colophony::dsp::instrument::INTERNAL_RATE_HZ / 1e3
+            colophony::dsp::vocabulary::INTERNAL_RATE_HZ / 1e3
         ),
         "|---|---|---|".into(),
     ];
@@ -511,13 +511,13 @@ macro_rules! scene_instrument {
 scene_instrument!(
     colophony::dsp::instrument::Instrument,
     |i: &colophony::dsp::instrument::Instrument| {
-        1.0 - i.awake_strings() as f64 / colophony::dsp::instrument::STRINGS as f64
+        1.0 - i.awake_strings() as f64 / colophony::dsp::vocabulary::STRINGS as f64
     }
 );
 scene_instrument!(
     colophony::dsp::thermal_instrument::ThermalInstrument,
     |i: &colophony::dsp::thermal_instrument::ThermalInstrument| {
-        i.asleep_polarisations() as f64 / (2 * colophony::dsp::instrument::STRINGS) as f64
+        i.asleep_polarisations() as f64 / (2 * colophony::dsp::vocabulary::STRINGS) as f64
     }
 );
 
@@ -564,7 +564,7 @@ pub fn peers(seconds: f64, dir: &std::path::Path) -> Result<String, String> {
     })?;
     let me = std::env::current_exe().map_err(|e| e.to_string())?;
     let secs = format!("{seconds}");
-    let d3_hz = format!("{}", colophony::dsp::instrument::midi_to_hz(50.0));
+    let d3_hz = format!("{}", colophony::dsp::vocabulary::midi_to_hz(50.0));
     // `quality`: a solver preset (its Newton tolerance); without one, `render` solves the
     // bristle laws to the reference's tolerance, as issue 20's table was first measured.
     let ours = |friction: &str, quality: Option<&str>| {

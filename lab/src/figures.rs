@@ -11,8 +11,8 @@
 use crate::render::{render, RenderSettings};
 use colophony::dsp::friction::bristle::BristleParams;
 use colophony::dsp::friction::FrictionModel;
-use colophony::dsp::instrument::{BowControl, InstrumentKind};
 use colophony::dsp::rubbed::{RubbedPreset, RubbedScene};
+use colophony::dsp::vocabulary::{BowControl, InstrumentKind};
 use plotters::prelude::*;
 use plotters::style::{register_font, FontStyle};
 use std::path::Path;

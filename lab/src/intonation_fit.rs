@@ -33,8 +33,8 @@
 //! (docs/playing-space.md, "Tuned at the defaults").
 
 use crate::playing_space::{measure, Bowing, Cell, Model};
-use colophony::dsp::instrument::{InstrumentKind, MAX_STOP_SEMITONES, STRINGS};
 use colophony::dsp::intonation::{model_index, IntonationTable};
+use colophony::dsp::vocabulary::{InstrumentKind, MAX_STOP_SEMITONES, STRINGS};
 use rayon::prelude::*;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -254,7 +254,7 @@ pub fn run(
          # run at {internal} Hz inside, the violin's and viola's strings and the cello's A string at\n\
          # twice that), {passes} passes.\n{}",
         merged.to_csv(),
-        internal = colophony::dsp::instrument::INTERNAL_RATE_HZ,
+        internal = colophony::dsp::vocabulary::INTERNAL_RATE_HZ,
     );
     std::fs::write(out, text).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
     Ok(format!("{report}wrote {}", out.display()))

@@ -2,8 +2,8 @@
 
 use clap::{Parser, Subcommand};
 use colophony::dsp::friction::FrictionModel;
-use colophony::dsp::instrument::{BowControl, InstrumentKind};
 use colophony::dsp::rubbed::RubbedPreset;
+use colophony::dsp::vocabulary::{BowControl, InstrumentKind};
 use colophony::quality::Quality;
 use colophony_lab::render::{check, parse_note, render_frames, write_wav, RenderSettings, WavOut};
 use std::path::PathBuf;
@@ -279,7 +279,7 @@ fn main() -> ExitCode {
             let nodes = match (quality, instrument.string_for_note(note)) {
                 (Some(Quality::Auto), Some(i)) => colophony::quality::auto_nodes_at_speed(
                     2.0 * instrument.string_length_m() * instrument.strings()[i].open_hz,
-                    colophony::dsp::instrument::midi_to_hz(note as f64),
+                    colophony::dsp::vocabulary::midi_to_hz(note as f64),
                     bow_position,
                     bow_width,
                 ),

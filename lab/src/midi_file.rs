@@ -9,7 +9,7 @@
 //! velocity, force and position are the constants given.
 
 use colophony::dsp::filters::{flush_tiny, safety_limit};
-use colophony::dsp::instrument::BowControl;
+use colophony::dsp::vocabulary::BowControl;
 use colophony::performer::{Performer, Setup, Status};
 use midly::{MetaMessage, MidiMessage, Smf, Timing, TrackEventKind};
 
@@ -159,7 +159,7 @@ impl Performance {
     /// The plugin at its default parameters playing `instrument` with `point_law` (`None`:
     /// paper B's thermal model), unity gain, in blocks of 512 at `sample_rate_hz`.
     pub fn plugin_defaults(
-        instrument: colophony::dsp::instrument::InstrumentKind,
+        instrument: colophony::dsp::vocabulary::InstrumentKind,
         point_law: Option<colophony::dsp::friction::FrictionModel>,
         sample_rate_hz: f64,
     ) -> Self {

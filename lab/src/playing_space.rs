@@ -39,12 +39,13 @@ use colophony::analysis::{cents, peak_frequency_hz, slip_stats};
 use colophony::dsp::engine::Engine;
 use colophony::dsp::friction::bristle::BristleIntegrator;
 use colophony::dsp::friction::FrictionModel;
-use colophony::dsp::instrument::{midi_to_hz, BowControl, Instrument, InstrumentKind, STRINGS};
+use colophony::dsp::instrument::Instrument;
 use colophony::dsp::intonation::{self, IntonationTable};
 use colophony::dsp::thermal::ThermalParams;
 use colophony::dsp::thermal_instrument::{
     ThermalInstrument, ThermalSettings, THERMAL_WEIGHT_REFERENCE_Z0,
 };
+use colophony::dsp::vocabulary::{midi_to_hz, BowControl, InstrumentKind, STRINGS};
 use colophony::measure::contact::ContactSample;
 use colophony::measure::regime::{classify_regime, Regime};
 use colophony::measure::window::SchellengWindow;
@@ -843,7 +844,7 @@ mod tests {
         (0..n)
             .map(|i| {
                 let bow = catcher.bow(i);
-                let frame = colophony::dsp::instrument::Frame {
+                let frame = colophony::dsp::vocabulary::Frame {
                     bow_point_velocity_m_per_s: v_s(i),
                     friction_force_n: 0.3 * bow.force_n,
                     ..Default::default()

@@ -41,9 +41,9 @@ use crate::render::{
 };
 use colophony::analysis::{cents, partial_amplitude, peak_frequency_hz, rms, slip_stats};
 use colophony::dsp::friction::FrictionModel;
-use colophony::dsp::instrument::{midi_to_hz, BowControl, InstrumentKind};
 use colophony::dsp::resample::{resample_whole_from, Resampler};
 use colophony::dsp::rubbed::RubbedPreset;
+use colophony::dsp::vocabulary::{midi_to_hz, BowControl, InstrumentKind};
 use colophony::dsp::waveguide::MAX_DISPERSION_STAGES;
 use std::fmt::Write as _;
 use std::path::Path;

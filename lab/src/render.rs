@@ -9,8 +9,9 @@
 
 use colophony::dsp::friction::bristle::{BristleParams, SolverStats};
 use colophony::dsp::friction::FrictionModel;
-use colophony::dsp::instrument::{BowControl, Frame, Instrument, InstrumentKind};
+use colophony::dsp::instrument::Instrument;
 use colophony::dsp::rubbed::{RubbedPreset, RubbedScene};
+use colophony::dsp::vocabulary::{BowControl, Frame, InstrumentKind};
 use std::fmt;
 use std::path::Path;
 
@@ -57,7 +58,7 @@ impl Default for RenderSettings {
             release_s: None,
             friction: FrictionModel::Hyperbolic,
             bristle: BristleParams::plugin_string(),
-            reference_hz: colophony::dsp::instrument::REFERENCE_HZ_DEFAULT,
+            reference_hz: colophony::dsp::vocabulary::REFERENCE_HZ_DEFAULT,
             torsion: true,
             bow_hair: true,
             intonation: true,
@@ -140,7 +141,7 @@ pub fn check(settings: &RenderSettings) -> Result<(), RenderError> {
             settings.sample_rate_hz
         ));
     }
-    use colophony::dsp::instrument::{REFERENCE_HZ_MAX, REFERENCE_HZ_MIN};
+    use colophony::dsp::vocabulary::{REFERENCE_HZ_MAX, REFERENCE_HZ_MIN};
     if !(settings.reference_hz.is_finite()
         && (REFERENCE_HZ_MIN..=REFERENCE_HZ_MAX).contains(&settings.reference_hz))
     {
@@ -337,9 +338,9 @@ pub fn thermal_string(
         .string_for_note(settings.note)
         .expect("check() accepted the note");
     let open = kind.strings()[index];
-    let f0 = colophony::dsp::instrument::midi_to_hz(
+    let f0 = colophony::dsp::vocabulary::midi_to_hz(
         settings.note as f64
-            + colophony::dsp::instrument::reference_semitones(settings.reference_hz),
+            + colophony::dsp::vocabulary::reference_semitones(settings.reference_hz),
     );
     let spec = ThermalStringSpec {
         f0_hz: f0,

@@ -14,8 +14,8 @@
 //! the set's own `mu_cold` and `mu_hot`.
 
 use crate::playing_space::{measure, Bowing, Cell, Model};
-use colophony::dsp::instrument::InstrumentKind;
 use colophony::dsp::thermal::{bulk_cooled, ThermalParams};
+use colophony::dsp::vocabulary::InstrumentKind;
 use colophony::measure::regime::Regime;
 use colophony::measure::window::SchellengWindow;
 use rayon::prelude::*;

@@ -18,7 +18,7 @@
 //! and static counts as above. `cargo test --release --test attack_survey -- --ignored
 //! --nocapture`.
 use colophony::dsp::friction::FrictionModel;
-use colophony::dsp::instrument::{midi_to_hz, BowControl, InstrumentKind};
+use colophony::dsp::vocabulary::{midi_to_hz, BowControl, InstrumentKind};
 use colophony::measure::contact::ContactSample;
 use colophony::measure::regime::{classify_regime, Regime};
 use colophony::performer::{Performer, Setup};

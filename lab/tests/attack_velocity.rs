@@ -5,7 +5,7 @@
 
 use colophony::analysis::{cents, peak_frequency_hz};
 use colophony::dsp::friction::FrictionModel;
-use colophony::dsp::instrument::InstrumentKind;
+use colophony::dsp::vocabulary::InstrumentKind;
 use colophony_lab::midi_file::{perform, MidiEvent, Performance, Timed};
 
 const FS: f64 = 48_000.0;

@@ -3,7 +3,7 @@
 //! bowed pitch, passivity with the bow lifted.
 
 use colophony::analysis::{cents, peak_frequency_hz, rms, slip_stats};
-use colophony::dsp::instrument::{midi_to_hz, BowControl, InstrumentKind};
+use colophony::dsp::vocabulary::{midi_to_hz, BowControl, InstrumentKind};
 use colophony_lab::render::{render, RenderSettings};
 
 const FS: f64 = 48_000.0;

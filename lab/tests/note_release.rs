@@ -5,7 +5,7 @@
 
 use colophony::analysis::partial_amplitude;
 use colophony::dsp::friction::FrictionModel;
-use colophony::dsp::instrument::InstrumentKind;
+use colophony::dsp::vocabulary::InstrumentKind;
 use colophony::performer::stroke::StrokeMode;
 use colophony_lab::midi_file::{perform, MidiEvent, Performance, Timed};
 

@@ -4,9 +4,10 @@
 use colophony::analysis::{cents, peak_frequency_hz, rms, slip_stats};
 use colophony::dsp::friction::bristle::{BristleFriction, BristleLaw, BristleParams};
 use colophony::dsp::friction::{BowInput, FrictionContact, FrictionModel, LoadLine};
-use colophony::dsp::instrument::{midi_to_hz, BowControl, Instrument, InstrumentKind};
+use colophony::dsp::instrument::Instrument;
 use colophony::dsp::modal::{ModalObject, ModeSpec};
 use colophony::dsp::rubbed::{RubbedPreset, RubbedScene};
+use colophony::dsp::vocabulary::{midi_to_hz, BowControl, InstrumentKind};
 use colophony_lab::render::{render, RenderSettings};
 
 const FS: f64 = 48_000.0;

@@ -302,7 +302,7 @@ fn one_slip_per_period_inside_the_schelleng_window() {
 #[test]
 fn the_thermal_bow_renders_at_the_host_rate_in_tune_and_bounded() {
     use colophony::analysis::rms;
-    use colophony::dsp::instrument::{BowControl, InstrumentKind};
+    use colophony::dsp::vocabulary::{BowControl, InstrumentKind};
     use colophony_lab::render::{render_thermal, RenderSettings};
     // Forces inside each string's Schelleng window at 0.15 m/s and beta 0.1.
     for (kind, note, force_n) in [
@@ -339,8 +339,8 @@ fn the_thermal_bow_renders_at_the_host_rate_in_tune_and_bounded() {
 
 #[test]
 fn bowing_one_string_makes_the_open_strings_ring_through_the_bridge() {
-    use colophony::dsp::instrument::{BowControl, InstrumentKind};
     use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
+    use colophony::dsp::vocabulary::{BowControl, InstrumentKind};
     use colophony_lab::admittance_fit::shipped_cello_bridge;
     let run = |bridge: &[colophony::dsp::bridge::BridgeMode]| {
         let settings = ThermalSettings {
@@ -380,8 +380,8 @@ fn bowing_one_string_makes_the_open_strings_ring_through_the_bridge() {
 #[test]
 fn the_thermal_instrument_rings_in_tune_and_flattens_with_bow_force() {
     use colophony::analysis::{cents, peak_frequency_hz, rms};
-    use colophony::dsp::instrument::{midi_to_hz, BowControl, InstrumentKind};
     use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
+    use colophony::dsp::vocabulary::{midi_to_hz, BowControl, InstrumentKind};
     use colophony_lab::admittance_fit::shipped_cello_bridge;
     let bridge = shipped_cello_bridge().modes;
     let mut g_string = Vec::new();
@@ -463,8 +463,8 @@ fn render_thermal_scene(
     frames: usize,
     skipping: bool,
 ) -> (Vec<f64>, Vec<usize>) {
-    use colophony::dsp::instrument::{BowControl, InstrumentKind};
     use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
+    use colophony::dsp::vocabulary::{BowControl, InstrumentKind};
     let settings = ThermalSettings {
         nodes: 6,
         width_m: 0.01,
@@ -620,8 +620,8 @@ fn the_lone_strings_fundamental_decays_at_its_q1_terminations_included() {
 /// for the whole bow plays with the nodes that fit, at the same total force.
 #[test]
 fn every_note_speaks_with_every_bow_setting_at_every_host_rate() {
-    use colophony::dsp::instrument::{BowControl, InstrumentKind};
     use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
+    use colophony::dsp::vocabulary::{BowControl, InstrumentKind};
     use colophony_lab::admittance_fit::{shipped_cello_bridge, shipped_violin_bridge};
     let bow = BowControl {
         velocity_m_per_s: 0.1,
@@ -727,8 +727,8 @@ fn the_thermal_grid_never_cools_below_ambient_or_blows_up_at_the_fastest_slips()
 /// 192 kHz against 48 kHz.
 #[test]
 fn the_thermal_instrument_plays_the_same_motion_and_pitch_at_every_host_rate() {
-    use colophony::dsp::instrument::{midi_to_hz, BowControl, InstrumentKind};
     use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
+    use colophony::dsp::vocabulary::{midi_to_hz, BowControl, InstrumentKind};
     use colophony_lab::admittance_fit::shipped_cello_bridge;
     let bridge = shipped_cello_bridge().modes;
     let bow = BowControl::default();

@@ -2,7 +2,7 @@
 //! every fifth semitone from the lowest open string to two octaves above the highest, at
 //! 44.1 and 96 kHz, through the engines the plugin plays (`colophony_lab::playing_space`).
 
-use colophony::dsp::instrument::InstrumentKind;
+use colophony::dsp::vocabulary::InstrumentKind;
 use colophony::measure::regime::Regime;
 use colophony_lab::playing_space::{
     measure, notes, regime_name, run_plan, Bowing, Cell, Measured, Model, Plan,
@@ -313,7 +313,7 @@ fn weighted_strings_settle_the_cellos_middle_strings_at_the_defaults() {
         assert!(cell.bow.force_n > 2.0, "the defaults cell is weighted");
         weighted.push(cell);
         bare.push(Cell {
-            bow: colophony::dsp::instrument::BowControl {
+            bow: colophony::dsp::vocabulary::BowControl {
                 force_n: 1.0,
                 ..cell.bow
             },

@@ -4,7 +4,7 @@
 //! a broken or unknown one fails in one line with no file.
 
 use colophony::analysis::{cents, rms};
-use colophony::dsp::instrument::midi_to_hz;
+use colophony::dsp::vocabulary::midi_to_hz;
 use colophony::params::ColophonyParams;
 use colophony::performer::Performer;
 use colophony::presets;

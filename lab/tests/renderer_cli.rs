@@ -2,7 +2,7 @@
 //! motion, and bad arguments fail with a one-line error, a non-zero exit and no file.
 
 use colophony::analysis::slip_stats;
-use colophony::dsp::instrument::midi_to_hz;
+use colophony::dsp::vocabulary::midi_to_hz;
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
@@ -414,7 +414,7 @@ fn a_chosen_bridge_plays_through_the_plugins_instruments() {
     );
     use colophony_lab::midi_file::{perform, MidiEvent, Performance, Timed};
     // The renderer's defaults (in f64: the plugin's parameters are f32).
-    let bow = colophony::dsp::instrument::BowControl {
+    let bow = colophony::dsp::vocabulary::BowControl {
         velocity_m_per_s: 0.1,
         force_n: 1.0,
         position_beta: 0.1,

@@ -4,7 +4,8 @@
 //!
 //! ```
 //! use colophony::dsp::engine::Engine;
-//! use colophony::dsp::instrument::{BowControl, Instrument, InstrumentKind};
+//! use colophony::dsp::instrument::Instrument;
+//! use colophony::dsp::vocabulary::{BowControl, InstrumentKind};
 //! let mut cello = Instrument::new(InstrumentKind::Cello, 48_000.0);
 //! let engine: &mut dyn Engine = &mut cello;
 //! engine.note_on(50);
@@ -13,9 +14,9 @@
 //! assert!(sound > 0.0);
 //! ```
 
-use super::instrument::{BowControl, Frame, NoteExpression};
 use super::rubbed::RubbedInstrument;
 use super::strings::{FourStrings, StringBank};
+use super::vocabulary::{BowControl, Frame, NoteExpression};
 
 /// An instrument the notes play.
 pub trait Engine {

@@ -8,7 +8,7 @@
 //!
 //! ```
 //! use colophony::dsp::fingering::{BowEnvelope, Fingering};
-//! use colophony::dsp::instrument::InstrumentKind;
+//! use colophony::dsp::vocabulary::InstrumentKind;
 //! let mut f = Fingering::new(InstrumentKind::Cello, Some(0));
 //! let string = f.string_for_note_on(50).unwrap(); // D3: the D string
 //! f.start(string, 50);

@@ -18,7 +18,8 @@
 //! laws, torsion, bow hair, custom bodies).
 //!
 //! ```
-//! use colophony::dsp::instrument::{BowControl, Instrument, InstrumentKind};
+//! use colophony::dsp::instrument::Instrument;
+//! use colophony::dsp::vocabulary::{BowControl, InstrumentKind};
 //! let mut cello = Instrument::new(InstrumentKind::Cello, 48_000.0);
 //! assert_eq!(cello.note_on(50), Some(2)); // D3 on the D string
 //! let bow = BowControl { velocity_m_per_s: 0.1, force_n: 1.0, position_beta: 0.1 };
@@ -36,7 +37,7 @@ pub use super::strings::FourStrings;
 use super::strings::{StringBank, StringBow};
 use super::waveguide::WaveguideString;
 
-pub use super::vocabulary::*;
+use super::vocabulary::*;
 
 /// The body sleeps once every mode's state is below this (N-scale: output below -200 dB of
 /// a bowed note).

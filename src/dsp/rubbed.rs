@@ -28,8 +28,8 @@
 
 use super::friction::bristle::{BristleParams, SolverStats};
 use super::friction::{AnyFriction, BowInput, FrictionContact, FrictionModel};
-use super::instrument::BowControl;
 use super::modal::{Exciter, FrictionPair, ModalObject, ModeSpec, PairOutput};
+use super::vocabulary::BowControl;
 
 /// The built-in rubbed scenes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

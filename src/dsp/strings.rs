@@ -21,7 +21,8 @@
 //! non-finite guard and the probe.
 //!
 //! ```
-//! use colophony::dsp::instrument::{BowControl, Instrument, InstrumentKind};
+//! use colophony::dsp::instrument::Instrument;
+//! use colophony::dsp::vocabulary::{BowControl, InstrumentKind};
 //! // The point-bow instrument is `FourStrings<WaveguideBank>`.
 //! let mut violin = Instrument::new(InstrumentKind::Violin, 44_100.0);
 //! assert_eq!(violin.note_on(69), Some(2)); // A4 on the A string
@@ -561,7 +562,7 @@ impl<B: StringBank> FourStrings<B> {
     }
 
     /// Tunes every note from the reference pitch `a4_hz` (415..466 Hz; see
-    /// [`super::instrument::reference_semitones`]); sounding notes follow at once.
+    /// [`super::vocabulary::reference_semitones`]); sounding notes follow at once.
     pub fn set_reference_pitch(&mut self, a4_hz: f64) {
         if self.hands.fingering.set_reference_pitch(a4_hz) {
             self.retune();

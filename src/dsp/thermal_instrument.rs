@@ -14,7 +14,7 @@
 //! [`super::strings::FourStrings`]; this module holds the strings and bridge,
 //! [`ThermalBank`]): a note goes to the highest open string at or below it, stopped to
 //! sound it (the wave speed stays, the vibrating length shortens); the bow lands and lifts
-//! over [`BOW_RAMP_S`](super::instrument::BOW_RAMP_S). Every playable note speaks: the
+//! over [`BOW_RAMP_S`](super::vocabulary::BOW_RAMP_S). Every playable note speaks: the
 //! internal rate never falls below [`MIN_SAMPLES_PER_TOP_PERIOD`] samples per period of the
 //! highest note, and where a stopped string is too short for the whole bow the contact is
 //! narrowed to the nodes that fit, keeping the total force
@@ -37,7 +37,7 @@
 //! exactly.
 //!
 //! ```
-//! use colophony::dsp::instrument::{BowControl, InstrumentKind};
+//! use colophony::dsp::vocabulary::{BowControl, InstrumentKind};
 //! use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
 //! let bridge = colophony::dsp::bridge_data::shipped_cello_bridge().modes;
 //! let mut cello = ThermalInstrument::new(InstrumentKind::Cello, &bridge, 48_000.0, ThermalSettings::default()).unwrap();
@@ -47,16 +47,16 @@
 //! ```
 
 use super::bridge::{solve_junction, BridgeMode, ModalBridge};
-use super::instrument::{
-    midi_to_hz, InstrumentKind, HIGHEST_TUNING_SEMITONES, LOWEST_TUNING_SEMITONES, SLEEP_ENERGY_J,
-    STRINGS,
-};
 use super::intonation;
 use super::resample::Resampler;
 pub use super::strings::{FourStrings, RECONFIGURE_FADE_S};
 use super::strings::{InternalStep, StringBank, StringBow};
 use super::thermal::{
     HairParams, ThermalBowControl, ThermalCapacity, ThermalParams, ThermalString, ThermalStringSpec,
+};
+use super::vocabulary::{
+    midi_to_hz, InstrumentKind, HIGHEST_TUNING_SEMITONES, LOWEST_TUNING_SEMITONES, SLEEP_ENERGY_J,
+    STRINGS,
 };
 
 /// Most bow nodes on the lowest string (paper B's Figure 6 uses 60).
@@ -370,7 +370,7 @@ impl StringBank for ThermalBank {
     }
 
     /// Every string counts (the bridge keeps them coupled), each at its fundamental's
-    /// decay rate ([`super::instrument::ring_out_s`]).
+    /// decay rate ([`super::vocabulary::ring_out_s`]).
     fn ring_out_s(&self, lifted: &[bool; STRINGS]) -> Option<f64> {
         if !self.awake {
             return Some(0.0);
@@ -382,7 +382,7 @@ impl StringBank for ThermalBank {
             .core
             .strings
             .iter()
-            .map(|s| super::instrument::ring_out_s(s.energy_j(), s.fundamental_hz(), s.q1()))
+            .map(|s| super::vocabulary::ring_out_s(s.energy_j(), s.fundamental_hz(), s.q1()))
             .fold(0.0, f64::max);
         Some(longest)
     }

@@ -5,7 +5,7 @@
 //! rebuilds the thermal instruments on it and the point-bow body from its passive
 //! reduction ([`crate::dsp::body::body_from_bridge`]).
 
-use crate::dsp::instrument::InstrumentKind;
+use crate::dsp::vocabulary::InstrumentKind;
 use crate::params::ColophonyParams;
 use crate::user_bridges;
 use egui::Ui;

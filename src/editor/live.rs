@@ -245,7 +245,7 @@ pub fn paint_friction_loop(ui: &Ui, rect: Rect, samples: &[ContactSample]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::dsp::instrument::{BowControl, Frame};
+    use crate::dsp::vocabulary::{BowControl, Frame};
 
     fn sample(x: f32) -> ContactSample {
         ContactSample {

@@ -420,9 +420,9 @@ mod tests {
 
     #[test]
     fn thermal_cello_in_helmholtz_motion_warms_the_bow_and_every_node_sticks_and_slips() {
-        use crate::dsp::instrument::{BowControl, InstrumentKind};
         use crate::dsp::thermal::ThermalParams;
         use crate::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
+        use crate::dsp::vocabulary::{BowControl, InstrumentKind};
         let fs = 48_000.0;
         let bridge = crate::dsp::bridge_data::shipped_cello_bridge().modes;
         let settings = ThermalSettings::default();

@@ -10,8 +10,8 @@ use super::nodes::{paint_slip_image, paint_temperature_profile, NodeRecord, RING
 use super::pad::{format_force, format_velocity, XyPad, MAX_FORCE_COLOUR, MIN_FORCE_COLOUR};
 use super::presets::PresetBar;
 use super::{EditorLink, EditorSize};
-use crate::dsp::instrument::{midi_to_hz, InstrumentKind};
 use crate::dsp::thermal_instrument::THERMAL_WEIGHT_REFERENCE_Z0;
+use crate::dsp::vocabulary::{midi_to_hz, InstrumentKind};
 use crate::measure::contact::ContactSample;
 use crate::measure::regime::{classify_regime, Regime};
 use crate::measure::window::SchellengWindow;

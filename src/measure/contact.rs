@@ -1,7 +1,7 @@
 //! One sample of the bow-string contact, as the probe records it: what the regime
 //! classifier ([`super::regime`]) reads and the editor's live views draw.
 
-use crate::dsp::instrument::{BowControl, Frame};
+use crate::dsp::vocabulary::{BowControl, Frame};
 
 /// One sample of the probed string's contact.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]

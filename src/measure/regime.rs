@@ -38,7 +38,7 @@
 //! ```
 
 use super::contact::ContactSample;
-use crate::dsp::instrument::INTERNAL_RATE_HZ;
+use crate::dsp::vocabulary::INTERNAL_RATE_HZ;
 
 /// A sample slips where the relative velocity exceeds this fraction of the bow velocity.
 /// Sticking is `v_s = v_b` exactly for the point laws and within a creep far below `v_b` for
@@ -172,8 +172,9 @@ mod tests {
     use super::*;
     use crate::dsp::bridge_data::shipped_cello_bridge;
     use crate::dsp::friction::FrictionModel;
-    use crate::dsp::instrument::{midi_to_hz, BowControl, Instrument, InstrumentKind};
+    use crate::dsp::instrument::Instrument;
     use crate::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
+    use crate::dsp::vocabulary::{midi_to_hz, BowControl, InstrumentKind};
 
     const FS: f64 = 48_000.0;
     const D3: u8 = 50;

@@ -19,7 +19,7 @@
 //! (Schoonderwaldt, Guettler and Askenfelt 2008). `mu_s` 0.4 and `mu_d` 0.2 are the defaults
 //! of the hyperbolic friction law (and of the bristle models).
 
-use crate::dsp::instrument::{InstrumentKind, STRINGS};
+use crate::dsp::vocabulary::{InstrumentKind, STRINGS};
 use std::f64::consts::PI;
 
 /// Static friction coefficient of the hyperbolic law's defaults.
@@ -70,7 +70,7 @@ impl SchellengWindow {
     }
 
     /// The window in units of the force parameter when the string is bowed with `weight`
-    /// times it ([`crate::dsp::instrument::InstrumentKind::string_weight`]): both limits
+    /// times it ([`crate::dsp::vocabulary::InstrumentKind::string_weight`]): both limits
     /// divided by `weight` (Z0 and R divided by it).
     pub fn seen_through_weight(self, weight: f64) -> Self {
         Self {

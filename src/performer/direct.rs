@@ -12,7 +12,7 @@
 //!
 //! ```
 //! use colophony::performer::direct::{DirectBow, CC_BOW_FORCE};
-//! use colophony::dsp::instrument::BowControl;
+//! use colophony::dsp::vocabulary::BowControl;
 //! let mut direct = DirectBow::new(48_000.0);
 //! let knob = BowControl::default(); // 1 N
 //! assert!(direct.set_controller(CC_BOW_FORCE, 1.0)); // the controller's top: 10 N
@@ -25,7 +25,7 @@
 //! assert_eq!(direct.apply(moved).force_n, 2.0);
 //! ```
 
-use crate::dsp::instrument::BowControl;
+use crate::dsp::vocabulary::BowControl;
 
 /// The controller that sets the bow speed.
 pub const CC_BOW_VELOCITY: u8 = 21;

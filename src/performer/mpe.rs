@@ -22,7 +22,7 @@
 //! position, with the same mappings ([`NoteState`]); they add to (bend) or multiply
 //! (scales) a member channel's.
 
-use crate::dsp::instrument::NoteExpression;
+use crate::dsp::vocabulary::NoteExpression;
 
 /// MPE's default pitch-bend range of member channels, semitones.
 pub const MEMBER_BEND_RANGE_SEMITONES: f64 = 48.0;
@@ -323,7 +323,7 @@ mod tests {
     }
 
     mod through_the_performer {
-        use crate::dsp::instrument::{BowControl, InstrumentKind};
+        use crate::dsp::vocabulary::{BowControl, InstrumentKind};
         use crate::performer::{Performer, Setup};
 
         fn cello() -> Performer {

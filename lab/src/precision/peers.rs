@@ -15,7 +15,7 @@
 
 use super::{Errors, Measured, Row, ANALYSIS_RATE_HZ};
 use colophony::analysis::{cents, peak_frequency_hz, rms};
-use colophony::dsp::instrument::midi_to_hz;
+use colophony::dsp::vocabulary::midi_to_hz;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
