@@ -1,5 +1,5 @@
 //! The MIDI map shared between the editor, the plugin state and the audio thread, and
-//! what MIDI learn needs from the audio thread (issue 18: the mapping page).
+//! what MIDI learn needs from the audio thread (the editor's MIDI map page).
 //!
 //! [`SharedMidiMap`] holds the performer's [`MidiMap`] in atomics behind a sequence
 //! number: the editor (and a state load) writes it, the audio thread reads it once per

@@ -794,13 +794,6 @@ impl Performer {
         // The 7-bit value of a data byte.
         let byte = (v * 127.0).round() as u8;
         match cc {
-            // The sustain pedal: released notes keep their fingers down and ring on at
-            // their stopped pitch until it is let go (still routed through the map).
-            64 => {
-                for engine in self.engines() {
-                    engine.set_fingers_held(byte >= 64);
-                }
-            }
             101 => return self.gesture.rpn.0 = byte,
             100 => return self.gesture.rpn.1 = byte,
             6 | 38 if self.gesture.rpn == (0, 0) => {
@@ -842,6 +835,12 @@ impl Performer {
                 self.direct.set_controller(direct::CC_BOW_POSITION, x);
             }
             Target::Portamento => self.gesture.portamento_pedal = (x * 127.0).round() >= 64.0,
+            Target::Sustain => {
+                let held = (x * 127.0).round() >= 64.0;
+                for engine in self.engines() {
+                    engine.set_fingers_held(held);
+                }
+            }
         }
     }
 
@@ -1030,8 +1029,8 @@ impl Performer {
     /// The commonest case, a steady gesture on the waveguide strings alone, is a few
     /// instructions here and inlined into the caller; everything else is out of line in
     /// [`Performer::tick_general`], so its registers and stack do not weigh on the common
-    /// path (issue 18's cost budget: 561 against 521 instructions per sample with both in
-    /// one function, callgrind).
+    /// path (callgrind: 521 instructions per sample this way, 561 with both in one
+    /// function).
     #[inline]
     pub fn tick(&mut self, bow: BowControl) -> Frame {
         if !self.others_awake {
@@ -1093,7 +1092,7 @@ impl Performer {
     /// same samples as as many [`Performer::tick`]s. Once the gesture is steady and only
     /// the waveguide strings sound, the strings run alone over the rest (the gesture has
     /// nothing to do per sample), which is what makes the performance layer cost nothing
-    /// per sample (issue 18's budget).
+    /// per sample.
     pub fn tick_block(&mut self, bow: BowControl, out: &mut [f64]) {
         let mut i = 0;
         while i < out.len() {
@@ -1118,8 +1117,8 @@ impl Performer {
     /// is steady and only the waveguide strings sound (which no sample of an event-free run
     /// can change), the rest of the run loops over the strings alone with the checks
     /// hoisted: the performance layer's per-sample work is then the two or three factors
-    /// on the bow (issue 18's cost budget, for the plugin's per-sample path: automation
-    /// moving, or a live view open).
+    /// on the bow (the plugin's per-sample path while automation moves or a live view is
+    /// open).
     #[inline]
     pub fn tick_run<C>(
         &mut self,
@@ -1355,8 +1354,9 @@ mod tests {
     #[test]
     fn a_chosen_bridge_colours_the_point_bow_sound_and_leaves_the_string_alone() {
         // The point-bow body only colours what radiates (it feeds nothing back): with a
-        // chosen bridge's reduction as the body the string moves exactly as before, and
-        // the sound changes, towards the bridge's strongest horizontal mode.
+        // chosen bridge's reduction as the body the string moves exactly as with the
+        // generic body, and the sound changes, towards the bridge's strongest horizontal
+        // mode.
         let bow = BowControl::default();
         let play = |bridge: Option<BridgeModes>| {
             let setup = Setup::default();

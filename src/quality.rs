@@ -16,13 +16,12 @@
 //! strings and the cello's A string at 96 kHz, [`InstrumentKind::point_oversampling`]),
 //! with the default dispersion filter order (8 sections).
 //!
-//! Measured by the full benchmark of 2026-11-26's sixth stop (docs/precision.csv: the
-//! plugin's stiffer bristle with the tangent predictor; cello D3 at 48 kHz, each
-//! tolerance against 1e-13 at the same rate; thermal: paper B's Fig. 6 bow at beta 0.07
-//! and 0.1 against N_B 120; speed ratios from one run's timings). The run of 2026-11-27
-//! (docs/precision.md) moved only the draft tolerance's cello D3 rows for LuGre and
-//! elasto-plastic, another path at the same regime boundary (the fallback change of the
-//! sixth stop): the draft row below is the sixth stop's.
+//! Measured by the work-precision benchmark (docs/precision.md and docs/precision.csv:
+//! cello D3 at 48 kHz, each tolerance against 1e-13 at the same rate; thermal: paper B's
+//! Fig. 6 bow at beta 0.07 and 0.1 against N_B 120; speed ratios from one run's timings).
+//! The draft tolerance's cello D3 rows for LuGre and elasto-plastic sit at a regime
+//! boundary, so small changes of the solver's path move them between runs; the table
+//! gives one run's figures.
 //!
 //! | preset | Newton tolerance | thermal N_B | measured |
 //! |---|---|---|---|

@@ -3,7 +3,7 @@
 //! onset level: a faster and heavier bow, scaled together so the bow keeps its place in
 //! Schelleng's window), and both still speak, at the note's pitch, soon after they land.
 
-use colophony::analysis::{cents, peak_frequency_hz};
+use colophony::analysis::{cents, partial_amplitude, peak_frequency_hz, rms};
 use colophony::dsp::friction::FrictionModel;
 use colophony::dsp::vocabulary::InstrumentKind;
 use colophony_lab::midi_file::{perform, MidiEvent, Performance, Timed};
@@ -37,35 +37,20 @@ fn play(kind: InstrumentKind, law: Option<FrictionModel>, note: u8, velocity: u8
 /// listener hears, not one sample of a transient's spike.
 fn peak_db(x: &[f64]) -> f64 {
     let (w, hop) = ((0.01 * FS) as usize, (0.0025 * FS) as usize);
-    let mut best = 0.0f64;
-    let mut i = 0;
-    while i + w <= x.len() {
-        let ms = x[i..i + w].iter().map(|v| v * v).sum::<f64>() / w as f64;
-        best = best.max(ms);
-        i += hop;
-    }
-    10.0 * best.max(1e-24).log10()
+    let best = (0..x.len().saturating_sub(w) + 1)
+        .step_by(hop)
+        .map(|i| rms(&x[i..i + w]))
+        .fold(0.0f64, f64::max);
+    20.0 * best.max(1e-12).log10()
 }
 
-/// Spectral centroid, Hz, of `x` (Hann window, a plain DFT up to 8 kHz in 10 Hz steps:
-/// the attack's brightness).
+/// Spectral centroid, Hz, of `x`: the partial amplitudes (Hann-windowed DTFT) every 10 Hz
+/// up to 8 kHz, weighted by frequency (the attack's brightness).
 fn centroid_hz(x: &[f64]) -> f64 {
-    let n = x.len();
-    let w: Vec<f64> = x
-        .iter()
-        .enumerate()
-        .map(|(i, v)| v * (0.5 - 0.5 * (2.0 * std::f64::consts::PI * i as f64 / n as f64).cos()))
-        .collect();
     let (mut num, mut den) = (0.0, 0.0);
     for k in 1..800 {
         let f = 10.0 * k as f64;
-        let step = 2.0 * std::f64::consts::PI * f / FS;
-        let (mut re, mut im) = (0.0, 0.0);
-        for (i, v) in w.iter().enumerate() {
-            re += v * (step * i as f64).cos();
-            im -= v * (step * i as f64).sin();
-        }
-        let mag = (re * re + im * im).sqrt();
+        let mag = partial_amplitude(x, FS, f);
         num += f * mag;
         den += mag;
     }

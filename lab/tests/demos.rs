@@ -54,9 +54,7 @@ fn read_wav(path: &Path) -> (Vec<f64>, f64) {
 }
 
 fn rms_db(x: &[f64]) -> f64 {
-    10.0 * (x.iter().map(|v| v * v).sum::<f64>() / x.len().max(1) as f64)
-        .max(1e-30)
-        .log10()
+    20.0 * colophony::analysis::rms(x).max(1e-15).log10()
 }
 
 /// The fundamental of a window by YIN (de Cheveigne and Kawahara 2002): the first lag

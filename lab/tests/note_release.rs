@@ -3,7 +3,7 @@
 //! open, quietly); an open string has no finger and rings on.
 //!
 
-use colophony::analysis::partial_amplitude;
+use colophony::analysis::{partial_amplitude, rms};
 use colophony::dsp::friction::FrictionModel;
 use colophony::dsp::vocabulary::InstrumentKind;
 use colophony::performer::stroke::StrokeMode;
@@ -49,9 +49,7 @@ fn play(
 }
 
 fn rms_db(x: &[f64]) -> f64 {
-    10.0 * (x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64)
-        .max(1e-30)
-        .log10()
+    20.0 * rms(x).max(1e-15).log10()
 }
 
 const LAWS: [Option<FrictionModel>; 5] = [

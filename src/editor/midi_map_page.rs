@@ -1,4 +1,4 @@
-//! The editor's MIDI map page (issue 18): one row per mapping, with its controller (a
+//! The editor's MIDI map page: one row per mapping, with its controller (a
 //! number, or **Learn**: click, then move a controller), its target, the target's value
 //! at the controller's bottom and top, and the curve between; **Add mapping**, **Remove**
 //! and **Default map**. Every change is written at once to the plugin's shared map

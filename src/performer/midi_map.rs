@@ -2,7 +2,7 @@
 //! and with what curve. One controller may drive several targets, and a target may have
 //! several controllers (the last to move wins).
 //!
-//! The default map is the one the performer always had (issue 18's defaults):
+//! The default map:
 //!
 //! | CC | target |
 //! |---|---|
@@ -11,6 +11,7 @@
 //! | 19 | vibrato rate |
 //! | 21, 22, 23 | bow speed, force, position ([`super::direct`]) |
 //! | 65 (portamento pedal) | portamento (on at 64 and up) |
+//! | 64 (sustain pedal) | sustain: released notes keep their fingers down (at 64 and up) |
 //!
 //! Each mapping turns the controller's value `x` (0..=1) into `min + (max - min) x^e` with
 //! `e = 3^-curve` (`curve` in -1..=1: 0 is linear, 1 rises fast from the bottom, -1 slowly);
@@ -49,10 +50,13 @@ pub enum Target {
     BowPosition,
     /// Portamento: a legato note glides while the value is 0.5 or more.
     Portamento,
+    /// The sustain pedal: while the value is 0.5 or more, released notes keep their
+    /// fingers down and ring on at their stopped pitch; below it, the fingers lift.
+    Sustain,
 }
 
 impl Target {
-    pub const ALL: [Target; 7] = [
+    pub const ALL: [Target; 8] = [
         Target::Dynamics,
         Target::VibratoDepth,
         Target::VibratoRate,
@@ -60,6 +64,7 @@ impl Target {
         Target::BowForce,
         Target::BowPosition,
         Target::Portamento,
+        Target::Sustain,
     ];
 
     /// The name the editor shows.
@@ -72,6 +77,7 @@ impl Target {
             Target::BowForce => "Bow force",
             Target::BowPosition => "Bow position",
             Target::Portamento => "Portamento",
+            Target::Sustain => "Sustain (fingers down)",
         }
     }
 
@@ -166,6 +172,7 @@ impl Default for MidiMap {
             Mapping::new(22, Target::BowForce),
             Mapping::new(23, Target::BowPosition),
             Mapping::new(65, Target::Portamento),
+            Mapping::new(64, Target::Sustain),
         ] {
             map.add(m);
         }
