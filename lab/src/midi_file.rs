@@ -10,6 +10,7 @@
 
 use colophony::dsp::filters::{flush_tiny, safety_limit};
 use colophony::dsp::vocabulary::BowControl;
+use colophony::measure::contact::ContactSample;
 use colophony::performer::{Performer, Setup, Status};
 use midly::{MetaMessage, MidiMessage, Smf, Timing, TrackEventKind};
 
@@ -196,7 +197,28 @@ pub fn perform_until(
     events: &[Timed],
     how: &Performance,
     limit: Option<u64>,
+    progress: impl FnMut(u64, u64),
+) -> Result<Vec<f32>, String> {
+    perform_probing(events, how, limit, progress, None)
+}
+
+/// [`perform`], with the contact probe as the editor records it (the string at the bow,
+/// [`ContactSample`]) beside each output sample: what the repertoire test measures.
+pub fn perform_probed(
+    events: &[Timed],
+    how: &Performance,
+) -> Result<(Vec<f32>, Vec<ContactSample>), String> {
+    let mut probe = Vec::new();
+    let out = perform_probing(events, how, None, |_, _| {}, Some(&mut probe))?;
+    Ok((out, probe))
+}
+
+fn perform_probing(
+    events: &[Timed],
+    how: &Performance,
+    limit: Option<u64>,
     mut progress: impl FnMut(u64, u64),
+    mut probe: Option<&mut Vec<ContactSample>>,
 ) -> Result<Vec<f32>, String> {
     let block = how.block.max(1);
     let mut performer = Performer::new(how.setup.instrument);
@@ -216,6 +238,9 @@ pub fn perform_until(
             // As the plugin: a silent block with nothing landing is skipped.
             performer.skip(block, how.bow);
             out.resize(out.len() + block, 0.0);
+            if let Some(p) = probe.as_deref_mut() {
+                p.resize(out.len(), ContactSample::default());
+            }
             quiet += block as u64;
         } else {
             let end = done + block as u64;
@@ -248,7 +273,10 @@ pub fn perform_until(
                 performer.tick_run(
                     (run_end - now) as usize,
                     || (how.bow, ()),
-                    |_, (), frame, _, _| {
+                    |_, (), frame, played, _| {
+                        if let Some(p) = probe.as_deref_mut() {
+                            p.push(ContactSample::new(frame, played));
+                        }
                         let y = safety_limit(flush_tiny(frame.audio * how.gain)) as f32;
                         quiet = if y.abs() < QUIET_LEVEL { quiet + 1 } else { 0 };
                         out.push(y);

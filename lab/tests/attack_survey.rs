@@ -76,3 +76,51 @@ fn attacks_through_the_performer_survey() {
         }
     }
 }
+
+/// Guettler's diagram on the bare instrument (no performer): cello D3 (or `NOTE`), the
+/// hyperbolic law, beta 0.1 (or `BETA`), the bow from rest at constant acceleration to
+/// 0.1 m/s (0: landing at speed) at constant force, 0.6 s; printed: the time from the
+/// landing to established Helmholtz motion ([`helmholtz_since`]), ms. `cargo test --release
+/// -p colophony-lab --test attack_survey guettler -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn guettler_diagram_survey() {
+    use colophony::dsp::instrument::Instrument;
+    use colophony::measure::regime::helmholtz_since;
+    let note: u8 = std::env::var("NOTE").map_or(50, |s| s.parse().expect("NOTE: a MIDI note"));
+    let beta: f64 = std::env::var("BETA").map_or(0.1, |s| s.parse().expect("BETA: 0.02-0.25"));
+    let f0 = midi_to_hz(note as f64);
+    let accels = [0.0, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0];
+    println!("cello note {note}, beta {beta}: rows bow force (N), columns acceleration (m/s^2; 0: landing at speed); ms to Helmholtz motion");
+    println!(
+        "      {}",
+        accels.iter().map(|a| format!("{a:>7}")).collect::<String>()
+    );
+    for force_n in [0.25, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 6.0] {
+        let mut row = format!("{force_n:>5} ");
+        for &a in &accels {
+            let mut cello = Instrument::new(InstrumentKind::Cello, FS);
+            cello.set_friction_model(FrictionModel::Hyperbolic);
+            cello.note_on(note);
+            let n = (0.6 * FS) as usize;
+            let mut probe = Vec::with_capacity(n);
+            for i in 0..n {
+                if i % 256 == 0 {
+                    cello.update_sleep();
+                }
+                let t = i as f64 / FS;
+                let bow = BowControl {
+                    velocity_m_per_s: if a == 0.0 { 0.1 } else { (a * t).min(0.1) },
+                    force_n,
+                    position_beta: beta,
+                };
+                probe.push(ContactSample::new(&cello.tick(bow), &bow));
+            }
+            row += &match helmholtz_since(&probe, FS as f32, f0 as f32) {
+                Some(k) => format!("{:>7.0}", k as f64 / FS * 1e3),
+                None => "  never".into(),
+            };
+        }
+        println!("{row}");
+    }
+}

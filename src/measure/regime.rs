@@ -109,32 +109,20 @@ pub fn classify_regime(samples: &[ContactSample], sample_rate: f32, f0_hz: f32) 
         return None;
     }
     let in_contact = samples.iter().any(|s| s.mu.abs() > CONTACT_MU_FLOOR);
-    let bow = |s: &ContactSample| s.string_velocity - s.relative_velocity;
-    let bow_moving = samples.iter().any(|s| bow(s).abs() > MOTION_FLOOR_M_PER_S);
+    let bow_moving = samples
+        .iter()
+        .any(|s| bow_velocity(s).abs() > MOTION_FLOOR_M_PER_S);
     let string_moving = samples
         .iter()
         .any(|s| s.string_velocity.abs() > MOTION_FLOOR_M_PER_S);
     if !in_contact || !(bow_moving || string_moving) {
         return Some(Regime::Silent);
     }
-    let slipping = |s: &ContactSample| {
-        s.relative_velocity.abs() > (SLIP_FRACTION_OF_BOW * bow(s).abs()).max(MOTION_FLOOR_M_PER_S)
-    };
+    let slipping = |s: &ContactSample| is_slipping(s, SLIP_FRACTION_OF_BOW);
     if samples.iter().all(slipping) {
         return Some(Regime::Sliding);
     }
-    // A slip is a run of slipping samples whose relative velocity reaches
-    // SLIP_PEAK_OF_BOW times the bow's somewhere; shallower runs are ripples.
-    let deep = |s: &ContactSample| {
-        s.relative_velocity.abs() > (SLIP_PEAK_OF_BOW * bow(s).abs()).max(MOTION_FLOOR_M_PER_S)
-    };
-    let onsets: Vec<usize> = samples
-        .windows(2)
-        .enumerate()
-        .filter(|(_, w)| !slipping(&w[0]) && slipping(&w[1]))
-        .map(|(i, _)| i + 1)
-        .filter(|&i| samples[i..].iter().take_while(|s| slipping(s)).any(deep))
-        .collect();
+    let onsets = slip_onsets(samples);
     Some(
         (1..=MAX_SLIPS_PER_PERIOD)
             .find(|&n| repeats_every_period(&onsets, n, period, sample_rate))
@@ -143,6 +131,71 @@ pub fn classify_regime(samples: &[ContactSample], sample_rate: f32, f0_hz: f32) 
                 n => Regime::MultipleSlips(n as u8),
             }),
     )
+}
+
+/// The bow velocity a contact sample was taken at, m/s.
+fn bow_velocity(s: &ContactSample) -> f32 {
+    s.string_velocity - s.relative_velocity
+}
+
+/// Whether the string moves against the bow by more than `fraction` of the bow velocity
+/// (and more than [`MOTION_FLOOR_M_PER_S`]).
+fn is_slipping(s: &ContactSample, fraction: f32) -> bool {
+    s.relative_velocity.abs() > (fraction * bow_velocity(s).abs()).max(MOTION_FLOOR_M_PER_S)
+}
+
+/// The samples where slips begin (see the module doc): a sticking sample followed by a
+/// slipping one, counted when the run of slipping samples reaches [`SLIP_PEAK_OF_BOW`]
+/// times the bow velocity (shallower runs are ripples).
+pub fn slip_onsets(samples: &[ContactSample]) -> Vec<usize> {
+    let slipping = |s: &ContactSample| is_slipping(s, SLIP_FRACTION_OF_BOW);
+    samples
+        .windows(2)
+        .enumerate()
+        .filter(|(_, w)| !slipping(&w[0]) && slipping(&w[1]))
+        .map(|(i, _)| i + 1)
+        .filter(|&i| {
+            samples[i..]
+                .iter()
+                .take_while(|s| slipping(s))
+                .any(|s| is_slipping(s, SLIP_PEAK_OF_BOW))
+        })
+        .collect()
+}
+
+/// Where Helmholtz motion is established in `samples` (at `sample_rate` Hz, a note whose
+/// fundamental is `f0_hz`): the first slip onset from which every slip to the end comes
+/// one period after the one before, `None` if there is no such run of at least two
+/// periods. The period is the median of the last three spans between slips, within [`PERIOD_RANGE`] of the note's; a span counts as one period within
+/// [`PERIOD_JITTER`] of it (or two samples of the model, as [`classify_regime`] allows).
+/// A note *speaks* at that sample: how long its attack took.
+pub fn helmholtz_since(samples: &[ContactSample], sample_rate: f32, f0_hz: f32) -> Option<usize> {
+    if !(sample_rate > 0.0 && f0_hz > 0.0) {
+        return None;
+    }
+    let onsets = slip_onsets(samples);
+    let spans: Vec<f32> = onsets.windows(2).map(|w| (w[1] - w[0]) as f32).collect();
+    if spans.len() < 2 {
+        return None;
+    }
+    let mut tail: Vec<f32> = spans[spans.len().saturating_sub(3)..].to_vec();
+    tail.sort_by(f32::total_cmp);
+    let period = tail[tail.len() / 2];
+    let expected = sample_rate / f0_hz;
+    if !(expected / PERIOD_RANGE..=expected * PERIOD_RANGE).contains(&period) {
+        return None;
+    }
+    let model_sample = (sample_rate / INTERNAL_RATE_HZ as f32).max(1.0);
+    let tolerance = (PERIOD_JITTER * period).max(2.0 * model_sample);
+    let first_steady = spans
+        .iter()
+        .rposition(|s| (s - period).abs() > tolerance)
+        .map_or(0, |i| i + 1);
+    // The motion must still be going at the end: no more than a period and a half since
+    // the last slip.
+    let last = *onsets.last()?;
+    let quiet_tail = (samples.len() - last) as f32 > 1.5 * period;
+    (spans.len() - first_steady >= 2 && !quiet_tail).then(|| onsets[first_steady])
 }
 
 /// Whether every onset is followed `n` onsets later by one a period later (see the module
@@ -401,6 +454,28 @@ mod tests {
         assert_eq!(
             detect(&train(&onsets, 3300, 30)),
             Some(Regime::MultipleSlips(2))
+        );
+    }
+
+    #[test]
+    fn helmholtz_motion_is_established_at_the_first_slip_of_the_steady_run() {
+        // Irregular slips (a raucous attack), then one slip every 327 samples from 1000.
+        let mut onsets = vec![50, 200, 260, 600, 700];
+        onsets.extend((0..8).map(|k| 1000 + k * 327));
+        let samples = train(&onsets, 1000 + 8 * 327, 30);
+        assert_eq!(helmholtz_since(&samples, FS as f32, 146.8), Some(1000));
+        // Two slips a period to the end never establish Helmholtz motion at the note's
+        // period ...
+        let doubled: Vec<usize> = (0..10).flat_map(|k| [k * 327, k * 327 + 100]).collect();
+        assert_eq!(
+            helmholtz_since(&train(&doubled, 3300, 30), FS as f32, 146.8),
+            None
+        );
+        // ... nor does motion that stopped: the last slip three periods before the end.
+        let stopped: Vec<usize> = (0..6).map(|k| k * 327).collect();
+        assert_eq!(
+            helmholtz_since(&train(&stopped, 9 * 327, 30), FS as f32, 146.8),
+            None
         );
     }
 }
