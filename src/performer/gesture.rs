@@ -1,0 +1,511 @@
+//! The gesture: what the player's controllers ask of the bow and the finger: dynamics (with
+//! the window guard), the finger vibrato with its drift, and the factors the stroke and
+//! the dynamics put on the bow each sample.
+
+use super::midi::RPN_NULL;
+use super::*;
+
+/// The dynamics' range: expression 0 (CC11, CC2 or channel pressure at 0) plays the bow
+/// this many dB below expression 1 (the default, and the parameters' own bow).
+pub const DYNAMICS_RANGE_DB: f64 = 30.0;
+/// With the window guard the bow position is the parameter's times `scale^-x` (the
+/// dynamics' bow scale): the bow sits at the parameter's place at full expression and
+/// drifts away from the bridge as the dynamics fall, 2^(1/2) = 1.41 times farther at the
+/// softest (-30 dB: `x = log10(2) / 3`), as players bow nearer the fingerboard for
+/// piano and nearer the bridge for forte.
+pub const DYNAMICS_DRIFT_EXPONENT: f64 = std::f64::consts::LOG10_2 / 3.0;
+/// Time constant of the dynamics' smoothing, s (no zipper noise from 7-bit steps).
+pub const DYNAMICS_SMOOTHING_S: f64 = 0.01;
+/// Vibrato depth at the mod wheel's top, cents (peak, either side: players' wide vibrato).
+pub const MAX_VIBRATO_CENTS: f64 = 30.0;
+/// Vibrato rate, Hz (string players: 5-7 Hz).
+pub const VIBRATO_RATE_HZ: f64 = 5.5;
+/// The vibrato rate's range (the Vibrato Rate parameter, and CC19 across it), Hz.
+pub const VIBRATO_RATE_MIN_HZ: f64 = 3.0;
+pub const VIBRATO_RATE_MAX_HZ: f64 = 9.0;
+/// A player's vibrato is not a machine's: its rate and depth wander by up to this
+/// fraction either way, slowly ([`VIBRATO_DRIFT_S`]), from a fixed-seed random walk (the
+/// same input gives the same output).
+pub const VIBRATO_RATE_DRIFT: f64 = 0.03;
+pub const VIBRATO_DEPTH_DRIFT: f64 = 0.04;
+/// How often the drift picks a new direction, s (it glides there over the same time).
+pub const VIBRATO_DRIFT_S: f64 = 0.4;
+/// The vibrato starts this long after a note lands, s...
+pub const VIBRATO_DELAY_S: f64 = 0.15;
+/// ... and fades in over this long, s.
+pub const VIBRATO_FADE_S: f64 = 0.3;
+/// Samples between two vibrato updates of the finger (a retune of the sounding strings):
+/// 1.3 ms at 48 kHz, steps of at most 1.4 cents at the widest vibrato.
+const VIBRATO_EVERY: u32 = 64;
+
+/// A legato note softer than this (MIDI 64) slides the finger (portamento).
+pub const PORTAMENTO_BELOW_VELOCITY: f64 = 64.0 / 127.0;
+/// Default finger glide time, s.
+pub const GLIDE_S_DEFAULT: f64 = 0.12;
+
+/// What the player's controllers ask of the bow and the finger (the performance layer):
+/// dynamics (CC11 expression, CC2 breath, channel pressure) scale the bow's velocity and
+/// force together, which keeps the bow at the same place in Schelleng's window (both
+/// limits are proportional to the bow velocity) while the amplitude follows the velocity;
+/// the mod wheel (CC1) sets the depth of a finger vibrato.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Gesture {
+    /// The bow scale the asked expression (0..=1) gives: `10^(-range (1 - e) / 20)`.
+    pub(super) target: f64,
+    /// The bow's present scale (smoothed toward `target`).
+    pub(super) scale: f64,
+    /// The window guard's drift of the bow position at this scale:
+    /// `scale^-`[`DYNAMICS_DRIFT_EXPONENT`] (1 at full scale).
+    pub(super) away: f64,
+    pub(super) smoothing: f64,
+    /// Vibrato depth, cents.
+    pub(super) vibrato_cents: f64,
+    /// The MIDI pitch bend, semitones (the vibrato is added to it).
+    pub(super) bend: f64,
+    /// The pitch-bend wheel, -1..=1.
+    pub(super) wheel: f64,
+    /// The bend range MIDI RPN 0 set, semitones (overrides the setup's).
+    pub(super) rpn_bend_range: Option<f64>,
+    /// The registered parameter number CC101/CC100 selected ([`RPN_NULL`]: none).
+    pub(super) rpn: (u8, u8),
+    /// CC65 (portamento) down.
+    pub(super) portamento_pedal: bool,
+    /// The vibrato's present offset, semitones.
+    pub(super) vibrato_now: f64,
+    pub(super) phase: f64,
+    pub(super) phase_step: f64,
+    /// The rate CC19 set, Hz (over the setup's until that changes).
+    pub(super) cc_rate_hz: Option<f64>,
+    /// Drift of rate and depth: now, target (fractions), updates to the next target, and
+    /// the random state.
+    pub(super) drift: [f64; 2],
+    pub(super) drift_target: [f64; 2],
+    pub(super) drift_countdown: u32,
+    pub(super) seed: u64,
+    /// Samples since the last note landed.
+    pub(super) since_note: u64,
+    pub(super) countdown: u32,
+}
+
+impl Gesture {
+    pub(super) fn new(sample_rate_hz: f64) -> Self {
+        Self {
+            target: 1.0,
+            scale: 1.0,
+            away: 1.0,
+            smoothing: 1.0 - (-1.0 / (DYNAMICS_SMOOTHING_S * sample_rate_hz)).exp(),
+            vibrato_cents: 0.0,
+            bend: 0.0,
+            wheel: 0.0,
+            rpn_bend_range: None,
+            rpn: (RPN_NULL, RPN_NULL),
+            portamento_pedal: false,
+            vibrato_now: 0.0,
+            phase: 0.0,
+            phase_step: VIBRATO_RATE_HZ / sample_rate_hz,
+            cc_rate_hz: None,
+            drift: [0.0; 2],
+            drift_target: [0.0; 2],
+            drift_countdown: 0,
+            seed: 0x9e37_79b9_7f4a_7c15,
+            since_note: 0,
+            countdown: 0,
+        }
+    }
+
+    pub(super) fn set_expression(&mut self, e: f64) {
+        self.target = 10f64.powf(-DYNAMICS_RANGE_DB * (1.0 - e.clamp(0.0, 1.0)) / 20.0);
+    }
+}
+
+impl Performer {
+    /// The vibrato's offset now, semitones: a sine at [`VIBRATO_RATE_HZ`], silent for
+    /// [`VIBRATO_DELAY_S`] after a note lands, then faded in over [`VIBRATO_FADE_S`].
+    pub(super) fn vibrato_semitones(&self) -> f64 {
+        let t = self.gesture.since_note as f64 / self.sample_rate_hz - VIBRATO_DELAY_S;
+        let fade = (t / VIBRATO_FADE_S).clamp(0.0, 1.0);
+        let depth = self.gesture.vibrato_cents * (1.0 + self.gesture.drift[1]);
+        fade * depth / 100.0 * (2.0 * std::f64::consts::PI * self.gesture.phase).sin()
+    }
+
+    /// The vibrato rate now, Hz: CC19's if it moved last, else the setup's.
+    pub fn vibrato_rate_hz(&self) -> f64 {
+        midi_over_setup(
+            self.gesture.cc_rate_hz,
+            self.setup.vibrato_rate_hz,
+            VIBRATO_RATE_HZ,
+            VIBRATO_RATE_MIN_HZ..=VIBRATO_RATE_MAX_HZ,
+        )
+    }
+
+    /// One vibrato update of the drift (every [`VIBRATO_EVERY`] samples): each wander glides
+    /// toward its target, and a new target is drawn every [`VIBRATO_DRIFT_S`].
+    pub(super) fn advance_drift(&mut self) {
+        let fs = self.sample_rate_hz;
+        let g = &mut self.gesture;
+        let updates = (VIBRATO_DRIFT_S * fs / VIBRATO_EVERY as f64).max(1.0);
+        if g.drift_countdown == 0 {
+            g.drift_countdown = updates as u32;
+            for (k, limit) in [VIBRATO_RATE_DRIFT, VIBRATO_DEPTH_DRIFT]
+                .into_iter()
+                .enumerate()
+            {
+                // xorshift64*: a uniform draw in -1..1.
+                g.seed ^= g.seed >> 12;
+                g.seed ^= g.seed << 25;
+                g.seed ^= g.seed >> 27;
+                let r =
+                    (g.seed.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64;
+                g.drift_target[k] = limit * (2.0 * r - 1.0);
+            }
+        }
+        g.drift_countdown -= 1;
+        for k in 0..2 {
+            g.drift[k] += (g.drift_target[k] - g.drift[k]) / updates;
+        }
+        let rate = self.vibrato_rate_hz() * (1.0 + self.gesture.drift[0]);
+        self.gesture.phase_step = rate / fs;
+    }
+
+    /// Advances the gesture one sample and returns the bow it shapes: the direct bow
+    /// controllers in place of the parameters they hold, the stroke (its direction and
+    /// attack), then the dynamics. With the mod wheel and the dynamics at
+    /// rest and a down stroke under way it costs a few comparisons.
+    #[inline]
+    pub(super) fn shape(&mut self, bow: BowControl) -> BowControl {
+        if self.gesture.vibrato_cents > 0.0 || self.gesture.vibrato_now != 0.0 {
+            self.advance_vibrato();
+        }
+        let bow = self.direct.apply(bow);
+        let (speed, landing) = if self.stroke.is_settled() {
+            (self.stroke.direction(), 1.0)
+        } else {
+            self.stroke.tick()
+        };
+        let g = &mut self.gesture;
+        if g.scale != g.target {
+            g.scale += g.smoothing * (g.target - g.scale);
+            if (g.scale - g.target).abs() < 1e-9 {
+                g.scale = g.target;
+            }
+            // The guard's drift follows the scale: one power per change of the scale,
+            // none per sample while it rests (a vibrato ticks this path every sample).
+            g.away = if g.scale == 1.0 {
+                1.0
+            } else {
+                g.scale.powf(-DYNAMICS_DRIFT_EXPONENT)
+            };
+        }
+        // With the guard the force follows the velocity and the bow drifts from the
+        // bridge as the dynamics fall; without it only the velocity follows.
+        let (force_scale, away) = if self.setup.dynamics_guard {
+            (g.scale, g.away)
+        } else {
+            (1.0, 1.0)
+        };
+        let out = if g.scale == 1.0 && speed == 1.0 && landing == 1.0 && away == 1.0 {
+            bow
+        } else {
+            BowControl {
+                velocity_m_per_s: bow.velocity_m_per_s * g.scale * speed,
+                force_n: bow.force_n * force_scale * landing,
+                position_beta: (bow.position_beta * away).clamp(MIN_NOTE_BETA, MAX_NOTE_BETA),
+            }
+        };
+        // Steady from here on until a controller, a pressure or a note: the next samples
+        // only multiply (the same bits: `speed` is +-1, so the order of the products does
+        // not round differently).
+        let steady = g.vibrato_cents == 0.0
+            && g.vibrato_now == 0.0
+            && g.scale == g.target
+            && self.direct.is_idle()
+            && self.stroke.is_settled();
+        self.steady = steady.then_some((g.scale * speed, force_scale, away));
+        out
+    }
+
+    /// One sample of the vibrato: its clock runs while the mod wheel is up (so the onset
+    /// delay counts from the note or from the wheel, whichever is later), and the finger
+    /// moves every [`VIBRATO_EVERY`] samples.
+    pub(super) fn advance_vibrato(&mut self) {
+        let g = &mut self.gesture;
+        g.since_note = g.since_note.saturating_add(1);
+        g.phase += g.phase_step;
+        if g.phase >= 1.0 {
+            g.phase -= 1.0;
+        }
+        if g.countdown == 0 {
+            g.countdown = VIBRATO_EVERY;
+            self.advance_drift();
+            let now = if self.gesture.vibrato_cents > 0.0 {
+                self.vibrato_semitones()
+            } else {
+                0.0
+            };
+            self.gesture.vibrato_now = now;
+            let bend = self.gesture.bend + now;
+            // Only what sounds moves its finger; a silent engine takes the vibrato at the
+            // first update after its note lands (the vibrato starts later still).
+            for engine in self.engines().filter(|e| e.is_sounding()) {
+                engine.set_pitch_bend(bend);
+            }
+        }
+        self.gesture.countdown -= 1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::measure::contact::ContactSample;
+    use crate::measure::regime::{classify_regime, Regime};
+    use crate::performer::testing::*;
+
+    #[test]
+    fn the_bow_as_played_follows_the_dynamics_and_is_none_when_lifted() {
+        let mut p = cello();
+        assert_eq!(p.bowed_bow(), None);
+        p.set_controller(11, 0.5);
+        p.note_on(50, 0.8);
+        let bow = BowControl::default();
+        for _ in 0..(0.5 * FS) as usize {
+            p.tick(bow);
+        }
+        let (v, f) = p.bowed_bow().unwrap();
+        // Half expression is half the range down, on both (smoothing and the attack have
+        // settled after 0.5 s; 1e-6 is f32 rounding).
+        let scale = 10f64.powf(-DYNAMICS_RANGE_DB * 0.5 / 20.0);
+        assert!(((v as f64).abs() / 0.1 - scale).abs() < 1e-6, "{v}");
+        assert!((f as f64 / 1.0 - scale).abs() < 1e-6, "{f}");
+        p.note_off(50);
+        assert_eq!(p.bowed_bow(), None);
+    }
+
+    /// Bows cello D3 at the defaults with the expression at `e` from the start; returns
+    /// the RMS over 1.5..2 s and the regime of its last 8 periods on the probe.
+    fn bowed_at(e: f32) -> (f64, Option<Regime>) {
+        let mut p = cello();
+        p.set_controller(11, e);
+        p.note_on(50, 0.8);
+        let bow = BowControl::default();
+        let n = (2.0 * FS) as usize;
+        let mut audio = Vec::with_capacity(n);
+        let mut probe = Vec::with_capacity(n);
+        for i in 0..n {
+            if i % 256 == 0 {
+                p.configure(&Setup::default());
+            }
+            let frame = p.tick(bow);
+            audio.push(frame.audio);
+            probe.push(ContactSample::new(&frame, &p.bow()));
+        }
+        let tail = &audio[(1.5 * FS) as usize..];
+        let rms = (tail.iter().map(|x| x * x).sum::<f64>() / tail.len() as f64).sqrt();
+        let f0 = midi_to_hz(50.0);
+        let window = (8.0 * FS / f0) as usize;
+        (
+            rms,
+            classify_regime(&probe[n - window..], FS as f32, f0 as f32),
+        )
+    }
+
+    #[test]
+    fn without_the_window_guard_a_soft_dynamic_under_a_heavy_bow_turns_raucous() {
+        // Expression 0.25 is 22.5 dB down: with the guard the force follows the velocity
+        // (Helmholtz, the test below); without it a bow 13x slower under the full 1 N
+        // presses about three times Schelleng's F_max for cello D3 and loses Helmholtz
+        // motion: either more than one slip per period, or (with the bow hair yielding,
+        // which at this slow bow takes up much of the force's swing) one short slip whose
+        // slip fraction is far from beta (Raman: it equals beta; the map's 15 %).
+        let setup = Setup {
+            dynamics_guard: false,
+            ..Setup::default()
+        };
+        let mut p = cello_with(&setup);
+        p.set_controller(11, 0.25);
+        p.note_on(50, 0.8);
+        let bow = BowControl::default();
+        let n = (2.0 * FS) as usize;
+        let mut probe = Vec::with_capacity(n);
+        for i in 0..n {
+            if i % 256 == 0 {
+                p.configure(&setup);
+            }
+            let frame = p.tick(bow);
+            probe.push(ContactSample::new(&frame, &p.bow()));
+        }
+        let played = p.bow();
+        assert_eq!(played.force_n, 1.0, "the force is the parameter's");
+        assert_eq!(played.position_beta, 0.1, "no drift without the guard");
+        let f0 = midi_to_hz(50.0);
+        let window = 8 * (FS / f0) as usize;
+        let tail = &probe[n - window..];
+        let regime = classify_regime(tail, FS as f32, f0 as f32);
+        let v: Vec<f64> = tail.iter().map(|s| s.string_velocity as f64).collect();
+        let v_b = played.velocity_m_per_s;
+        let stats = crate::analysis::slip_stats(&v, v_b, FS, f0, 0.05 * v_b);
+        let beta = played.position_beta;
+        let helmholtz =
+            regime == Some(Regime::Helmholtz) && (stats.slip_fraction - beta).abs() <= 0.15 * beta;
+        println!(
+            "{regime:?}, slip fraction {:.3} (beta {beta})",
+            stats.slip_fraction
+        );
+        assert!(!helmholtz, "{regime:?}, {stats:?}");
+    }
+
+    #[test]
+    fn with_the_window_guard_soft_dynamics_move_the_bow_from_the_bridge() {
+        let mut p = cello();
+        p.set_controller(11, 0.0);
+        p.note_on(50, 0.8);
+        let bow = BowControl::default();
+        for _ in 0..(0.5 * FS) as usize {
+            p.tick(bow);
+        }
+        // -30 dB: the bow 2^(1/2) times farther from the bridge (1e-6: the smoothing's
+        // last step and rounding).
+        assert!(
+            (p.bow().position_beta / 0.1 - 2f64.sqrt()).abs() < 1e-6,
+            "{:?}",
+            p.bow()
+        );
+        p.set_controller(11, 1.0);
+        for _ in 0..(0.5 * FS) as usize {
+            p.tick(bow);
+        }
+        assert_eq!(
+            p.bow().position_beta,
+            0.1,
+            "full expression: the parameter's place"
+        );
+    }
+
+    #[test]
+    fn dynamics_raise_the_level_monotonically_and_keep_helmholtz_motion() {
+        let mut last = 0.0;
+        for e in [0.25, 0.5, 0.75, 1.0] {
+            let (rms, regime) = bowed_at(e);
+            println!("expression {e}: RMS {rms:.5}, {regime:?}");
+            assert!(rms > last, "expression {e}: RMS {rms} not above {last}");
+            // Velocity and force scale together, so the bow keeps its place in the window.
+            assert_eq!(regime, Some(Regime::Helmholtz), "expression {e}");
+            last = rms;
+        }
+        // The amplitude follows the bow velocity (Raman): 30 dB of range, so expression
+        // 0.5 plays 15 dB below full, within 3 dB (the corners round more at low force).
+        let ratio_db = 20.0 * (bowed_at(0.5).0 / bowed_at(1.0).0).log10();
+        assert!((ratio_db + 15.0).abs() < 3.0, "{ratio_db:.1} dB");
+    }
+
+    /// Plays D3 for 3 s with the mod wheel up under `setup`, after `controllers`; returns
+    /// the finger's offset in cents every sample.
+    fn vibrato_cents(setup: &Setup, controllers: &[(u8, f32)]) -> Vec<f64> {
+        let mut p = cello();
+        p.configure(setup);
+        p.set_controller(1, 1.0);
+        for &(cc, v) in controllers {
+            p.set_controller(cc, v);
+        }
+        let string = InstrumentKind::Cello.string_for_note(50).unwrap();
+        p.note_on(50, 0.8);
+        let bow = BowControl::default();
+        let centre = p.strings().string(string).fundamental_hz();
+        (0..(3.0 * FS) as usize)
+            .map(|_| {
+                p.tick(bow);
+                1200.0 * (p.strings().string(string).fundamental_hz() / centre).log2()
+            })
+            .collect()
+    }
+
+    /// Depth (largest offset, cents) and rate (upward zero crossings, Hz) after the fade-in.
+    fn depth_and_rate(cents: &[f64]) -> (f64, f64) {
+        let steady = &cents[((VIBRATO_DELAY_S + VIBRATO_FADE_S) * FS) as usize + 64..];
+        let depth = steady.iter().fold(0.0f64, |m, c| m.max(c.abs()));
+        let ups: Vec<usize> = steady
+            .windows(2)
+            .enumerate()
+            .filter(|(_, w)| w[0] < 0.0 && w[1] >= 0.0)
+            .map(|(i, _)| i)
+            .collect();
+        let rate = (ups.len() - 1) as f64 * FS / (ups[ups.len() - 1] - ups[0]) as f64;
+        (depth, rate)
+    }
+
+    #[test]
+    fn the_mod_wheel_vibrato_moves_the_finger_at_its_rate_and_depth() {
+        let cents = vibrato_cents(&Setup::default(), &[]);
+        // Silent through the onset delay.
+        let delay = (VIBRATO_DELAY_S * FS) as usize;
+        assert!(cents[..delay - 64].iter().all(|c| c.abs() < 1e-6));
+        // After the fade-in: depth and rate within 5 % of the setting (the drift wanders
+        // by at most 4 % and 3 %).
+        let (depth, rate) = depth_and_rate(&cents);
+        println!("vibrato depth {depth:.2} cents, rate {rate:.3} Hz");
+        assert!(
+            (depth / MAX_VIBRATO_CENTS - 1.0).abs() < 0.05,
+            "depth {depth}"
+        );
+        assert!((rate / VIBRATO_RATE_HZ - 1.0).abs() < 0.05, "rate {rate}");
+    }
+
+    #[test]
+    fn the_vibrato_rate_follows_its_parameter_and_cc19_and_drifts_a_little() {
+        let setup = Setup {
+            vibrato_rate_hz: 7.0,
+            ..Setup::default()
+        };
+        let (_, rate) = depth_and_rate(&vibrato_cents(&setup, &[]));
+        assert!((rate / 7.0 - 1.0).abs() < 0.05, "parameter: {rate}");
+        // CC19 at 0: the slowest rate.
+        let (_, rate) = depth_and_rate(&vibrato_cents(&setup, &[(19, 0.0)]));
+        assert!(
+            (rate / VIBRATO_RATE_MIN_HZ - 1.0).abs() < 0.05,
+            "CC19: {rate}"
+        );
+        // The drift: successive cycles are not all the same length, and none strays
+        // further than the drift allows (3 %, plus 2 % for cycles counted to a sample
+        // and the finger's 64-sample steps).
+        let cents = vibrato_cents(&Setup::default(), &[]);
+        let steady = &cents[((VIBRATO_DELAY_S + VIBRATO_FADE_S) * FS) as usize + 64..];
+        let ups: Vec<usize> = steady
+            .windows(2)
+            .enumerate()
+            .filter(|(_, w)| w[0] < 0.0 && w[1] >= 0.0)
+            .map(|(i, _)| i)
+            .collect();
+        let periods: Vec<f64> = ups.windows(2).map(|w| (w[1] - w[0]) as f64 / FS).collect();
+        let nominal = 1.0 / VIBRATO_RATE_HZ;
+        assert!(
+            periods.iter().all(|t| (t / nominal - 1.0).abs() < 0.05),
+            "{periods:?}"
+        );
+        let spread = periods.iter().fold(0.0f64, |m, t| m.max(*t))
+            - periods.iter().fold(1.0f64, |m, t| m.min(*t));
+        assert!(spread > 64.0 / FS, "no drift: {periods:?}");
+    }
+
+    #[test]
+    fn without_controllers_a_down_stroke_settles_on_the_parameters_own_bow() {
+        let mut p = cello();
+        p.note_on(50, 0.5);
+        let bow = BowControl {
+            velocity_m_per_s: -0.37,
+            force_n: 2.5,
+            position_beta: 0.13,
+        };
+        // The attack: from rest to the asked speed, the force landing as asked (no accent
+        // at half velocity).
+        p.tick(bow);
+        assert!(p.bow().velocity_m_per_s.abs() < 0.01 && p.bow().force_n == bow.force_n);
+        let attack = (stroke::ATTACK_SLOWEST_S * FS) as usize;
+        for _ in 0..attack {
+            p.tick(bow);
+        }
+        for _ in 0..1000 {
+            p.tick(bow);
+            assert_eq!(p.bow(), bow);
+        }
+    }
+}
