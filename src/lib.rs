@@ -14,6 +14,7 @@ pub mod analysis;
 pub mod dsp;
 pub mod editor;
 pub mod editor_state;
+mod host_event;
 pub mod measure;
 pub mod midi_learn;
 pub mod params;
@@ -24,7 +25,6 @@ pub mod telemetry;
 pub mod user_bridges;
 
 use dsp::vocabulary::{BowControl, InstrumentKind};
-use nice_plug::midi::Key;
 use nice_plug::prelude::*;
 use params::ColophonyParams;
 use performer::{Performer, Status};
@@ -52,57 +52,6 @@ impl Default for Colophony {
             node_probe: editor::nodes::NodeProbe::default(),
             midi_map_seen: 0,
             params,
-        }
-    }
-}
-
-impl Colophony {
-    fn handle_event(&mut self, event: NoteEvent<()>) {
-        let p = &mut self.performer;
-        match event {
-            NoteEvent::NoteOn {
-                key: Key::Number(note),
-                velocity,
-                channel,
-                ..
-            } => p.note_on_channel(channel.number().unwrap_or(0), note, velocity),
-            NoteEvent::NoteOff {
-                key: Key::Number(note),
-                ..
-            } => p.note_off(note),
-            NoteEvent::NoteOff {
-                key: Key::Wildcard, ..
-            }
-            | NoteEvent::Choke { .. } => p.all_notes_off(),
-            NoteEvent::MidiPitchBend { channel, value, .. } => {
-                p.set_pitch_wheel_channel(channel, value)
-            }
-            NoteEvent::MidiCC {
-                channel, cc, value, ..
-            } => {
-                self.params.last_controller.record(cc);
-                p.set_controller_channel(channel, cc, value)
-            }
-            NoteEvent::MidiChannelPressure {
-                channel, pressure, ..
-            } => p.set_pressure_channel(channel, pressure),
-            // CLAP note expressions and polyphonic aftertouch, per note.
-            NoteEvent::PolyTuning {
-                key: Key::Number(note),
-                tuning,
-                ..
-            } => p.set_note_tuning(note, tuning),
-            NoteEvent::PolyPressure {
-                key: Key::Number(note),
-                pressure,
-                ..
-            } => p.set_note_pressure(note, pressure),
-            NoteEvent::PolyBrightness {
-                key: Key::Number(note),
-                brightness,
-                ..
-            } => p.set_note_brightness(note, brightness),
-            _ => {}
         }
     }
 }
@@ -169,14 +118,10 @@ impl Plugin for Colophony {
         for (kind, bridge) in InstrumentKind::ALL.into_iter().zip(bridges) {
             self.performer.set_user_bridge(kind, bridge);
         }
-        if let Err(e) = self.performer.activate(&self.params.setup(), fs) {
-            // A chosen bridge the thermal model cannot run at this rate: never refuse the
-            // host for it, play the shipped bridges instead.
-            nice_log!("{e}; playing the shipped bridges");
-            for kind in InstrumentKind::ALL {
-                self.performer.set_user_bridge(kind, None);
-            }
-            if let Err(e) = self.performer.activate(&self.params.setup(), fs) {
+        match self.performer.activate_or_shipped(&self.params.setup(), fs) {
+            Ok(None) => {}
+            Ok(Some(given_up)) => nice_log!("{given_up}"),
+            Err(e) => {
                 nice_log!("{e}");
                 return false;
             }
@@ -216,78 +161,6 @@ impl Plugin for Colophony {
             self.performer.set_midi_map(&map);
         }
         // The editor's live views are fed only while an editor shows them.
-        let live = self.editor_link.is_listening();
-        let mut next_event = context.next_event();
-        let samples = buffer.samples();
-        let channels = buffer.as_slice();
-        if next_event.is_none() && self.settled() && self.performer.is_asleep() {
-            // Nothing sounds and nothing lands in this block: silence, without a per-sample
-            // call (the performer's gesture clocks still advance).
-            channels.iter_mut().for_each(|c| c.fill(0.0));
-            self.performer.skip(samples, self.params.bow());
-            self.editor_link.set_note(self.performer.last_note());
-            self.editor_link.set_played_bow(None);
-            return host_status(self.performer.status(samples));
-        }
-        let mut sample = 0;
-        while sample < samples {
-            while let Some(event) = next_event.filter(|e| e.timing() <= sample as u32) {
-                self.handle_event(event);
-                next_event = context.next_event();
-            }
-            // Up to the next event nothing lands: one run.
-            let end = next_event.map_or(samples, |e| {
-                (e.timing() as usize).clamp(sample + 1, samples)
-            });
-            if !live && self.settled() {
-                self.play_run(channels, sample, end);
-            } else {
-                self.play_moving(channels, sample, end, live);
-            }
-            sample = end;
-        }
-        // Events at or after the block's end (none should be) are still applied.
-        while let Some(event) = next_event {
-            self.handle_event(event);
-            next_event = context.next_event();
-        }
-        self.editor_link.set_note(self.performer.last_note());
-        self.editor_link.set_played_bow(self.performer.bowed_bow());
-        host_status(self.performer.status(samples))
-    }
-}
-
-impl Colophony {
-    /// Whether no bow parameter and not the gain is still smoothing (a settled smoother
-    /// returns its target on every call).
-    fn settled(&self) -> bool {
-        let p = &self.params;
-        !(p.bow_velocity.smoothed.is_smoothing()
-            || p.bow_force.smoothed.is_smoothing()
-            || p.bow_position.smoothed.is_smoothing()
-            || p.gain.smoothed.is_smoothing())
-    }
-
-    /// Samples `from..to` with the parameters settled and no event between: the performer
-    /// renders them as a block ([`Performer::tick_block`]), the same samples as ticking.
-    fn play_run(&mut self, channels: &mut [&mut [f32]], from: usize, to: usize) {
-        let (bow, gain) = next_controls(&self.params);
-        let mut chunk = [0.0f64; 64];
-        let mut at = from;
-        while at < to {
-            let n = (to - at).min(chunk.len());
-            self.performer.tick_block(bow, &mut chunk[..n]);
-            for (k, audio) in chunk[..n].iter().enumerate() {
-                write_frame(channels, at + k, *audio * gain);
-            }
-            at += n;
-        }
-    }
-
-    /// Samples `from..to` with no event between while a parameter smooths or the editor's
-    /// live views listen: the bow moves sample by sample ([`Performer::tick_run`]), and
-    /// the live views get every sample.
-    fn play_moving(&mut self, channels: &mut [&mut [f32]], from: usize, to: usize, live: bool) {
         let Self {
             params,
             performer,
@@ -295,25 +168,53 @@ impl Colophony {
             node_probe,
             ..
         } = self;
-        performer.tick_run(
-            to - from,
-            || next_controls(params),
-            |k, gain, frame, played, performer| {
-                if live {
-                    let contact = measure::contact::ContactSample::new(frame, played);
-                    editor_link.scope.push(contact);
-                    if let Some(string) = performer.probed_thermal_string() {
-                        node_probe.add_from(
-                            string.node_temperatures(),
-                            string.node_sliding_velocities(),
-                            editor_link,
-                        );
-                    }
+        let mut feed =
+            |frame: &dsp::vocabulary::Frame, played: &BowControl, performer: &Performer| {
+                editor_link
+                    .scope
+                    .push(measure::contact::ContactSample::new(frame, played));
+                if let Some(string) = performer.probed_thermal_string() {
+                    node_probe.add_from(
+                        string.node_temperatures(),
+                        string.node_sliding_velocities(),
+                        editor_link,
+                    );
                 }
-                write_frame(channels, from + k, frame.audio * gain);
+            };
+        let live: Option<&mut dyn FnMut(&_, &_, &_)> = if editor_link.is_listening() {
+            Some(&mut feed)
+        } else {
+            None
+        };
+        let status = performer.render_block(
+            buffer.as_slice(),
+            || loop {
+                let event = context.next_event()?;
+                let at = event.timing() as usize;
+                if let NoteEvent::MidiCC { cc, .. } = event {
+                    params.last_controller.record(cc);
+                }
+                if let Some(event) = host_event::performer_event(event) {
+                    return Some((at, event));
+                }
             },
+            || next_controls(params),
+            || settled(params),
+            live,
         );
+        self.editor_link.set_note(self.performer.last_note());
+        self.editor_link.set_played_bow(self.performer.bowed_bow());
+        host_status(status)
     }
+}
+
+/// Whether no bow parameter and not the gain is still smoothing (a settled smoother
+/// returns its target on every call).
+fn settled(p: &ColophonyParams) -> bool {
+    !(p.bow_velocity.smoothed.is_smoothing()
+        || p.bow_force.smoothed.is_smoothing()
+        || p.bow_position.smoothed.is_smoothing()
+        || p.gain.smoothed.is_smoothing())
 }
 
 /// The next sample's bow and output gain from the (smoothed) parameters.
@@ -325,15 +226,6 @@ fn next_controls(p: &ColophonyParams) -> (BowControl, f64) {
         position_beta: p.bow_position.smoothed.next() as f64,
     };
     (bow, util::db_to_gain(p.gain.smoothed.next()) as f64)
-}
-
-/// One output sample on every channel: subnormals flushed, the safety limiter applied.
-#[inline]
-fn write_frame(channels: &mut [&mut [f32]], sample: usize, audio: f64) {
-    let out = dsp::filters::safety_limit(dsp::filters::flush_tiny(audio)) as f32;
-    for channel in channels.iter_mut() {
-        channel[sample] = out;
-    }
 }
 
 /// The performer's status in nice-plug's words.

@@ -8,10 +8,9 @@
 //! CC2 and channel pressure set the dynamics, CC1 the vibrato depth. The bow's own
 //! velocity, force and position are the constants given.
 
-use colophony::dsp::filters::{flush_tiny, safety_limit};
-use colophony::dsp::vocabulary::BowControl;
+use colophony::dsp::vocabulary::{BowControl, Frame};
 use colophony::measure::contact::ContactSample;
-use colophony::performer::{Performer, Setup, Status};
+use colophony::performer::{Event, Performer, Setup, Status};
 use midly::{MetaMessage, MidiMessage, Smf, Timing, TrackEventKind};
 
 /// What a MIDI file asks of the performer.
@@ -231,62 +230,41 @@ fn perform_probing(
     let mut done = 0u64;
     let quiet_needed = (QUIET_S * how.sample_rate_hz) as u64;
     let mut quiet = 0u64;
+    let mut buffer = vec![0.0f32; block];
     loop {
+        // As the plugin plays a host block.
         performer.configure(&how.setup);
-        let event_in_block = next < events.len() && events[next].sample < done + block as u64;
-        if !event_in_block && performer.is_asleep() {
-            // As the plugin: a silent block with nothing landing is skipped.
-            performer.skip(block, how.bow);
-            out.resize(out.len() + block, 0.0);
+        let end = done + block as u64;
+        let probing = probe.is_some();
+        let mut record = |frame: &Frame, played: &BowControl, _: &Performer| {
             if let Some(p) = probe.as_deref_mut() {
-                p.resize(out.len(), ContactSample::default());
+                p.push(ContactSample::new(frame, played));
             }
-            quiet += block as u64;
-        } else {
-            let end = done + block as u64;
-            let mut now = done;
-            while now < end {
-                while next < events.len() && events[next].sample <= now {
-                    let c = events[next].channel;
-                    match events[next].event {
-                        MidiEvent::NoteOn(n, v) => {
-                            performer.note_on_channel(c, n, v as f32 / 127.0)
-                        }
-                        MidiEvent::NoteOff(n) => performer.note_off(n),
-                        MidiEvent::PitchBend(raw) => {
-                            // As nice-plug hands it to the plugin: 0..1 in f32.
-                            performer.set_pitch_wheel_channel(c, raw as f32 / 16383.0);
-                        }
-                        MidiEvent::Controller(cc, v) => {
-                            performer.set_controller_channel(c, cc, v as f32 / 127.0)
-                        }
-                        MidiEvent::Pressure(v) => {
-                            performer.set_pressure_channel(c, v as f32 / 127.0)
-                        }
-                    }
-                    next += 1;
-                }
-                // Up to the next event (or the block's end) nothing lands: one run.
-                let run_end = events
-                    .get(next)
-                    .map_or(end, |e| e.sample.clamp(now + 1, end));
-                performer.tick_run(
-                    (run_end - now) as usize,
-                    || (how.bow, ()),
-                    |_, (), frame, played, _| {
-                        if let Some(p) = probe.as_deref_mut() {
-                            p.push(ContactSample::new(frame, played));
-                        }
-                        let y = safety_limit(flush_tiny(frame.audio * how.gain)) as f32;
-                        quiet = if y.abs() < QUIET_LEVEL { quiet + 1 } else { 0 };
-                        out.push(y);
-                    },
-                );
-                now = run_end;
-            }
+        };
+        let live: Option<&mut dyn FnMut(&Frame, &BowControl, &Performer)> = match probing {
+            true => Some(&mut record),
+            false => None,
+        };
+        let status = performer.render_block(
+            &mut [&mut buffer[..]],
+            || {
+                let e = events.get(next).filter(|e| e.sample < end)?;
+                next += 1;
+                Some(((e.sample.max(done) - done) as usize, event_of(e)))
+            },
+            || (how.bow, how.gain),
+            || true,
+            live,
+        );
+        for &y in &buffer {
+            quiet = if y.abs() < QUIET_LEVEL { quiet + 1 } else { 0 };
         }
-        done += block as u64;
-        let status = performer.status(block);
+        out.extend_from_slice(&buffer);
+        if let Some(p) = probe.as_deref_mut() {
+            // A silent block is skipped without frames: the probe reads rest there.
+            p.resize(out.len(), ContactSample::default());
+        }
+        done = end;
         progress(done, last.max(done));
         if limit.is_some_and(|n| done >= n) {
             break;
@@ -297,6 +275,33 @@ fn perform_probing(
         }
     }
     Ok(out)
+}
+
+/// The performer's event for a file's (values as nice-plug hands them to the plugin:
+/// 0..=1 in f32).
+fn event_of(e: &Timed) -> Event {
+    let channel = e.channel;
+    match e.event {
+        MidiEvent::NoteOn(note, v) => Event::NoteOn {
+            channel,
+            note,
+            velocity: v as f32 / 127.0,
+        },
+        MidiEvent::NoteOff(note) => Event::NoteOff { note },
+        MidiEvent::PitchBend(raw) => Event::PitchWheel {
+            channel,
+            value: raw as f32 / 16383.0,
+        },
+        MidiEvent::Controller(cc, v) => Event::Controller {
+            channel,
+            cc,
+            value: v as f32 / 127.0,
+        },
+        MidiEvent::Pressure(v) => Event::ChannelPressure {
+            channel,
+            pressure: v as f32 / 127.0,
+        },
+    }
 }
 
 /// `colophony render --midi FILE`: reads `midi`, plays it as [`perform`] (blocks of 512),

@@ -31,6 +31,7 @@
 //! assert!(peak > 0.0);
 //! ```
 
+mod block;
 pub mod direct;
 mod gesture;
 mod midi;
@@ -57,6 +58,7 @@ use crate::dsp::vocabulary::{
     MIN_NOTE_BETA, PITCH_BEND_SEMITONES,
 };
 use crate::quality::{self, Quality};
+pub use block::{write_frame, Event};
 use direct::DirectBow;
 use gesture::Gesture;
 pub use gesture::{

@@ -17,6 +17,24 @@ impl Performer {
         }
     }
 
+    /// [`Performer::activate`], falling back to the shipped bridges when a chosen bridge
+    /// cannot run at this rate: a host is never refused for a bridge. `Ok` carries what
+    /// was given up (a line for the log), `Err` what failed even on the shipped bridges.
+    pub fn activate_or_shipped(
+        &mut self,
+        setup: &Setup,
+        sample_rate_hz: f64,
+    ) -> Result<Option<String>, String> {
+        match self.activate(setup, sample_rate_hz) {
+            Ok(()) => Ok(None),
+            Err(e) => {
+                self.user_bridges = Default::default();
+                self.activate(setup, sample_rate_hz)?;
+                Ok(Some(format!("{e}; playing the shipped bridges")))
+            }
+        }
+    }
+
     /// Allocates every engine for `sample_rate_hz`; nothing allocates after this.
     pub fn activate(&mut self, setup: &Setup, sample_rate_hz: f64) -> Result<(), String> {
         self.setup = *setup;
