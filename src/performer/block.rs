@@ -265,23 +265,31 @@ mod tests {
         [left, right]
     }
 
-    #[test]
-    fn a_block_plays_the_same_samples_as_ticking_with_the_output_stage_on_every_channel() {
-        let total = 4096;
-        let events = phrase();
-        // Tick by tick: events at their samples, output stage applied by hand.
+    /// The same, tick by tick: events at their samples, the output stage applied by hand.
+    fn ticked(
+        events: &[(usize, Event)],
+        total: usize,
+        bow_at: impl Fn(usize) -> BowControl,
+    ) -> Vec<f32> {
         let mut p = cello();
-        let bow = BowControl::default();
         let mut next = 0;
-        let want: Vec<f32> = (0..total)
+        (0..total)
             .map(|i| {
                 while next < events.len() && events[next].0 <= i {
                     p.handle(events[next].1);
                     next += 1;
                 }
-                safety_limit(flush_tiny(p.tick(bow).audio * 0.5)) as f32
+                safety_limit(flush_tiny(p.tick(bow_at(i)).audio * 0.5)) as f32
             })
-            .collect();
+            .collect()
+    }
+
+    #[test]
+    fn a_block_plays_the_same_samples_as_ticking_with_the_output_stage_on_every_channel() {
+        let total = 4096;
+        let events = phrase();
+        let bow = BowControl::default();
+        let want = ticked(&events, total, |_| bow);
         for block in [1, 64, 512, 1000] {
             for settled in [true, false] {
                 let [left, right] = rendered(&events, total, block, settled, |_| bow);
@@ -299,17 +307,7 @@ mod tests {
             velocity_m_per_s: 0.05 + 1e-5 * i as f64,
             ..BowControl::default()
         };
-        let mut p = cello();
-        let mut next = 0;
-        let want: Vec<f32> = (0..total)
-            .map(|i| {
-                while next < events.len() && events[next].0 <= i {
-                    p.handle(events[next].1);
-                    next += 1;
-                }
-                safety_limit(flush_tiny(p.tick(bow_at(i)).audio * 0.5)) as f32
-            })
-            .collect();
+        let want = ticked(&events, total, bow_at);
         let [left, _] = rendered(&events, total, 256, false, bow_at);
         assert_eq!(left, want);
         // Nothing held or ringing: the block is silence.
