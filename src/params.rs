@@ -37,13 +37,11 @@ pub enum InstrumentChoice {
     Cello,
 }
 
+/// The parameter's choices are the instruments in [`InstrumentKind::ALL`]'s order, with
+/// their names as ids (a test checks both).
 impl From<InstrumentChoice> for InstrumentKind {
     fn from(choice: InstrumentChoice) -> Self {
-        match choice {
-            InstrumentChoice::Violin => InstrumentKind::Violin,
-            InstrumentChoice::Viola => InstrumentKind::Viola,
-            InstrumentChoice::Cello => InstrumentKind::Cello,
-        }
+        InstrumentKind::ALL[choice.to_index().min(InstrumentKind::COUNT - 1)]
     }
 }
 
@@ -468,6 +466,21 @@ impl ColophonyParams {
             velocity_m_per_s: self.bow_velocity.value() as f64,
             force_n: self.bow_force.value() as f64,
             position_beta: self.bow_position.value() as f64,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_instrument_choices_are_the_instruments_in_order_with_their_names_as_ids() {
+        let ids = InstrumentChoice::ids().expect("the choices have ids");
+        assert_eq!(ids.len(), InstrumentKind::COUNT);
+        for (i, kind) in InstrumentKind::ALL.into_iter().enumerate() {
+            assert_eq!(ids[i], kind.name());
+            assert_eq!(InstrumentKind::from(InstrumentChoice::from_index(i)), kind);
         }
     }
 }

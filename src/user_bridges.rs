@@ -72,7 +72,9 @@ pub fn chosen_name(bridges: &UserBridges, kind: InstrumentKind) -> Option<String
 
 /// Every instrument's saved bridge as modes (`None`: the shipped one), with a message for
 /// each saved bridge that does not parse (it plays the shipped one).
-pub fn saved_modes(bridges: &UserBridges) -> ([Option<BridgeModes>; 3], Vec<String>) {
+pub fn saved_modes(
+    bridges: &UserBridges,
+) -> ([Option<BridgeModes>; InstrumentKind::COUNT], Vec<String>) {
     let map = bridges.lock().map(|m| m.clone()).unwrap_or_default();
     let mut problems = Vec::new();
     let modes = InstrumentKind::ALL.map(|kind| {

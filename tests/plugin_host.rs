@@ -67,9 +67,12 @@ fn tuned_free_decay_hz(kind: InstrumentKind, note: u8) -> f64 {
 /// Where the intonation table of `model` (its name in the table) puts `semitones` (MIDI,
 /// fractional: bends) played on `string` of `kind`, Hz.
 fn tuned_hz(kind: InstrumentKind, model: &str, string: usize, semitones: f64) -> f64 {
-    use colophony::dsp::intonation::{model_index, shipped};
+    use colophony::dsp::intonation::{shipped, TunedModel};
     let above_open = semitones - kind.open_notes()[string] as f64;
-    let c = shipped().correction_cents(model_index(model), kind, string, above_open);
+    let row = TunedModel::from_name(model)
+        .expect("a model the table covers")
+        .row();
+    let c = shipped().correction_cents(row, kind, string, above_open);
     midi_to_hz(semitones - c / 100.0)
 }
 

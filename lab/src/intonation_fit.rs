@@ -33,7 +33,7 @@
 //! (docs/playing-space.md, "Tuned at the defaults").
 
 use crate::playing_space::{measure, Bowing, Cell, Model};
-use colophony::dsp::intonation::{model_index, IntonationTable};
+use colophony::dsp::intonation::IntonationTable;
 use colophony::dsp::vocabulary::{InstrumentKind, MAX_STOP_SEMITONES, STRINGS};
 use rayon::prelude::*;
 use std::fmt::Write as _;
@@ -215,7 +215,7 @@ pub fn fit(
             let mut r: Vec<f64> = ms.to_vec();
             fill_gaps(&mut r);
             for (e, r) in es.iter().zip(r) {
-                let row = model_index(e.model.name());
+                let row = e.model.row();
                 let old = table.get(row, e.kind, e.string, e.semitone);
                 table.set(row, e.kind, e.string, e.semitone, old + r);
             }
@@ -238,7 +238,7 @@ pub fn run(
     // Models and instruments not fitted keep the shipped entries.
     let mut merged = colophony::dsp::intonation::shipped().clone();
     for &model in models {
-        let row = model_index(model.name());
+        let row = model.row();
         for &kind in kinds {
             for string in 0..STRINGS {
                 for s in 0..=MAX_STOP_SEMITONES as usize {

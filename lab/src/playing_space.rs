@@ -13,7 +13,7 @@
 //!   `F_max / 2`.
 //!
 //! The window is [`SchellengWindow`] for the string that plays the note, with the model's
-//! own static and sliding friction coefficients ([`Model::friction_coefficients`]). The bow
+//! own static and sliding friction coefficients ([`friction_coefficients`]). The bow
 //! velocity is 0.1 m/s, lowered (not below 0.05 m/s) where `F_max / 2` would exceed the
 //! plugin's 10 N.
 //!
@@ -70,38 +70,17 @@ pub const WINDOW_CENTS: f64 = 10.0;
 /// Highest bow force of the plugin's range, N.
 const MAX_FORCE_N: f64 = 10.0;
 
-/// A friction model as the plugin offers it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Model {
-    Point(FrictionModel),
-    Thermal,
-}
+/// A friction model as the plugin offers it: the registry the intonation table keys on.
+pub use colophony::dsp::intonation::TunedModel as Model;
 
-impl Model {
-    pub const ALL: [Model; 5] = [
-        Model::Point(FrictionModel::Hyperbolic),
-        Model::Point(FrictionModel::Stribeck),
-        Model::Point(FrictionModel::LuGre),
-        Model::Point(FrictionModel::ElastoPlastic),
-        Model::Thermal,
-    ];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Model::Point(m) => m.name(),
-            Model::Thermal => "thermal",
-        }
-    }
-
-    /// Static and sliding friction coefficients: 0.4 / 0.2 for paper A's laws, the
-    /// thermal law's cool and hot ends for paper B's.
-    pub fn friction_coefficients(self) -> (f64, f64) {
-        match self {
-            Model::Point(_) => (0.4, 0.2),
-            Model::Thermal => {
-                let p = ThermalParams::default();
-                (p.mu_cold, p.mu_hot)
-            }
+/// Static and sliding friction coefficients of `model`: 0.4 / 0.2 for paper A's laws, the
+/// thermal law's cool and hot ends for paper B's.
+pub fn friction_coefficients(model: Model) -> (f64, f64) {
+    match model {
+        Model::Point(_) => (0.4, 0.2),
+        Model::Thermal => {
+            let p = ThermalParams::default();
+            (p.mu_cold, p.mu_hot)
         }
     }
 }
@@ -246,7 +225,7 @@ impl Cell {
             Bowing::Defaults | Bowing::Middle => 0.1,
             Bowing::TwiceMin(b) | Bowing::Centre(b) | Bowing::HalfMax(b) => b,
         };
-        let (mu_s, mu_d) = model.friction_coefficients();
+        let (mu_s, mu_d) = friction_coefficients(model);
         let index = kind.string_for_note_on(note, string).unwrap_or(0);
         let window = SchellengWindow {
             mu_s,
@@ -460,11 +439,7 @@ impl Catcher {
 
 /// The modal bridge the plugin gives each instrument's thermal model.
 fn thermal_bridge(kind: InstrumentKind) -> crate::admittance_fit::BridgeModes {
-    match kind {
-        InstrumentKind::Cello => crate::admittance_fit::shipped_cello_bridge(),
-        InstrumentKind::Viola => colophony::dsp::bridge_data::shipped_viola_bridge(),
-        InstrumentKind::Violin => crate::admittance_fit::shipped_violin_bridge(),
-    }
+    colophony::dsp::bridge_data::shipped_bridge(kind)
 }
 
 /// Renders and measures one cell.

@@ -135,10 +135,15 @@ fn helmholtz_amplitude_scales_as_bow_velocity_over_beta() {
 /// Where the intonation table puts the free decay of `note` on `kind` (hyperbolic law,
 /// the usual string): equal temperament moved by the table's correction, Hz.
 fn tuned_free_decay_hz(kind: InstrumentKind, note: u8) -> f64 {
-    use colophony::dsp::intonation::{model_index, shipped};
+    use colophony::dsp::intonation::{shipped, TunedModel};
     let string = kind.string_for_note(note).unwrap();
     let above_open = (note - kind.open_notes()[string]) as f64;
-    let c = shipped().correction_cents(model_index("hyperbolic"), kind, string, above_open);
+    let c = shipped().correction_cents(
+        TunedModel::Point(colophony::dsp::friction::FrictionModel::Hyperbolic).row(),
+        kind,
+        string,
+        above_open,
+    );
     midi_to_hz(note as f64 - c / 100.0)
 }
 

@@ -36,7 +36,8 @@ fn the_internal_rate_is_wave_speed_over_node_spacing_as_in_table_1() {
         // fs = c N_B / w exactly, with c = 2 L f0 = 90.3 m/s. The paper's column is not
         // one c over its dx column (30.3 kHz at 3.3 mm is c = 100 m/s, 546.5 kHz at
         // 0.16 mm is 91 m/s), so it is printed beside ours, not asserted.
-        let c = 2.0 * 0.69 * 65.41;
+        let spec = ThermalStringSpec::cello_c();
+        let c = 2.0 * spec.length_m * spec.f0_hz;
         assert!((s.internal_rate_hz() - c * nodes as f64 / 0.01).abs() < 1e-6);
     }
 }
@@ -178,9 +179,11 @@ fn temperature_rises_while_slipping_and_diffuses_while_sticking() {
     }
     println!("whole-width slips well below the sliding equilibrium that warmed: {heated}/{below}; well above it that cooled: {cooled}/{above}; all-stick samples obeying diffusion: {diffusive}/{sticks}");
     // The default contact cools in 33 us, so a slip spends only its first samples far
-    // from equilibrium: about one such sample per period of the 65 Hz string (about 20
-    // over the 0.3 s).
-    assert!(below + above > 10 && heated == below && cooled == above);
+    // from equilibrium, and whole-width slips that far off come with the attack's first
+    // slips, not every period: 9 in these 0.3 s (and no more in 0.5 s, measured on
+    // 2026-11-27). Every one must move toward equilibrium; at least five, so the
+    // direction is seen on several.
+    assert!(below + above >= 5 && heated == below && cooled == above);
     assert!(sticks > 100 && diffusive == sticks);
 }
 

@@ -21,6 +21,7 @@
 
 use colophony::analysis::{cents, peak_frequency_hz};
 use colophony::dsp::friction::FrictionModel;
+use colophony::dsp::intonation::TunedModel;
 use colophony::dsp::vocabulary::{midi_to_hz, InstrumentKind};
 use colophony::measure::contact::ContactSample;
 use colophony::measure::regime::{classify_regime, helmholtz_since, Regime};
@@ -187,13 +188,17 @@ const PARTS: [Part; 11] = [
     },
 ];
 
-const LAWS: [(&str, Option<FrictionModel>); 5] = [
-    ("hyperbolic", Some(FrictionModel::Hyperbolic)),
-    ("static", Some(FrictionModel::Stribeck)),
-    ("lugre", Some(FrictionModel::LuGre)),
-    ("elasto-plastic", Some(FrictionModel::ElastoPlastic)),
-    ("thermal", None),
-];
+/// Every model the plugin offers, by name, with its point law (`None`: paper B's thermal
+/// bow).
+fn laws() -> impl Iterator<Item = (&'static str, Option<FrictionModel>)> {
+    TunedModel::all().map(|m| {
+        let law = match m {
+            TunedModel::Point(law) => Some(law),
+            TunedModel::Thermal => None,
+        };
+        (m.name(), law)
+    })
+}
 
 const RATES: [f64; 3] = [44_100.0, 48_000.0, 96_000.0];
 
@@ -282,8 +287,7 @@ fn survey(only_cantabile: bool) -> (Vec<String>, Vec<String>) {
         .iter()
         .filter(|p| p.cantabile || !only_cantabile)
         .flat_map(|p| {
-            LAWS.iter()
-                .flat_map(move |&(name, law)| RATES.iter().map(move |&fs| (p, name, law, fs)))
+            laws().flat_map(move |(name, law)| RATES.iter().map(move |&fs| (p, name, law, fs)))
         })
         .filter(|(p, name, _, fs)| {
             // `REPERTOIRE_ONLY=text`: only the cases whose line contains it (for a look at

@@ -18,13 +18,7 @@ use std::f64::consts::PI;
 
 pub const MAX_BODY_MODES: usize = 6;
 
-/// One body mode: centre frequency, quality factor, gain relative to the direct path.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BodyMode {
-    pub freq_hz: f64,
-    pub q: f64,
-    pub gain: f64,
-}
+pub use super::vocabulary::BodyMode;
 
 #[derive(Debug, Clone)]
 pub struct BodyModes {

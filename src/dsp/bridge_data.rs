@@ -15,6 +15,7 @@
 //! assert_eq!((one.modes.len(), ports), (1, 1));
 //! ```
 
+use super::vocabulary::InstrumentKind;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -268,24 +269,32 @@ mod tests {
     }
 }
 
-/// The shipped generic (designed, not measured) cello bridge, `assets/bridges/cello-generic.json`,
-/// embedded in the binary and validated.
+/// Each instrument's shipped bridge file, in [`InstrumentKind::ALL`]'s order: generic
+/// (designed, not measured) bridges in `assets/bridges/`, embedded in the binary.
+const SHIPPED_BRIDGES: [&str; InstrumentKind::COUNT] = [
+    include_str!("../../assets/bridges/violin-generic.json"),
+    include_str!("../../assets/bridges/viola-generic.json"),
+    include_str!("../../assets/bridges/cello-generic.json"),
+];
+
+/// `kind`'s shipped bridge (`assets/bridges/<name>-generic.json`), validated.
+pub fn shipped_bridge(kind: InstrumentKind) -> BridgeModes {
+    parse_bridge(SHIPPED_BRIDGES[kind.index()])
+        .unwrap_or_else(|e| panic!("the shipped {} bridge is invalid: {e}", kind.name()))
+        .0
+}
+
+/// The shipped cello bridge, `assets/bridges/cello-generic.json`.
 pub fn shipped_cello_bridge() -> BridgeModes {
-    parse_bridge(include_str!("../../assets/bridges/cello-generic.json"))
-        .expect("the shipped cello bridge is valid")
-        .0
+    shipped_bridge(InstrumentKind::Cello)
 }
 
-/// The shipped generic viola bridge, `assets/bridges/viola-generic.json`.
+/// The shipped viola bridge, `assets/bridges/viola-generic.json`.
 pub fn shipped_viola_bridge() -> BridgeModes {
-    parse_bridge(include_str!("../../assets/bridges/viola-generic.json"))
-        .expect("the shipped viola bridge is valid")
-        .0
+    shipped_bridge(InstrumentKind::Viola)
 }
 
-/// The shipped generic violin bridge, `assets/bridges/violin-generic.json`.
+/// The shipped violin bridge, `assets/bridges/violin-generic.json`.
 pub fn shipped_violin_bridge() -> BridgeModes {
-    parse_bridge(include_str!("../../assets/bridges/violin-generic.json"))
-        .expect("the shipped violin bridge is valid")
-        .0
+    shipped_bridge(InstrumentKind::Violin)
 }

@@ -67,7 +67,7 @@ pub struct WaveguideBank {
     body: BodyModes,
     /// Each instrument's body in place of the generic one ([`Instrument::set_body`]):
     /// modes and their count, per [`InstrumentKind::ALL`] index.
-    custom_bodies: [Option<([BodyMode; MAX_BODY_MODES], usize)>; 3],
+    custom_bodies: [Option<([BodyMode; MAX_BODY_MODES], usize)>; InstrumentKind::COUNT],
     output_scale: f64,
     /// The probed string's last internal sample: velocity at the bow, friction force.
     probe: (f64, f64),
@@ -97,8 +97,7 @@ impl WaveguideBank {
 
     /// The body `kind` plays: its custom one if set, else the generic one.
     fn body_of(&self, kind: InstrumentKind) -> BodyModes {
-        let k = InstrumentKind::ALL.iter().position(|&x| x == kind);
-        match k.and_then(|k| self.custom_bodies[k].as_ref()) {
+        match &self.custom_bodies[kind.index()] {
             Some((modes, n)) => BodyModes::new(&modes[..*n], 1.0, self.sample_rate_hz),
             None => BodyModes::new(&kind.body_modes(), 1.0, self.sample_rate_hz),
         }
@@ -355,7 +354,7 @@ impl Instrument {
             sample_rate_hz,
             voices,
             body: BodyModes::new(&kind.body_modes(), 1.0, sample_rate_hz),
-            custom_bodies: [None; 3],
+            custom_bodies: [None; InstrumentKind::COUNT],
             output_scale: kind.output_scale_per_n(),
             probe: (0.0, 0.0),
             oversample,
@@ -369,7 +368,7 @@ impl Instrument {
             kind,
             host_rate_hz,
             resampler,
-            intonation::model_index(FrictionModel::Hyperbolic.name()),
+            intonation::TunedModel::Point(FrictionModel::Hyperbolic).row(),
         )
     }
 
@@ -404,9 +403,7 @@ impl Instrument {
     /// `None` goes back to it. Takes effect now if `kind` is playing, else when it is
     /// chosen. Real-time safe.
     pub fn set_body(&mut self, kind: InstrumentKind, modes: Option<&[BodyMode]>) {
-        let Some(k) = InstrumentKind::ALL.iter().position(|&x| x == kind) else {
-            return;
-        };
+        let k = kind.index();
         let bank = &mut self.bank;
         bank.custom_bodies[k] = modes.map(|m| {
             let mut kept = [BodyMode {
@@ -442,7 +439,7 @@ impl Instrument {
         if self
             .hands
             .fingering
-            .set_intonation_row(intonation::model_index(model.name()))
+            .set_intonation_row(intonation::TunedModel::Point(model).row())
         {
             self.retune();
         }
@@ -588,7 +585,7 @@ mod tests {
             let want = a4 * 2f64.powf((note as f64 + bend - 69.0) / 12.0);
             let above_open = note as f64 + bend - InstrumentKind::Cello.open_notes()[index] as f64;
             let c = intonation::shipped().correction_cents(
-                intonation::model_index("hyperbolic"),
+                intonation::TunedModel::Point(FrictionModel::Hyperbolic).row(),
                 InstrumentKind::Cello,
                 index,
                 above_open,

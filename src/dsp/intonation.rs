@@ -21,24 +21,74 @@
 //!
 //! ```
 //! use colophony::dsp::vocabulary::InstrumentKind;
-//! use colophony::dsp::intonation::{model_index, shipped};
+//! use colophony::dsp::friction::FrictionModel;
+//! use colophony::dsp::intonation::{shipped, TunedModel};
 //! // How far the cello's D string is tuned from equal temperament for F#3 (4 semitones
 //! // up) under the hyperbolic law, so that it sounds in tune bowed.
-//! let c = shipped().correction_cents(model_index("hyperbolic"), InstrumentKind::Cello, 2, 4.0);
+//! let row = TunedModel::Point(FrictionModel::Hyperbolic).row();
+//! let c = shipped().correction_cents(row, InstrumentKind::Cello, 2, 4.0);
 //! assert!(c.abs() < 50.0);
 //! ```
 
+use super::friction::FrictionModel;
 use super::vocabulary::{InstrumentKind, MAX_CORRECTION_CENTS, MAX_STOP_SEMITONES, STRINGS};
 use std::sync::OnceLock;
 
 /// Semitones per string in the table: 0 (open) ..= [`MAX_STOP_SEMITONES`].
 const SEMITONES: usize = MAX_STOP_SEMITONES as usize + 1;
 
-/// The models the table covers, in file order.
-pub const MODEL_NAMES: [&str; 5] = ["hyperbolic", "static", "lugre", "elasto-plastic", "thermal"];
+/// A model the table holds corrections for: one of paper A's point laws on the waveguide
+/// strings ([`FrictionModel::ALL`], each by its `name()`), or paper B's thermal bow
+/// ("thermal"). Its row in the table follows [`FrictionModel::ALL`], the thermal bow last:
+/// a new friction law gets its row from the registry, with no table to keep in step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TunedModel {
+    Point(FrictionModel),
+    Thermal,
+}
 
-/// The thermal model's row (paper B's bow).
-pub const THERMAL_ROW: usize = 4;
+impl TunedModel {
+    /// How many models the table covers.
+    pub const COUNT: usize = FrictionModel::ALL.len() + 1;
+
+    /// Every model, in row order: the point laws of [`FrictionModel::ALL`], then the
+    /// thermal bow.
+    pub const ALL: [TunedModel; Self::COUNT] = {
+        let mut all = [TunedModel::Thermal; Self::COUNT];
+        let mut i = 0;
+        while i < FrictionModel::ALL.len() {
+            all[i] = TunedModel::Point(FrictionModel::ALL[i]);
+            i += 1;
+        }
+        all
+    };
+
+    /// Every model, in row order.
+    pub fn all() -> impl Iterator<Item = TunedModel> {
+        Self::ALL.into_iter()
+    }
+
+    /// Its row in the table.
+    pub const fn row(self) -> usize {
+        match self {
+            TunedModel::Point(law) => law.index(),
+            TunedModel::Thermal => FrictionModel::ALL.len(),
+        }
+    }
+
+    /// Its name in the table's file (the friction law's `name()`, or "thermal").
+    pub fn name(self) -> &'static str {
+        match self {
+            TunedModel::Point(law) => law.name(),
+            TunedModel::Thermal => "thermal",
+        }
+    }
+
+    /// The model named `name`, `None` for no model the table covers.
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::all().find(|m| m.name() == name)
+    }
+}
 
 /// The free-decay pitch, Hz, that `string` of `kind` is stopped at to play MIDI `note`
 /// bent by `bend` semitones under a reference `reference` semitones from A4 = 440 Hz:
@@ -66,12 +116,6 @@ pub fn tuned_hz(
     super::vocabulary::midi_to_hz(played + reference - correction / 100.0)
 }
 
-/// The table row of a model named as [`MODEL_NAMES`] (the friction models' `name()`, and
-/// "thermal"); an unknown name reads the first row.
-pub fn model_index(name: &str) -> usize {
-    MODEL_NAMES.iter().position(|&m| m == name).unwrap_or(0)
-}
-
 /// Corrections for every model, instrument, string and semitone, cents.
 #[derive(Debug, Clone, PartialEq)]
 pub struct IntonationTable {
@@ -79,18 +123,14 @@ pub struct IntonationTable {
 }
 
 fn index(model: usize, kind: InstrumentKind, string: usize, semitone: usize) -> usize {
-    let k = InstrumentKind::ALL
-        .iter()
-        .position(|&k| k == kind)
-        .unwrap_or(0);
-    ((model * InstrumentKind::ALL.len() + k) * STRINGS + string) * SEMITONES + semitone
+    ((model * InstrumentKind::COUNT + kind.index()) * STRINGS + string) * SEMITONES + semitone
 }
 
 impl IntonationTable {
     /// A table of zeros: every string tuned by its free decay.
     pub fn zero() -> Self {
         Self {
-            cents: vec![0.0; MODEL_NAMES.len() * InstrumentKind::ALL.len() * STRINGS * SEMITONES],
+            cents: vec![0.0; TunedModel::COUNT * InstrumentKind::COUNT * STRINGS * SEMITONES],
         }
     }
 
@@ -116,7 +156,7 @@ impl IntonationTable {
         self.cents[index(model, kind, string, semitone)] = c;
     }
 
-    /// The correction for `model` (an index into [`MODEL_NAMES`]) on `string` of `kind`,
+    /// The correction for `model` (a [`TunedModel::row`]) on `string` of `kind`,
     /// `semitones` (fractional) above the open string, cents: linear between semitones,
     /// the end values beyond them.
     pub fn correction_cents(
@@ -126,7 +166,7 @@ impl IntonationTable {
         string: usize,
         semitones: f64,
     ) -> f64 {
-        if model >= MODEL_NAMES.len() || string >= STRINGS || !semitones.is_finite() {
+        if model >= TunedModel::COUNT || string >= STRINGS || !semitones.is_finite() {
             return 0.0;
         }
         let s = semitones.clamp(0.0, (SEMITONES - 1) as f64);
@@ -154,10 +194,7 @@ impl IntonationTable {
             if f.len() != 5 {
                 return Err(bad());
             }
-            let model = MODEL_NAMES
-                .iter()
-                .position(|&m| m == f[0])
-                .ok_or_else(bad)?;
+            let model = TunedModel::from_name(f[0]).ok_or_else(bad)?.row();
             let kind = InstrumentKind::from_name(f[1]).ok_or_else(bad)?;
             let string: usize = f[2].parse().map_err(|_| bad())?;
             let semitone: usize = f[3].parse().map_err(|_| bad())?;
@@ -173,7 +210,8 @@ impl IntonationTable {
     /// The table as CSV (header `model,instrument,string,semitone,cents`).
     pub fn to_csv(&self) -> String {
         let mut s = String::from("model,instrument,string,semitone,cents\n");
-        for (m, name) in MODEL_NAMES.iter().enumerate() {
+        for model in TunedModel::all() {
+            let (m, name) = (model.row(), model.name());
             for kind in InstrumentKind::ALL {
                 for string in 0..STRINGS {
                     for semitone in 0..SEMITONES {
@@ -211,8 +249,21 @@ mod tests {
     }
 
     #[test]
-    fn the_thermal_row_is_the_thermal_model() {
-        assert_eq!(model_index("thermal"), THERMAL_ROW);
+    fn every_model_has_its_own_row_and_its_name_finds_it() {
+        let rows: Vec<usize> = TunedModel::all().map(TunedModel::row).collect();
+        assert_eq!(rows, (0..TunedModel::COUNT).collect::<Vec<_>>());
+        for model in TunedModel::all() {
+            assert_eq!(TunedModel::from_name(model.name()), Some(model));
+        }
+        for (i, law) in FrictionModel::ALL.into_iter().enumerate() {
+            assert_eq!(law.index(), i);
+        }
+        // An unknown model is refused, never read as another's row.
+        assert_eq!(TunedModel::from_name("coulomb"), None);
+        assert!(IntonationTable::parse(
+            "model,instrument,string,semitone,cents\ncoulomb,cello,0,1,3.0\n"
+        )
+        .is_err());
     }
 
     #[test]

@@ -521,7 +521,7 @@ impl ThermalInstrument {
             kind,
             host_rate_hz,
             Some(resampler),
-            intonation::THERMAL_ROW,
+            intonation::TunedModel::Thermal.row(),
         );
         instrument.apply_settings(settings)?;
         Ok(instrument)

@@ -4,9 +4,6 @@
 //! and range constants. A leaf: it imports only the string and body data types it is
 //! made of, never an engine.
 
-use super::body::BodyMode;
-use super::waveguide::StringSpec;
-
 /// Largest correction the intonation table may hold, cents (the tuning margins of the
 /// instruments' buffers include it).
 pub const MAX_CORRECTION_CENTS: f64 = 50.0;
@@ -61,6 +58,25 @@ pub fn reference_semitones(a4_hz: f64) -> f64 {
 /// default bowed note's few millijoules).
 pub const SLEEP_ENERGY_J: f64 = 1e-16;
 
+/// Physical data of one string, open (the waveguide string's, [`super::waveguide`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StringSpec {
+    pub open_hz: f64,
+    pub z0_kg_per_s: f64,
+    /// `B` of the open string; a stopped string of length `L'` has `B (L / L')^2`.
+    pub inharmonicity_open: f64,
+    pub q1: f64,
+    pub q_hi: f64,
+}
+
+/// One mode of the point-bow instrument's body ([`super::body`]): centre frequency, quality factor, gain relative to the direct path.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BodyMode {
+    pub freq_hz: f64,
+    pub q: f64,
+    pub gain: f64,
+}
+
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum InstrumentKind {
     Violin,
@@ -68,15 +84,89 @@ pub enum InstrumentKind {
     Cello,
 }
 
+/// All of an instrument's data, read everywhere the instrument is played ([`SPECS`], one
+/// per [`InstrumentKind`], in [`InstrumentKind::ALL`]'s order). Its shipped bridge for
+/// paper B's model is its data file in `src/dsp/bridge_data.rs`
+/// ([`super::bridge_data::shipped_bridge`]), its intonation rows are in
+/// `assets/intonation.csv`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct InstrumentSpec {
+    /// Its name in presets, saved states, the renderer's `--instrument` and the data files.
+    pub name: &'static str,
+    /// MIDI notes of the open strings, low to high, equal-tempered from A4 = 440 Hz.
+    pub open_notes: [u8; STRINGS],
+    /// Each string's characteristic impedance `sqrt(T mu)`, kg/s, low to high.
+    pub z0_kg_per_s: [f64; STRINGS],
+    /// Each string's inharmonicity `B` (`f_n = n f_1 sqrt(1 + B n^2)`), low to high.
+    pub inharmonicity: [f64; STRINGS],
+    /// Quality factor of every string's fundamental, and at ten times it.
+    pub q1: f64,
+    pub q_hi: f64,
+    /// Vibrating length of the open strings, m.
+    pub string_length_m: f64,
+    /// The generic body's modal frequencies over the violin's ([`InstrumentKind::body_modes`]).
+    pub body_scale: f64,
+    /// How many times [`INTERNAL_RATE_HZ`] each point-bow string runs at
+    /// ([`InstrumentKind::point_oversampling`]).
+    pub point_oversampling: [usize; STRINGS],
+}
+
+/// Every instrument's data (docs/literature-values.md §1.4: the Desvages/NESS string sets;
+/// the viola's G, D, A inharmonicities are not in the table and are chosen between the
+/// neighbouring violin and viola values; lengths violin 0.32, viola 0.38, cello 0.69 m).
+pub const SPECS: [InstrumentSpec; InstrumentKind::COUNT] = [
+    InstrumentSpec {
+        name: "violin",
+        open_notes: [55, 62, 69, 76],
+        z0_kg_per_s: [0.350, 0.303, 0.203, 0.173],
+        inharmonicity: [2.7e-4, 2.3e-4, 2.1e-4, 4.8e-5],
+        q1: 500.0,
+        q_hi: 250.0,
+        string_length_m: 0.32,
+        body_scale: 1.0,
+        point_oversampling: [2; STRINGS],
+    },
+    InstrumentSpec {
+        name: "viola",
+        open_notes: [48, 55, 62, 69],
+        z0_kg_per_s: [0.484, 0.323, 0.281, 0.274],
+        inharmonicity: [3.4e-4, 2.7e-4, 2.3e-4, 2.1e-4],
+        q1: 500.0,
+        q_hi: 250.0,
+        string_length_m: 0.38,
+        body_scale: 0.8,
+        point_oversampling: [2; STRINGS],
+    },
+    InstrumentSpec {
+        name: "cello",
+        open_notes: [36, 43, 50, 57],
+        z0_kg_per_s: [1.91, 0.833, 0.506, 0.504],
+        inharmonicity: [5.7e-4, 1.7e-4, 1.5e-4, 5.3e-5],
+        q1: 500.0,
+        q_hi: 250.0,
+        string_length_m: 0.69,
+        body_scale: 0.42,
+        point_oversampling: [1, 1, 1, 2],
+    },
+];
+
 impl InstrumentKind {
-    pub const ALL: [InstrumentKind; 3] = [Self::Violin, Self::Viola, Self::Cello];
+    /// How many instruments there are.
+    pub const COUNT: usize = 3;
+    pub const ALL: [InstrumentKind; Self::COUNT] = [Self::Violin, Self::Viola, Self::Cello];
+
+    /// Its place in [`Self::ALL`] and [`SPECS`].
+    pub const fn index(self) -> usize {
+        self as usize
+    }
+
+    /// All of its data.
+    pub const fn spec(self) -> &'static InstrumentSpec {
+        &SPECS[self.index()]
+    }
 
     pub fn name(self) -> &'static str {
-        match self {
-            Self::Violin => "violin",
-            Self::Viola => "viola",
-            Self::Cello => "cello",
-        }
+        self.spec().name
     }
 
     pub fn from_name(name: &str) -> Option<Self> {
@@ -87,48 +177,25 @@ impl InstrumentKind {
 
     /// MIDI notes of the open strings, low to high.
     pub fn open_notes(self) -> [u8; STRINGS] {
-        match self {
-            Self::Violin => [55, 62, 69, 76],
-            Self::Viola => [48, 55, 62, 69],
-            Self::Cello => [36, 43, 50, 57],
-        }
+        self.spec().open_notes
     }
 
-    /// String data, low to high (docs/literature-values.md §1.4: Desvages/NESS sets; viola G, D, A
-    /// inharmonicities are not in the table and are chosen between the neighbouring
-    /// violin and viola values). Open pitches are equal-tempered from A4 = 440 Hz.
+    /// String data, low to high ([`InstrumentSpec`]). Open pitches are equal-tempered from
+    /// A4 = 440 Hz.
     pub fn strings(self) -> [StringSpec; STRINGS] {
-        let (z0, b): ([f64; 4], [f64; 4]) = match self {
-            Self::Violin => (
-                [0.350, 0.303, 0.203, 0.173],
-                [2.7e-4, 2.3e-4, 2.1e-4, 4.8e-5],
-            ),
-            Self::Viola => (
-                [0.484, 0.323, 0.281, 0.274],
-                [3.4e-4, 2.7e-4, 2.3e-4, 2.1e-4],
-            ),
-            Self::Cello => (
-                [1.91, 0.833, 0.506, 0.504],
-                [5.7e-4, 1.7e-4, 1.5e-4, 5.3e-5],
-            ),
-        };
-        let notes = self.open_notes();
+        let spec = self.spec();
         std::array::from_fn(|i| StringSpec {
-            open_hz: midi_to_hz(notes[i] as f64),
-            z0_kg_per_s: z0[i],
-            inharmonicity_open: b[i],
-            q1: 500.0,
-            q_hi: 250.0,
+            open_hz: midi_to_hz(spec.open_notes[i] as f64),
+            z0_kg_per_s: spec.z0_kg_per_s[i],
+            inharmonicity_open: spec.inharmonicity[i],
+            q1: spec.q1,
+            q_hi: spec.q_hi,
         })
     }
 
     /// Generic body modes (see [`super::body`]).
     pub(crate) fn body_modes(self) -> [BodyMode; 5] {
-        let scale = match self {
-            Self::Violin => 1.0,
-            Self::Viola => 0.8,
-            Self::Cello => 0.42,
-        };
+        let scale = self.spec().body_scale;
         [
             (275.0, 12.0, 0.8),
             (405.0, 15.0, 0.5),
@@ -171,10 +238,7 @@ impl InstrumentKind {
     /// strings, which play the notes below A3 unless a note is asked onto them, run at
     /// 48 kHz, at half the cost.
     pub fn point_oversampling(self) -> [usize; STRINGS] {
-        match self {
-            Self::Violin | Self::Viola => [2; STRINGS],
-            Self::Cello => [1, 1, 1, 2],
-        }
+        self.spec().point_oversampling
     }
 
     /// Output scale: bridge force to a sample value, so that a default note of any
@@ -185,17 +249,12 @@ impl InstrumentKind {
         0.1 / mean_z0
     }
 
-    /// The string a note goes to, if the instrument can play it.
-    /// Vibrating length of the open strings, m (docs/literature-values.md §1.4: violin 0.32,
-    /// viola 0.38, cello 0.69).
+    /// Vibrating length of the open strings, m.
     pub fn string_length_m(self) -> f64 {
-        match self {
-            Self::Violin => 0.32,
-            Self::Viola => 0.38,
-            Self::Cello => 0.69,
-        }
+        self.spec().string_length_m
     }
 
+    /// The string a note goes to, if the instrument can play it.
     pub fn string_for_note(self, note: u8) -> Option<usize> {
         let open = self.open_notes();
         if note < open[0] || note > open[STRINGS - 1] + MAX_STOP_SEMITONES {
@@ -335,3 +394,28 @@ pub const MAX_NOTE_FORCE_SCALE: f64 = 4.0;
 /// A note's own bow position stays within the Bow Position parameter's range.
 pub const MIN_NOTE_BETA: f64 = 0.02;
 pub const MAX_NOTE_BETA: f64 = 0.5;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_instrument_reads_its_own_spec_and_its_name_finds_it() {
+        for (i, kind) in InstrumentKind::ALL.into_iter().enumerate() {
+            assert_eq!(kind.index(), i);
+            assert_eq!(InstrumentKind::from_name(kind.name()), Some(kind));
+            let spec = kind.spec();
+            // Open strings rise, and every string has a positive impedance and length.
+            assert!(
+                spec.open_notes.windows(2).all(|w| w[0] < w[1]),
+                "{}",
+                spec.name
+            );
+            assert!(spec.z0_kg_per_s.iter().all(|&z| z > 0.0) && spec.string_length_m > 0.0);
+            assert!(spec
+                .point_oversampling
+                .iter()
+                .all(|&o| (1..=MAX_POINT_OVERSAMPLING).contains(&o)));
+        }
+    }
+}

@@ -88,16 +88,7 @@ const FIT_MAX_HZ: f64 = 6000.0;
 /// silent rather than play out of tune.
 pub const MIN_LOOP_SAMPLES: f64 = 8.0;
 
-/// Physical data of one string, open.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StringSpec {
-    pub open_hz: f64,
-    pub z0_kg_per_s: f64,
-    /// `B` of the open string; a stopped string of length `L'` has `B (L / L')^2`.
-    pub inharmonicity_open: f64,
-    pub q1: f64,
-    pub q_hi: f64,
-}
+pub use super::vocabulary::StringSpec;
 
 /// What one tick of the string produced.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]

@@ -134,7 +134,7 @@ pub struct Performer {
     /// The bow controls MIDI controllers hold (CC21-23).
     direct: DirectBow,
     /// Bridges the player chose for the thermal instrument of each kind.
-    user_bridges: [Option<BridgeModes>; 3],
+    user_bridges: [Option<BridgeModes>; InstrumentKind::COUNT],
     /// Whether any engine besides the waveguide strings sounds: they wake only at a note
     /// the performer hands them and sleep only at a block's `update_sleep`, so this is
     /// renewed there and the per-sample loop skips them with one test.
@@ -175,7 +175,7 @@ impl Performer {
             gesture: Gesture::new(48_000.0),
             stroke: Stroke::new(48_000.0),
             direct: DirectBow::new(48_000.0),
-            user_bridges: [None, None, None],
+            user_bridges: Default::default(),
             others_awake: false,
             steady: None,
             configured: false,
@@ -197,8 +197,7 @@ impl Performer {
 
     /// Paper B's instrument of `kind` (after [`Performer::activate`]).
     pub fn thermal(&self, kind: InstrumentKind) -> Option<&ThermalInstrument> {
-        let k = InstrumentKind::ALL.iter().position(|x| *x == kind)?;
-        self.thermal.get(k)
+        self.thermal.get(kind.index())
     }
 
     pub fn rubbed(&self) -> &RubbedInstrument {

@@ -89,12 +89,7 @@ impl Source {
         match (setup.rubbed, setup.point_law) {
             (Some(preset), _) => Source::Rubbed(preset),
             (None, Some(_)) => Source::Strings,
-            (None, None) => {
-                let k = InstrumentKind::ALL
-                    .iter()
-                    .position(|x| *x == setup.instrument);
-                Source::Thermal(k.unwrap_or(0))
-            }
+            (None, None) => Source::Thermal(setup.instrument.index()),
         }
     }
 }

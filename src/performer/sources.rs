@@ -12,9 +12,7 @@ impl Performer {
     /// the shipped bridge and the generic body. Takes effect at the next
     /// [`Performer::activate`] (it builds the engines: not for the audio thread).
     pub fn set_user_bridge(&mut self, kind: InstrumentKind, bridge: Option<BridgeModes>) {
-        if let Some(k) = InstrumentKind::ALL.iter().position(|&x| x == kind) {
-            self.user_bridges[k] = bridge;
-        }
+        self.user_bridges[kind.index()] = bridge;
     }
 
     /// [`Performer::activate`], falling back to the shipped bridges when a chosen bridge
@@ -52,18 +50,10 @@ impl Performer {
         self.thermal.clear();
         for (k, kind) in InstrumentKind::ALL.into_iter().enumerate() {
             let shipped;
-            let bridge = match (&self.user_bridges[k], kind) {
-                (Some(user), _) => user,
-                (None, InstrumentKind::Cello) => {
-                    shipped = bridge_data::shipped_cello_bridge();
-                    &shipped
-                }
-                (None, InstrumentKind::Viola) => {
-                    shipped = bridge_data::shipped_viola_bridge();
-                    &shipped
-                }
-                (None, InstrumentKind::Violin) => {
-                    shipped = bridge_data::shipped_violin_bridge();
+            let bridge = match &self.user_bridges[k] {
+                Some(user) => user,
+                None => {
+                    shipped = bridge_data::shipped_bridge(kind);
                     &shipped
                 }
             };

@@ -184,6 +184,12 @@ impl FrictionModel {
         FrictionModel::ElastoPlastic,
     ];
 
+    /// Its place in [`Self::ALL`] (the intonation table's row, with paper B's thermal bow
+    /// after the point laws: [`crate::dsp::intonation::TunedModel`]).
+    pub const fn index(self) -> usize {
+        self as usize
+    }
+
     /// Command-line and preset name.
     pub fn name(self) -> &'static str {
         match self {

@@ -80,6 +80,7 @@
 
 use super::delay::split_loop;
 use super::filters::{Allpass1, OnePoleLoss};
+use super::vocabulary::InstrumentKind;
 use grid::ThermalGrid;
 use hair::{solve_nodes, sum_lanes, NodeConsts, Nodes};
 use waves::Waves;
@@ -335,29 +336,27 @@ pub struct ThermalStringSpec {
 }
 
 impl ThermalStringSpec {
-    /// The cello's four strings C, G, D, A (Z0 from docs/literature-values.md §1.4 and §1.7), 0.69 m.
+    /// The cello's four strings C, G, D, A as the instrument's data gives them
+    /// ([`InstrumentKind::Cello`]'s spec), with [`Self::cello_c`]'s terminations.
     pub fn cello_strings() -> [Self; 4] {
-        [
-            (65.41, 1.88),
-            (98.0, 0.833),
-            (146.83, 0.506),
-            (220.0, 0.504),
-        ]
-        .map(|(f0_hz, z0_kg_per_s)| Self {
-            f0_hz,
-            z0_kg_per_s,
+        InstrumentKind::Cello.strings().map(|s| Self {
+            f0_hz: s.open_hz,
+            z0_kg_per_s: s.z0_kg_per_s,
             ..Self::cello_c()
         })
     }
 
-    /// Cello open C (docs/literature-values.md §1.7: Z0 ~ 1.85-1.91 kg/s, L 0.67-0.69 m).
+    /// Cello open C, from the cello's data ([`InstrumentKind::Cello`]: Z0 1.91 kg/s, within
+    /// docs/literature-values.md §1.7's 1.85-1.91 kg/s; 0.69 m).
     pub fn cello_c() -> Self {
+        let spec = InstrumentKind::Cello.spec();
+        let c = InstrumentKind::Cello.strings()[0];
         Self {
-            f0_hz: 65.41,
-            z0_kg_per_s: 1.88,
-            length_m: 0.69,
-            q1: 500.0,
-            q_hi: 250.0,
+            f0_hz: c.open_hz,
+            z0_kg_per_s: c.z0_kg_per_s,
+            length_m: spec.string_length_m,
+            q1: c.q1,
+            q_hi: c.q_hi,
             // Small resistive terminations with polarisation coupling (eigenvalues > 0),
             // losing less per round trip than Q1 allows (C string, horizontal: 0.5 % of
             // the amplitude against exp(-pi / 500) = 0.6 %), so the loop's loss filter
