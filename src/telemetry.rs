@@ -1,5 +1,5 @@
 //! One telemetry ring for every live view: the audio thread writes plain records, the
-//! editor reads the newest ones; neither waits, locks or allocates (issue 17 item 5).
+//! editor reads the newest ones; neither waits, locks or allocates (the audio thread never may).
 //!
 //! [`Ring`] is a single-writer ring of seqlocked slots of atomics. A [`Record`] is a
 //! plain `Copy` value stored as a fixed number of 32-bit words. To publish record `n` the

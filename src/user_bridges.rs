@@ -1,4 +1,4 @@
-//! The bridges the player chose, kept in the plugin state (issue 19): paper B's thermal
+//! The bridges the player chose, kept in the plugin state: paper B's thermal
 //! instruments play on them, the point-bow instrument takes their passive reduction as
 //! its body: the bridge file's text is saved with the project, so a project
 //! reopens with its bridge even when the file has moved or gone.

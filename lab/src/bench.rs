@@ -543,7 +543,7 @@ fn child_cpu_s(cmd: &mut std::process::Command, what: &str) -> Result<f64, Strin
     Ok(children_cpu_s() - before)
 }
 
-/// `colophony bench peers`: issue 20's comparison. Whole processes each render `seconds`
+/// `colophony bench peers`: Colophony against its peers (STK's `Bowed`, Faust). Whole processes each render `seconds`
 /// of cello D3 at 48 kHz to a file: this binary's `render` with the hyperbolic (default)
 /// and the elasto-plastic string (paper A), and STK's `stk::Bowed` at 146.8 Hz
 /// (`assets/peers/stk_bowed.cpp`, one render per process, raw f32 out, built with g++ -O2
@@ -566,7 +566,7 @@ pub fn peers(seconds: f64, dir: &std::path::Path) -> Result<String, String> {
     let secs = format!("{seconds}");
     let d3_hz = format!("{}", colophony::dsp::vocabulary::midi_to_hz(50.0));
     // `quality`: a solver preset (its Newton tolerance); without one, `render` solves the
-    // bristle laws to the reference's tolerance, as issue 20's table was first measured.
+    // bristle laws to the reference's tolerance as well, the precision bench's setting.
     let ours = |friction: &str, quality: Option<&str>| {
         let mut c = std::process::Command::new(&me);
         c.args([
@@ -621,7 +621,7 @@ pub fn peers(seconds: f64, dir: &std::path::Path) -> Result<String, String> {
             cpu / best[0]
         ));
     }
-    // Issue 20's table, from this run: the two strings against STK above, silence
+    // The comparison table, from this run: the two strings against STK above, silence
     // through the performer, and paper B's whole cello at N_B = 60 (`bench scenes` and
     // `bench table1` measure the same).
     let (silent_s, bowed_s) = performer_silence_cost(4.0);

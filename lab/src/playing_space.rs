@@ -54,7 +54,7 @@ use rayon::prelude::*;
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// Seconds a note has to settle before it is measured (issue 16: Helmholtz motion within
+/// Seconds a note has to settle before it is measured (Helmholtz motion within
 /// 0.3 s of the bow landing).
 pub const SETTLE_S: f64 = 0.3;
 /// Bow positions of the grid.
@@ -63,9 +63,10 @@ pub const GRID_BETAS: [f64; 4] = [0.05, 0.08, 0.12, 0.18];
 pub const SLIP_FRACTION_TOLERANCE: f64 = 0.15;
 /// Helmholtz: the string sticks at the bow velocity within this fraction of it.
 pub const STICK_TOLERANCE: f64 = 0.1;
-/// In tune at nominal bowing, cents (issue 16, item 1).
+/// In tune at nominal bowing, cents (about the smallest mistuning a listener hears in a
+/// held tone).
 pub const NOMINAL_CENTS: f64 = 3.0;
-/// In tune anywhere inside the window, cents (issue 16, item 6).
+/// In tune anywhere inside the window, cents (looser: pitch flattens toward `F_max`).
 pub const WINDOW_CENTS: f64 = 10.0;
 /// Highest bow force of the plugin's range, N.
 const MAX_FORCE_N: f64 = 10.0;
@@ -111,7 +112,7 @@ impl Bowing {
         }
     }
 
-    /// Nominal bowing (issue 16, item 1): the defaults and the window's middle.
+    /// Nominal bowing: the defaults and the window's middle.
     pub fn is_nominal(self) -> bool {
         matches!(self, Bowing::Defaults | Bowing::Middle)
     }
@@ -163,7 +164,7 @@ pub struct Cell {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Attack {
     /// The bow lands at its speed and the cell's force (over the engine's 20 ms ramp): the
-    /// motion must find Helmholtz motion from there (issue 16, item 2).
+    /// motion must find Helmholtz motion from there.
     #[default]
     Landing,
     /// The bow lands at `F_max / 2` where the cell's force is below it, is held there
@@ -500,7 +501,7 @@ pub struct Plan {
 }
 
 impl Plan {
-    /// The full map: every semitone, the whole grid, the six host rates of issue 16.
+    /// The full map: every semitone, the whole grid, the six usual host rates.
     pub fn full() -> Self {
         Self {
             models: Model::ALL.to_vec(),

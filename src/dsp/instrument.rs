@@ -317,9 +317,10 @@ impl Instrument {
                     .expect("finite positive rates are always resampled"),
             )
         });
-        // Lowest fundamental any instrument can reach: cello C bent down at the lowest
-        // reference pitch.
-        let lowest_hz = midi_to_hz(36.0 + LOWEST_TUNING_SEMITONES) * 0.99;
+        // Lowest fundamental any instrument can reach: its lowest open string bent down at
+        // the lowest reference pitch.
+        let lowest_hz =
+            midi_to_hz(InstrumentKind::LOWEST_OPEN_NOTE as f64 + LOWEST_TUNING_SEMITONES) * 0.99;
         let specs = kind.strings();
         let oversample = if oversampling {
             kind.point_oversampling()
@@ -567,7 +568,7 @@ mod tests {
         assert_eq!(cello.string_for_note_on(35, Some(0)), None);
     }
 
-    /// Issue 16, item 1: the reference pitch tunes every note, the lowest open string bent
+    /// The reference pitch tunes every note, the lowest open string bent
     /// down at 415 Hz and the highest stopped note bent up at 466 Hz included. With the
     /// intonation table the free string sits the table's correction (at the bent note's
     /// place on its string) below; without it, its first partial is tuned exactly (as at

@@ -14,7 +14,7 @@ pub const MAX_CORRECTION_CENTS: f64 = 50.0;
 /// attack falls into changes with any detail of the discretisation) and its pitch then do
 /// not depend on the project's rate, and the intonation table, measured at this rate,
 /// holds at every rate. 48 kHz: the commonest host rate (no resampling there), and twice
-/// the hearing range. Measured in docs/precision.md (issue 16, item 3). The violin's and
+/// the hearing range. Measured in docs/precision.md. The violin's and
 /// viola's strings run at a multiple of it ([`InstrumentKind::point_oversampling`]).
 pub const INTERNAL_RATE_HZ: f64 = 48_000.0;
 
@@ -154,6 +154,20 @@ impl InstrumentKind {
     /// How many instruments there are.
     pub const COUNT: usize = 3;
     pub const ALL: [InstrumentKind; Self::COUNT] = [Self::Violin, Self::Viola, Self::Cello];
+
+    /// The lowest open string of any instrument, MIDI note: what every string bank is
+    /// sized for, so that an instrument switch never reallocates.
+    pub const LOWEST_OPEN_NOTE: u8 = {
+        let mut lowest = u8::MAX;
+        let mut i = 0;
+        while i < Self::COUNT {
+            if SPECS[i].open_notes[0] < lowest {
+                lowest = SPECS[i].open_notes[0];
+            }
+            i += 1;
+        }
+        lowest
+    };
 
     /// Its place in [`Self::ALL`] and [`SPECS`].
     pub const fn index(self) -> usize {

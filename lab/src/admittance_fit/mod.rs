@@ -1,4 +1,4 @@
-//! Fitting a passive modal bridge admittance to measured data (issue 5), after Maestre,
+//! Fitting a passive modal bridge admittance to measured data, after Maestre,
 //! Scavone & Smith, "Digital modeling of bridge driving-point admittances from
 //! measurements on violin-family instruments" (SMAC 2013), as used by paper B (Maestre,
 //! Spa & Smith, finite-width thermal friction; docs/models.md §B, docs/literature-values.md §2).

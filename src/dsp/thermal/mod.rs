@@ -171,8 +171,7 @@ impl Default for ThermalParams {
 }
 
 impl ThermalParams {
-    /// Paper B's eq. (1) as written, with the constants Colophony used by default until
-    /// 2026-11-25: no bulk cooling, heating by the load; the equilibrium temperature of
+    /// Paper B's eq. (1) as written: no bulk cooling, heating by the load; the equilibrium temperature of
     /// steady sliding, `T_eq = C_H f / C_C`, is `250 * 0.4 * 300 / 2000 = 15 K` at paper B's
     /// 300 N/m (inside the 10-25 K swing reported for rosin) at every sliding speed; a
     /// slip of ~1 ms at ~0.5 m/s relaxes toward it (`C_C |v| ~ 1000 /s`); `mu` 0.8 to 0.3
