@@ -35,6 +35,9 @@ pub enum InstrumentChoice {
     Viola,
     #[id = "cello"]
     Cello,
+    #[id = "double-bass"]
+    #[name = "Double bass"]
+    DoubleBass,
 }
 
 /// The parameter's choices are the instruments in [`InstrumentKind::ALL`]'s order, with

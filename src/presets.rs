@@ -90,6 +90,10 @@ const FACTORY: &[(&str, &str)] = &[
         include_str!("../assets/presets/viola-stribeck.json"),
     ),
     (
+        "double-bass-arco",
+        include_str!("../assets/presets/double-bass-arco.json"),
+    ),
+    (
         "thermal-cello",
         include_str!("../assets/presets/thermal-cello.json"),
     ),
@@ -526,8 +530,8 @@ mod tests {
                 "unknown parameter 'bow_pressure'",
             ),
             (
-                r#"{"name": "x", "params": {"instrument": "double-bass"}}"#,
-                "no choice 'double-bass'",
+                r#"{"name": "x", "params": {"instrument": "lute"}}"#,
+                "no choice 'lute'",
             ),
             (
                 r#"{"name": "x", "params": {"bow_force": "loud"}}"#,

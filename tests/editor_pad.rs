@@ -716,7 +716,7 @@ fn the_midi_map_page_learns_a_controller_and_edits_the_shared_map() {
 fn the_bridge_picker_lists_a_folders_bridges_and_chooses_one() {
     use colophony::editor::bridge::{bridge_entries, BROWSE_LABEL};
     let folder = workspace_file("assets/bridges");
-    // The shipped folder: its three bridges, no CSV, sorted.
+    // The shipped folder: its four bridges, no CSV, sorted.
     let names: Vec<String> = bridge_entries(std::path::Path::new(&folder))
         .iter()
         .map(|(p, _)| p.file_name().unwrap().to_string_lossy().into_owned())
@@ -725,6 +725,7 @@ fn the_bridge_picker_lists_a_folders_bridges_and_chooses_one() {
         names,
         [
             "cello-generic.json",
+            "double-bass-generic.json",
             "viola-generic.json",
             "violin-generic.json"
         ]

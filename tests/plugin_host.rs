@@ -21,9 +21,9 @@ fn active_plugin(sample_rate: f64, max_block: usize) -> HostedPlugin {
     HostedPlugin::active_test_build(sample_rate, max_block)
 }
 
-/// The `instrument` parameter's display name for `kind` ("Violin", ...).
+/// The `instrument` parameter's display name for `kind` ("Violin", ..., "Double bass").
 fn instrument_text(kind: InstrumentKind) -> String {
-    let name = kind.name();
+    let name = kind.name().replace('-', " ");
     name[..1].to_uppercase() + &name[1..]
 }
 

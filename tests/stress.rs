@@ -969,7 +969,7 @@ fn resonator_text(r: Option<RubbedPreset>) -> &'static str {
 }
 
 fn instrument_text(kind: InstrumentKind) -> String {
-    let name = kind.name();
+    let name = kind.name().replace('-', " ");
     name[..1].to_uppercase() + &name[1..]
 }
 

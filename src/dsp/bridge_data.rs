@@ -275,6 +275,7 @@ const SHIPPED_BRIDGES: [&str; InstrumentKind::COUNT] = [
     include_str!("../../assets/bridges/violin-generic.json"),
     include_str!("../../assets/bridges/viola-generic.json"),
     include_str!("../../assets/bridges/cello-generic.json"),
+    include_str!("../../assets/bridges/double-bass-generic.json"),
 ];
 
 /// `kind`'s shipped bridge (`assets/bridges/<name>-generic.json`), validated.

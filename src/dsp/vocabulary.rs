@@ -82,6 +82,8 @@ pub enum InstrumentKind {
     Violin,
     Viola,
     Cello,
+    /// The orchestral double bass, tuned in fourths E1 A1 D2 G2.
+    DoubleBass,
 }
 
 /// All of an instrument's data, read everywhere the instrument is played ([`SPECS`], one
@@ -113,7 +115,8 @@ pub struct InstrumentSpec {
 
 /// Every instrument's data (docs/literature-values.md §1.4: the Desvages/NESS string sets;
 /// the viola's G, D, A inharmonicities are not in the table and are chosen between the
-/// neighbouring violin and viola values; lengths violin 0.32, viola 0.38, cello 0.69 m).
+/// neighbouring violin and viola values; lengths violin 0.32, viola 0.38, cello 0.69 m;
+/// the double bass below).
 pub const SPECS: [InstrumentSpec; InstrumentKind::COUNT] = [
     InstrumentSpec {
         name: "violin",
@@ -148,12 +151,30 @@ pub const SPECS: [InstrumentSpec; InstrumentKind::COUNT] = [
         body_scale: 0.42,
         point_oversampling: [1, 1, 1, 2],
     },
+    // Tension and linear density from Russo, Ducceschi and Zambon's double bass strings
+    // (DAFx 2022, 1.06 m; docs/literature-values.md §1.4): Z0 = sqrt(T mu). Their strings
+    // are solid steel of the wound string's mass, whose bending stiffness overstates a
+    // wound string's (its core bends, the winding adds mass): B is theirs times 1/16, a
+    // core of half the outer radius (chosen, not measured). The body's modes sit at 0.23
+    // of the violin's (A0 near 63 Hz).
+    InstrumentSpec {
+        name: "double-bass",
+        open_notes: [28, 33, 38, 43],
+        z0_kg_per_s: [3.56, 2.58, 1.87, 1.38],
+        inharmonicity: [7.6e-4, 2.3e-4, 7.1e-5, 2.2e-5],
+        q1: 500.0,
+        q_hi: 250.0,
+        string_length_m: 1.06,
+        body_scale: 0.23,
+        point_oversampling: [1; STRINGS],
+    },
 ];
 
 impl InstrumentKind {
     /// How many instruments there are.
-    pub const COUNT: usize = 3;
-    pub const ALL: [InstrumentKind; Self::COUNT] = [Self::Violin, Self::Viola, Self::Cello];
+    pub const COUNT: usize = 4;
+    pub const ALL: [InstrumentKind; Self::COUNT] =
+        [Self::Violin, Self::Viola, Self::Cello, Self::DoubleBass];
 
     /// The lowest open string of any instrument, MIDI note: what every string bank is
     /// sized for, so that an instrument switch never reallocates.
