@@ -27,7 +27,7 @@ enum Command {
         /// Output WAV file.
         #[arg(long)]
         out: PathBuf,
-        /// violin, viola or cello.
+        /// violin, viola, cello or double-bass.
         #[arg(long, default_value = "cello", value_parser = parse_instrument)]
         instrument: InstrumentKind,
         /// MIDI number or note name (C4 = 60); default D3 (50), or the preset's note.
@@ -141,7 +141,7 @@ enum Command {
         /// playing-space, intonation: friction models, comma-separated (default all five).
         #[arg(long, value_delimiter = ',')]
         models: Vec<String>,
-        /// playing-space, intonation: instruments, comma-separated (default all three;
+        /// playing-space, intonation: instruments, comma-separated (default all four;
         /// the intonation fit then rewrites only their rows).
         #[arg(long, value_delimiter = ',')]
         instruments: Vec<String>,
@@ -208,8 +208,9 @@ fn parse_quality(s: &str) -> Result<Quality, String> {
 }
 
 fn parse_instrument(s: &str) -> Result<InstrumentKind, String> {
-    InstrumentKind::from_name(s)
-        .ok_or_else(|| format!("unknown instrument '{s}': choose violin, viola or cello"))
+    InstrumentKind::from_name(s).ok_or_else(|| {
+        format!("unknown instrument '{s}': choose violin, viola, cello or double-bass")
+    })
 }
 
 fn main() -> ExitCode {

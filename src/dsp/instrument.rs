@@ -1,4 +1,4 @@
-//! The instrument: four bowed waveguide strings of a violin, viola or cello, a shared bow,
+//! The instrument: four bowed waveguide strings of a violin, viola, cello or double bass, a shared bow,
 //! note handling and a generic body.
 //!
 //! **Which string plays a note.** A note goes to the highest string whose open pitch is at
@@ -84,7 +84,7 @@ pub struct WaveguideBank {
     body_asleep: bool,
 }
 
-/// The four waveguide strings of a violin, viola or cello with a shared bow, note
+/// The four waveguide strings of a violin, viola, cello or double bass with a shared bow, note
 /// handling and a generic body (see the module doc): [`FourStrings`] over
 /// [`WaveguideBank`].
 pub type Instrument = FourStrings<WaveguideBank>;

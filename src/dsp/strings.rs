@@ -142,7 +142,7 @@ pub trait StringBank {
     fn configure(&mut self, settings: Self::Settings) -> Result<(), String>;
 }
 
-/// A violin, viola or cello: four strings of one model on one bridge, played by notes
+/// A violin, viola, cello or double bass: four strings of one model on one bridge, played by notes
 /// and one bow (see the module doc).
 #[derive(Debug, Clone)]
 pub struct FourStrings<B: StringBank> {
