@@ -164,7 +164,7 @@ fn performer_tick(c: &mut Criterion) {
 fn thermal_tick(c: &mut Criterion) {
     let bow = ThermalBowControl {
         velocity_m_per_s: 0.15,
-        force_per_m: 300.0,
+        force_n_per_m: 300.0,
         position_beta: 0.1,
     };
     let mut group = c.benchmark_group("thermal string tick (internal rate)");

@@ -243,7 +243,7 @@ pub fn maestre_fig6(out: &Path) -> Result<String, String> {
     )?;
     let bow = ThermalBowControl {
         velocity_m_per_s: 0.15,
-        force_per_m: 300.0,
+        force_n_per_m: 300.0,
         position_beta: 0.07,
     };
     let fs = s.internal_rate_hz();
@@ -500,7 +500,7 @@ fn fig6_movie(
     )?;
     let bow = ThermalBowControl {
         velocity_m_per_s: 0.15,
-        force_per_m: 300.0,
+        force_n_per_m: 300.0,
         position_beta: 0.07,
     };
     let fs = s.internal_rate_hz();

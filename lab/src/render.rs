@@ -283,7 +283,7 @@ pub fn render_thermal(
         let lifted = release.is_some_and(|r| done >= r);
         let control = ThermalBowControl {
             velocity_m_per_s: bow.velocity_m_per_s,
-            force_per_m: if lifted { 0.0 } else { bow.force_n / width_m },
+            force_n_per_m: if lifted { 0.0 } else { bow.force_n / width_m },
             position_beta: bow.position_beta,
         };
         internal.clear();

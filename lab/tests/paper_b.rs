@@ -10,7 +10,7 @@ use colophony::dsp::thermal::{
 /// Paper B's Figure 6 bow on the cello's open C: v_b 0.15 m/s, beta 0.07, 300 N/m.
 const FIG6_BOW: ThermalBowControl = ThermalBowControl {
     velocity_m_per_s: 0.15,
-    force_per_m: 300.0,
+    force_n_per_m: 300.0,
     position_beta: 0.07,
 };
 
@@ -48,7 +48,7 @@ fn the_free_string_is_in_tune_at_the_internal_rate() {
         let mut s = cello_c(nodes);
         let fs = s.internal_rate_hz();
         let lifted = ThermalBowControl {
-            force_per_m: 0.0,
+            force_n_per_m: 0.0,
             ..FIG6_BOW
         };
         let out: Vec<f64> = (0..(1.2 * fs) as usize)
@@ -140,7 +140,7 @@ fn temperature_rises_while_slipping_and_diffuses_while_sticking() {
             .map(|(f, v)| {
                 th.sliding_equilibrium_kelvin(
                     f64::from(*f) / dx,
-                    FIG6_BOW.force_per_m,
+                    FIG6_BOW.force_n_per_m,
                     f64::from(*v),
                 )
             })
@@ -195,7 +195,7 @@ fn energy_never_grows_with_the_bow_lifted() {
         s.tick(FIG6_BOW);
     }
     let lifted = ThermalBowControl {
-        force_per_m: 0.0,
+        force_n_per_m: 0.0,
         ..FIG6_BOW
     };
     // The wave energy in the delay lines, averaged over whole periods: the filters at the
@@ -355,7 +355,7 @@ fn bowing_one_string_makes_the_open_strings_ring_through_the_bridge() {
         // Paper B's Figure 6 bow at beta 0.1 (Helmholtz motion): 300 N/m over 1 cm.
         let bow = BowControl {
             velocity_m_per_s: FIG6_BOW.velocity_m_per_s,
-            force_n: FIG6_BOW.force_per_m * 0.01,
+            force_n: FIG6_BOW.force_n_per_m * 0.01,
             position_beta: 0.1,
         };
         assert_eq!(cello.note_on(36), Some(0));
@@ -477,7 +477,7 @@ fn render_thermal_scene(
     cello.set_skipping(skipping);
     let bow = BowControl {
         velocity_m_per_s: FIG6_BOW.velocity_m_per_s,
-        force_n: FIG6_BOW.force_per_m * 0.01,
+        force_n: FIG6_BOW.force_n_per_m * 0.01,
         position_beta: 0.1,
     };
     let (mut out, mut asleep) = (Vec::with_capacity(frames), Vec::new());
@@ -594,7 +594,7 @@ fn the_lone_strings_fundamental_decays_at_its_q1_terminations_included() {
         ..FIG6_BOW
     };
     let lifted = ThermalBowControl {
-        force_per_m: 0.0,
+        force_n_per_m: 0.0,
         ..bow
     };
     for _ in 0..(0.3 * fs) as usize {
@@ -685,7 +685,7 @@ fn the_thermal_grid_never_cools_below_ambient_or_blows_up_at_the_fastest_slips()
         let fs = s.internal_rate_hz();
         let bow = ThermalBowControl {
             velocity_m_per_s: 1.5,
-            force_per_m: 1000.0,
+            force_n_per_m: 1000.0,
             position_beta: 0.02,
         };
         let mut lowest = f64::MAX;

@@ -154,7 +154,7 @@ impl Core {
             }
             let velocity = string.tick_contact(ThermalBowControl {
                 velocity_m_per_s: bow.velocity_m_per_s,
-                force_per_m: force,
+                force_n_per_m: force,
                 position_beta: bow.position_beta,
             });
             if i == probed {

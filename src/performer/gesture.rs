@@ -53,17 +53,17 @@ pub(super) struct Gesture {
     /// The bow scale the asked expression (0..=1) gives: `10^(-range (1 - e) / 20)`.
     pub(super) target: f64,
     /// The bow's present scale (smoothed toward `target`).
-    pub(super) scale: f64,
+    pub(super) bow_scale: f64,
     /// The window guard's drift of the bow position at this scale:
     /// `scale^-`[`DYNAMICS_DRIFT_EXPONENT`] (1 at full scale).
-    pub(super) away: f64,
+    pub(super) beta_scale: f64,
     pub(super) smoothing: f64,
     /// Vibrato depth, cents.
     pub(super) vibrato_cents: f64,
     /// The MIDI pitch bend, semitones (the vibrato is added to it).
-    pub(super) bend: f64,
+    pub(super) bend_semitones: f64,
     /// The pitch-bend wheel, -1..=1.
-    pub(super) wheel: f64,
+    pub(super) wheel_position: f64,
     /// The bend range MIDI RPN 0 set, semitones (overrides the setup's).
     pub(super) rpn_bend_range: Option<f64>,
     /// The registered parameter number CC101/CC100 selected ([`RPN_NULL`]: none).
@@ -91,12 +91,12 @@ impl Gesture {
     pub(super) fn new(sample_rate_hz: f64) -> Self {
         Self {
             target: 1.0,
-            scale: 1.0,
-            away: 1.0,
+            bow_scale: 1.0,
+            beta_scale: 1.0,
             smoothing: 1.0 - (-1.0 / (DYNAMICS_SMOOTHING_S * sample_rate_hz)).exp(),
             vibrato_cents: 0.0,
-            bend: 0.0,
-            wheel: 0.0,
+            bend_semitones: 0.0,
+            wheel_position: 0.0,
             rpn_bend_range: None,
             rpn: (RPN_NULL, RPN_NULL),
             portamento_pedal: false,
@@ -183,31 +183,31 @@ impl Performer {
             self.stroke.tick()
         };
         let g = &mut self.gesture;
-        if g.scale != g.target {
-            g.scale += g.smoothing * (g.target - g.scale);
-            if (g.scale - g.target).abs() < 1e-9 {
-                g.scale = g.target;
+        if g.bow_scale != g.target {
+            g.bow_scale += g.smoothing * (g.target - g.bow_scale);
+            if (g.bow_scale - g.target).abs() < 1e-9 {
+                g.bow_scale = g.target;
             }
             // The guard's drift follows the scale: one power per change of the scale,
             // none per sample while it rests (a vibrato ticks this path every sample).
-            g.away = if g.scale == 1.0 {
+            g.beta_scale = if g.bow_scale == 1.0 {
                 1.0
             } else {
-                g.scale.powf(-DYNAMICS_DRIFT_EXPONENT)
+                g.bow_scale.powf(-DYNAMICS_DRIFT_EXPONENT)
             };
         }
         // With the guard the force follows the velocity and the bow drifts from the
         // bridge as the dynamics fall; without it only the velocity follows.
         let (force_scale, away) = if self.setup.dynamics_guard {
-            (g.scale, g.away)
+            (g.bow_scale, g.beta_scale)
         } else {
             (1.0, 1.0)
         };
-        let out = if g.scale == 1.0 && speed == 1.0 && landing == 1.0 && away == 1.0 {
+        let out = if g.bow_scale == 1.0 && speed == 1.0 && landing == 1.0 && away == 1.0 {
             bow
         } else {
             BowControl {
-                velocity_m_per_s: bow.velocity_m_per_s * g.scale * speed,
+                velocity_m_per_s: bow.velocity_m_per_s * g.bow_scale * speed,
                 force_n: bow.force_n * force_scale * landing,
                 position_beta: (bow.position_beta * away).clamp(MIN_NOTE_BETA, MAX_NOTE_BETA),
             }
@@ -217,10 +217,10 @@ impl Performer {
         // not round differently).
         let steady = g.vibrato_cents == 0.0
             && g.vibrato_now == 0.0
-            && g.scale == g.target
+            && g.bow_scale == g.target
             && self.direct.is_idle()
             && self.stroke.is_settled();
-        self.steady = steady.then_some((g.scale * speed, force_scale, away));
+        self.steady = steady.then_some((g.bow_scale * speed, force_scale, away));
         out
     }
 
@@ -243,7 +243,7 @@ impl Performer {
                 0.0
             };
             self.gesture.vibrato_now = now;
-            let bend = self.gesture.bend + now;
+            let bend = self.gesture.bend_semitones + now;
             // Only what sounds moves its finger; a silent engine takes the vibrato at the
             // first update after its note lands (the vibrato starts later still).
             for engine in self.engines().filter(|e| e.is_sounding()) {

@@ -47,8 +47,8 @@ impl Performer {
     /// The pitch-bend wheel at `value` (0..=1, 0.5 = centre, as nice-plug delivers it):
     /// bends by the bend range at its ends.
     pub fn set_pitch_wheel(&mut self, value: f32) {
-        self.gesture.wheel = wheel_position(value);
-        self.set_bend(self.gesture.wheel * self.bend_range());
+        self.gesture.wheel_position = wheel_position(value);
+        self.set_bend(self.gesture.wheel_position * self.bend_range());
     }
 
     /// The pitch-bend range, semitones: MIDI RPN 0's if one came, else the setup's
@@ -64,7 +64,7 @@ impl Performer {
 
     /// Pitch bend in semitones, for every engine with pitch (the vibrato adds to it).
     pub(super) fn set_bend(&mut self, semitones: f64) {
-        self.gesture.bend = semitones;
+        self.gesture.bend_semitones = semitones;
         self.bend_engines(semitones + self.gesture.vibrato_now);
     }
 
@@ -105,7 +105,7 @@ impl Performer {
                     semitones + byte.min(99) as f64 / 100.0
                 };
                 self.gesture.rpn_bend_range = Some(range.min(MAX_BEND_RANGE_SEMITONES));
-                self.set_bend(self.gesture.wheel * self.bend_range());
+                self.set_bend(self.gesture.wheel_position * self.bend_range());
                 return;
             }
             _ => {}

@@ -47,7 +47,7 @@ pub fn timbre_to_position_scale(timbre: f64) -> f64 {
 #[derive(Debug, Clone, Copy)]
 struct Channel {
     /// Pitch-bend wheel, -1..=1.
-    wheel: f64,
+    wheel_position: f64,
     /// Channel pressure 0..=1, `None` until one arrives (neutral force).
     pressure: Option<f64>,
     /// CC74 0..=1, `None` until one arrives (neutral position).
@@ -59,7 +59,7 @@ struct Channel {
 impl Default for Channel {
     fn default() -> Self {
         Self {
-            wheel: 0.0,
+            wheel_position: 0.0,
             pressure: None,
             timbre: None,
             rpn: RPN_NONE,
@@ -192,7 +192,7 @@ impl Mpe {
         if !self.is_member(channel) {
             return false;
         }
-        self.channels[channel as usize].wheel = wheel.clamp(-1.0, 1.0);
+        self.channels[channel as usize].wheel_position = wheel.clamp(-1.0, 1.0);
         true
     }
 
@@ -213,7 +213,7 @@ impl Mpe {
         };
         let c = &self.channels[channel as usize];
         NoteExpression {
-            bend_semitones: c.wheel * self.member_range[zone],
+            bend_semitones: c.wheel_position * self.member_range[zone],
             force_scale: c.pressure.map_or(1.0, pressure_to_force_scale),
             position_scale: c.timbre.map_or(1.0, timbre_to_position_scale),
         }

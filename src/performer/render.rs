@@ -22,7 +22,7 @@ impl Performer {
         let g = &self.gesture;
         let at_rest = g.vibrato_cents == 0.0
             && g.vibrato_now == 0.0
-            && g.scale == g.target
+            && g.bow_scale == g.target
             && self.stroke.is_settled()
             && self.direct.is_settled();
         let steps = if at_rest { n.min(1) } else { n };

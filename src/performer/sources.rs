@@ -93,7 +93,7 @@ impl Performer {
         let range_was = self.bend_range();
         self.setup = *setup;
         if self.bend_range() != range_was {
-            self.set_bend(self.gesture.wheel * self.bend_range());
+            self.set_bend(self.gesture.wheel_position * self.bend_range());
         }
         let wanted = Source::of(setup);
         // The waveguide strings change instrument at once (silenced) only while they are

@@ -13,7 +13,7 @@
 //! use colophony::dsp::thermal::{ThermalString, ThermalStringSpec};
 //! let mut s = ThermalString::new(ThermalStringSpec::cello_c(), 10, 0.01,
 //!     ThermalParams::default(), HairParams::default()).unwrap();
-//! let bow = ThermalBowControl { velocity_m_per_s: 0.15, force_per_m: 300.0, position_beta: 0.07 };
+//! let bow = ThermalBowControl { velocity_m_per_s: 0.15, force_n_per_m: 300.0, position_beta: 0.07 };
 //! for _ in 0..2000 { s.tick(bow); }
 //! // The slips heated the contact; the grid never goes below ambient.
 //! assert!(s.temperature_grid().iter().any(|t| *t > 0.0));

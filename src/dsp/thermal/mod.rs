@@ -70,7 +70,7 @@
 //!     HairParams::default(),
 //! )
 //! .unwrap();
-//! let bow = ThermalBowControl { velocity_m_per_s: 0.15, force_per_m: 300.0, position_beta: 0.07 };
+//! let bow = ThermalBowControl { velocity_m_per_s: 0.15, force_n_per_m: 300.0, position_beta: 0.07 };
 //! let fs = string.internal_rate_hz();
 //! let peak = (0..(0.1 * fs) as usize)
 //!     .map(|_| string.tick(bow).bridge_force_n.abs())
@@ -371,7 +371,7 @@ impl ThermalStringSpec {
 pub struct ThermalBowControl {
     pub velocity_m_per_s: f64,
     /// Bow force per unit length, N/m (paper B's 300 N/m over 1 cm is 3 N).
-    pub force_per_m: f64,
+    pub force_n_per_m: f64,
     /// Bow centre from the bridge over the string length.
     pub position_beta: f64,
 }
@@ -1050,13 +1050,13 @@ impl ThermalString {
         let centre = (bow.position_beta.clamp(0.01, 0.5) * m as f64 + 0.5) as usize;
         self.bow_start = centre.saturating_sub(n_b / 2).clamp(1, m - n_b - 1);
         let dx = self.dx_m;
-        let f_b = bow.force_per_m.max(0.0) * dx * self.narrowing;
+        let f_b = bow.force_n_per_m.max(0.0) * dx * self.narrowing;
         let on = f_b > 0.0;
         if on {
             // A landing bow wakes the string (its sleeping lines hold zeros).
             self.waves.wake();
             self.grid
-                .set_load(&self.thermal, bow.force_per_m * self.narrowing);
+                .set_load(&self.thermal, bow.force_n_per_m * self.narrowing);
         }
         let mut string_velocity = 0.0;
         let mid = n_b / 2;
@@ -1202,7 +1202,7 @@ mod tests {
             for n in 0..((0.1 + lifted_s) * fs) as usize {
                 let bow = ThermalBowControl {
                     velocity_m_per_s: 0.15,
-                    force_per_m: if n < (0.1 * fs) as usize { 300.0 } else { 0.0 },
+                    force_n_per_m: if n < (0.1 * fs) as usize { 300.0 } else { 0.0 },
                     position_beta: 0.07,
                 };
                 let (a, b) = (portable.tick(bow), wide.tick(bow));
