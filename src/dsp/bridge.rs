@@ -102,7 +102,7 @@ const LANES: usize = 4;
 #[repr(C, align(32))]
 struct F4([f64; LANES]);
 
-/// `(a + b) + (c + d)`: how both paths of [`ModalBridge::advance`] end their lane sums.
+/// `(a + b) + (c + d)`: how both paths of [`ModalBridge::tick`] end their lane sums.
 #[inline(always)]
 fn sum4(x: [f64; LANES]) -> f64 {
     (x[0] + x[1]) + (x[2] + x[3])
@@ -213,7 +213,7 @@ pub struct ModalBridge {
     /// The sections' coefficients and states, four to a block (section `i` in block
     /// `i / 4`, lane `i % 4`).
     lanes: Vec<Lanes>,
-    /// `v_hist`: the sum of the sections' `z1`, kept by [`ModalBridge::advance`].
+    /// `v_hist`: the sum of the sections' `z1`, kept by [`ModalBridge::tick`].
     hist: [f64; 2],
     /// AVX2 (hence AVX) available ([`super::detect_wide_simd`], once, at construction).
     wide_simd: bool,
@@ -384,11 +384,11 @@ impl ModalBridge {
     /// own sums; with AVX the four lanes are one vector (the same bits as the scalar path:
     /// the same operations in the same order, no FMA).
     #[inline(always)]
-    fn advance(&mut self, force: [f64; 2]) -> [f64; 2] {
+    fn tick(&mut self, force: [f64; 2]) -> [f64; 2] {
         #[cfg(target_arch = "x86_64")]
         if self.wide_simd {
             // SAFETY: `wide_simd` is true only where AVX2 (a superset of AVX) was detected.
-            return unsafe { self.advance_avx(force) };
+            return unsafe { self.tick_avx(force) };
         }
         let mut v = [[0.0; LANES]; 2];
         let mut hist = [[0.0; LANES]; 2];
@@ -409,10 +409,10 @@ impl ModalBridge {
         [sum4(v[0]), sum4(v[1])]
     }
 
-    /// [`ModalBridge::advance`] on AVX vectors, lane for lane the scalar path's arithmetic.
+    /// [`ModalBridge::tick`] on AVX vectors, lane for lane the scalar path's arithmetic.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
-    fn advance_avx(&mut self, force: [f64; 2]) -> [f64; 2] {
+    fn tick_avx(&mut self, force: [f64; 2]) -> [f64; 2] {
         use std::arch::x86_64::*;
         let f = [_mm256_set1_pd(force[0]), _mm256_set1_pd(force[1])];
         let sign = _mm256_set1_pd(-0.0);
@@ -488,7 +488,7 @@ pub fn solve_junction(
         (m[0][0] * rhs[1] - m[1][0] * rhs[0]) / det,
     ];
     let force = [drive[0] - z_sum * v[0], drive[1] - z_sum * v[1]];
-    let v_check = bridge.advance(force);
+    let v_check = bridge.tick(force);
     debug_assert!((v_check[0] - v[0]).abs() <= 1e-9 * (1.0 + v[0].abs()));
     for (out, a) in leaving.iter_mut().zip(arriving) {
         *out = [v[0] - a[0], v[1] - a[1]];
@@ -545,7 +545,7 @@ mod tests {
             } else {
                 [0.0; 2]
             };
-            let (a, b) = (scalar.advance(f), vector.advance(f));
+            let (a, b) = (scalar.tick(f), vector.tick(f));
             assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits), "sample {n}");
             assert_eq!(
                 scalar.history().map(f64::to_bits),
@@ -569,7 +569,7 @@ mod tests {
             for n in 0..20_000 {
                 let f = [next(), next()];
                 let before = bridge.energy_j();
-                let v = bridge.advance(f);
+                let v = bridge.tick(f);
                 let supplied = (f[0] * v[0] + f[1] * v[1]) / fs;
                 let gained = bridge.energy_j() - before;
                 // Rounding only: a few hundred products, each within 2^-53 of the energy.
@@ -594,7 +594,7 @@ mod tests {
         for _ in 0..5_000 {
             let f = [next(), next()];
             let before = bridge.energy_j();
-            let v = bridge.advance(f);
+            let v = bridge.tick(f);
             balance += bridge.energy_j() - before - (f[0] * v[0] + f[1] * v[1]) / fs;
         }
         // The 1e-9 Hz bandwidth dissipates about 2 pi 1e-9 / 300 of the energy a period.

@@ -17,7 +17,7 @@
 //! assert!(f.tuned_hz(string) > free);
 //! let mut bow = BowEnvelope::default();
 //! bow.bowed = true;
-//! assert_eq!(bow.advance(0.5), 0.5);
+//! assert_eq!(bow.tick(0.5), 0.5);
 //! ```
 
 use super::intonation::{self, IntonationTable};
@@ -36,7 +36,7 @@ pub struct BowEnvelope {
 impl BowEnvelope {
     /// One step of the ramp toward 1 (bowed) or 0 (lifted) by `step`; returns the gain.
     #[inline(always)]
-    pub fn advance(&mut self, step: f64) -> f64 {
+    pub fn tick(&mut self, step: f64) -> f64 {
         let target = if self.bowed { 1.0 } else { 0.0 };
         if self.gain != target {
             self.gain = if self.bowed {

@@ -18,7 +18,7 @@
 //! // -0.95, takes about 400 samples to fall below 1e-9).
 //! let mut y = 0.0;
 //! for _ in 0..2000 {
-//!     y = d.process(1.0, 1.0);
+//!     y = d.tick(1.0, 1.0);
 //! }
 //! assert!((y - 1.0).abs() < 1e-9);
 //! ```
@@ -97,7 +97,7 @@ impl HalfbandDecimator {
 
     /// The output for the input pair `earlier`, `later` (consecutive high-rate samples).
     #[inline]
-    pub fn process(&mut self, earlier: f64, later: f64) -> f64 {
+    pub fn tick(&mut self, earlier: f64, later: f64) -> f64 {
         let (mut a, mut b) = (later, earlier);
         for pair in self.sections.chunks_exact_mut(2) {
             a = pair[0].tick(a);
@@ -123,7 +123,7 @@ mod tests {
         let folded = if f <= 0.25 { 2.0 * f } else { 1.0 - 2.0 * f };
         let (mut ss, mut sc, mut cc, mut ys, mut yc) = (0.0, 0.0, 0.0, 0.0, 0.0);
         for m in 0..20_000 {
-            let y = d.process(x(2 * m), x(2 * m + 1));
+            let y = d.tick(x(2 * m), x(2 * m + 1));
             if m >= 4_000 {
                 let (s, c) = (2.0 * PI * folded * m as f64).sin_cos();
                 ss += s * s;
@@ -177,7 +177,7 @@ mod tests {
         assert!(expected > 0.5 && expected < 4.0, "{expected}");
         // Measured: a step's output crosses one half near that delay.
         let mut d = HalfbandDecimator::new();
-        let out: Vec<f64> = (0..64).map(|_| d.process(1.0, 1.0)).collect();
+        let out: Vec<f64> = (0..64).map(|_| d.tick(1.0, 1.0)).collect();
         let crossing = out.iter().position(|&y| y >= 0.5).unwrap() as f64;
         assert!(
             (crossing - expected).abs() < 1.5,

@@ -196,7 +196,7 @@ impl StringBank for WaveguideBank {
             }
         }
         if any_fine {
-            bridge += self.decimator.process(fine[0], fine[1]);
+            bridge += self.decimator.tick(fine[0], fine[1]);
         }
         super::filters::flush_tiny(self.body.tick(bridge) * self.output_scale)
     }

@@ -292,7 +292,7 @@ impl Hands {
     /// String `i`'s bow for this internal sample (its envelope moves one step).
     #[inline(always)]
     fn string_bow(&mut self, i: usize, bow: BowControl, divisor: f64) -> StringBow {
-        let gain = self.bows[i].advance(self.ramp_step);
+        let gain = self.bows[i].tick(self.ramp_step);
         // Weighted, a string is never bowed harder than the force parameter's top.
         let base = if self.weighted {
             (bow.force_n * self.weights[i]).min(MAX_WEIGHTED_FORCE_N)
