@@ -151,11 +151,12 @@ enum Command {
         /// peers: seconds each process renders (default 300).
         #[arg(long)]
         seconds: Option<f64>,
-        /// playing-space: how each note begins: `landing` (the default: the bow lands at
-        /// the cell's force) or `catch` (at `F_max / 2` until the string slips regularly,
-        /// then lowered to the cell's force by 0.3 s: whether that force holds Helmholtz
-        /// motion).
-        #[arg(long, default_value = "landing")]
+        /// playing-space: how each note begins: `performer` (the default: the plugin's
+        /// attack for a separate note at velocity 100, the bow from rest with the stroke's
+        /// ramp and accent), `landing` (the bow lands at its speed and the cell's force)
+        /// or `catch` (at `F_max / 2` until the string slips regularly, then lowered to the
+        /// cell's force by 0.3 s: whether that force holds Helmholtz motion).
+        #[arg(long, default_value = "performer")]
         attack: String,
     },
     /// List the presets: the factory set and the user presets (in the folder the editor

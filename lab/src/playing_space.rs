@@ -31,7 +31,10 @@
 //! [`SETTLE_S`]. With `--attack catch` ([`Attack::Catch`]) the bow lands at `F_max / 2`,
 //! stays there until the probe slips regularly, and is lowered to the cell's force before
 //! [`SETTLE_S`]: the map then asks whether the cell's force *holds* Helmholtz motion
-//! (Schelleng's window is a stability limit). The measurement is the same.
+//! (Schelleng's window is a stability limit). With `--attack performer`
+//! ([`Attack::Performer`]) the bow starts as the plugin's performer starts a separate
+//! note: from rest, up to the cell's speed over the stroke's ramp, with its accent. The
+//! measurement is the same.
 
 pub mod figure;
 
@@ -49,6 +52,7 @@ use colophony::dsp::vocabulary::{midi_to_hz, BowControl, InstrumentKind, STRINGS
 use colophony::measure::contact::ContactSample;
 use colophony::measure::regime::{classify_regime, Regime};
 use colophony::measure::window::SchellengWindow;
+use colophony::performer::stroke::{Stroke, StrokeMode};
 use colophony::quality::{Quality, GOOD_NODES};
 use rayon::prelude::*;
 use std::fmt::Write as _;
@@ -174,18 +178,27 @@ pub enum Attack {
     /// Helmholtz motion once established (the stability Schelleng's window describes),
     /// rather than whether a landing there finds it.
     Catch,
+    /// The performer's own attack for a separate down-bow note of velocity
+    /// [`PERFORMER_VELOCITY`] ([`Stroke`]): the bow starts from rest and reaches the
+    /// cell's speed over the stroke's ramp, with its landing accent on the force; what the
+    /// plugin plays when a note lands.
+    Performer,
 }
+
+/// [`Attack::Performer`]: the note velocity (1..=127) the cells are played with.
+pub const PERFORMER_VELOCITY: u8 = 100;
 
 impl Attack {
     pub fn name(self) -> &'static str {
         match self {
             Attack::Landing => "landing",
             Attack::Catch => "catch",
+            Attack::Performer => "performer",
         }
     }
 
     pub fn from_name(name: &str) -> Option<Self> {
-        [Attack::Landing, Attack::Catch]
+        [Attack::Landing, Attack::Catch, Attack::Performer]
             .into_iter()
             .find(|a| a.name().eq_ignore_ascii_case(name))
     }
@@ -360,6 +373,8 @@ fn play(cell: &Cell, engine: &mut impl Engine) -> (Vec<f64>, Vec<ContactSample>)
 /// The bow of a cell sample by sample ([`Attack`]).
 struct Catcher {
     bow: BowControl,
+    /// [`Attack::Performer`]'s stroke, ticked once a sample.
+    stroke: Option<Stroke>,
     /// The catching force, N (0: no catch).
     catch: f64,
     /// The note's period, host samples.
@@ -377,12 +392,18 @@ struct Catcher {
 impl Catcher {
     fn new(cell: &Cell) -> Self {
         let catch = match cell.attack {
-            Attack::Landing => 0.0,
+            Attack::Landing | Attack::Performer => 0.0,
             Attack::Catch => 0.5 * cell.f_max_n,
         };
+        let stroke = (cell.attack == Attack::Performer).then(|| {
+            let mut stroke = Stroke::new(cell.rate_hz);
+            stroke.start(StrokeMode::Down, PERFORMER_VELOCITY as f64 / 127.0);
+            stroke
+        });
         let period = cell.rate_hz / cell.nominal_hz();
         Self {
             bow: cell.bow,
+            stroke,
             catch,
             period,
             rate_hz: cell.rate_hz,
@@ -399,8 +420,16 @@ impl Catcher {
         ((CATCH_PERIODS as f64 + 0.5) * period).ceil() as usize
     }
 
-    /// The bow for sample `i`.
-    fn bow(&self, i: usize) -> BowControl {
+    /// The bow for sample `i` (called once a sample, in order).
+    fn bow(&mut self, i: usize) -> BowControl {
+        if let Some(stroke) = &mut self.stroke {
+            let (speed, force) = stroke.tick();
+            return BowControl {
+                velocity_m_per_s: self.bow.velocity_m_per_s * speed,
+                force_n: self.bow.force_n * force,
+                ..self.bow
+            };
+        }
         let target = self.bow.force_n;
         if self.catch <= target {
             return self.bow;

@@ -69,6 +69,11 @@ pub fn draw(
                 "Colophony playing space: {} (caught at F_max/2, then held at each force)",
                 model.name()
             ),
+            super::Attack::Performer => format!(
+                "Colophony playing space: {} (the performer's attack, velocity {})",
+                model.name(),
+                super::PERFORMER_VELOCITY
+            ),
         },
         "green Helmholtz (bowed pitch in cents from equal temperament); pale green one slip but".into(),
         "slip fraction or sticking off; blue multiple slips; red raucous; grey sliding; dark silent".into(),
