@@ -28,11 +28,7 @@ const FS: f64 = 48_000.0;
 #[test]
 #[ignore]
 fn attacks_through_the_performer_survey() {
-    for kind in [
-        InstrumentKind::Violin,
-        InstrumentKind::Viola,
-        InstrumentKind::Cello,
-    ] {
+    for kind in InstrumentKind::ALL {
         for law in FrictionModel::ALL {
             let (low, high) = kind.note_range();
             let mut helm = 0;

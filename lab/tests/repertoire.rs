@@ -1,5 +1,5 @@
 //! Real repertoire through the performer, as a musician plays it from MIDI at the plugin's
-//! defaults: eleven public-domain parts for the three instruments (slow and fast, string
+//! defaults: public-domain parts for the four instruments (slow and fast, string
 //! crossings, leaps, separate notes after rests), every friction model, at 44.1, 48 and
 //! 96 kHz. For each note, on the output and the contact probe the editor records:
 //!
@@ -45,7 +45,7 @@ struct Part {
 const VELOCITY: u8 = 90;
 
 #[rustfmt::skip]
-const PARTS: [Part; 11] = [
+const PARTS: [Part; 13] = [
     // J. S. Bach, cello suite no. 1, BWV 1007, prelude, bars 1-4: sixteenths at 120,
     // crossings to the open G string.
     Part {
@@ -97,6 +97,29 @@ const PARTS: [Part; 11] = [
             (36, 2.0), (38, 2.0), (40, 2.0), (41, 2.0), (43, 2.0), (45, 2.0), (47, 2.0), (48, 2.0),
             (50, 2.0), (52, 2.0), (53, 2.0), (55, 2.0), (57, 2.0), (59, 2.0), (60, 2.0), (62, 2.0),
             (64, 2.0), (65, 2.0), (67, 2.0), (69, 2.0), (71, 2.0), (72, 2.0),
+        ],
+    },
+    // J. Pachelbel, canon in D, the ground on the double bass, twice (its low D taken an
+    // octave up: the bass's lowest string is E1).
+    Part {
+        name: "Pachelbel canon, ground (double bass)",
+        cantabile: false,
+        kind: InstrumentKind::DoubleBass,
+        tempo: 60.0,
+        notes: &[
+            (38, 1.0), (33, 1.0), (35, 1.0), (30, 1.0), (31, 1.0), (38, 1.0), (31, 1.0), (33, 1.0),
+            (38, 1.0), (33, 1.0), (35, 1.0), (30, 1.0), (31, 1.0), (38, 1.0), (31, 1.0), (33, 1.0),
+        ],
+    },
+    // The double bass's range, E1 to E3 in E major, two beats a note.
+    Part {
+        name: "E major E1-E3 (double bass)",
+        cantabile: false,
+        kind: InstrumentKind::DoubleBass,
+        tempo: 120.0,
+        notes: &[
+            (28, 2.0), (30, 2.0), (32, 2.0), (33, 2.0), (35, 2.0), (37, 2.0), (39, 2.0), (40, 2.0),
+            (42, 2.0), (44, 2.0), (45, 2.0), (47, 2.0), (49, 2.0), (51, 2.0), (52, 2.0),
         ],
     },
     // L. van Beethoven, symphony no. 9, op. 125, finale, the "Ode to Joy" theme in G.
