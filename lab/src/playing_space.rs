@@ -329,7 +329,7 @@ pub fn render_cell(cell: &Cell) -> Result<(Vec<f64>, Vec<ContactSample>), String
             Ok(play(cell, &mut engine))
         }
         Model::Thermal => {
-            let bridge = thermal_bridge(cell.kind);
+            let bridge = colophony::dsp::bridge_data::shipped_bridge(cell.kind);
             let settings = ThermalSettings {
                 nodes: GOOD_NODES,
                 width_m: 0.01,
@@ -465,11 +465,6 @@ impl Catcher {
             self.fall_from = Some(probe.len());
         }
     }
-}
-
-/// The modal bridge the plugin gives each instrument's thermal model.
-fn thermal_bridge(kind: InstrumentKind) -> crate::admittance_fit::BridgeModes {
-    colophony::dsp::bridge_data::shipped_bridge(kind)
 }
 
 /// Renders and measures one cell.

@@ -185,8 +185,7 @@ pub fn helmholtz_since(samples: &[ContactSample], sample_rate: f32, f0_hz: f32) 
     if !(expected / PERIOD_RANGE..=expected * PERIOD_RANGE).contains(&period) {
         return None;
     }
-    let model_sample = (sample_rate / INTERNAL_RATE_HZ as f32).max(1.0);
-    let tolerance = (PERIOD_JITTER * period).max(2.0 * model_sample);
+    let tolerance = span_tolerance(period, sample_rate);
     let first_steady = spans
         .iter()
         .rposition(|s| (s - period).abs() > tolerance)
@@ -196,6 +195,16 @@ pub fn helmholtz_since(samples: &[ContactSample], sample_rate: f32, f0_hz: f32) 
     let last = *onsets.last()?;
     let quiet_tail = (samples.len() - last) as f32 > 1.5 * period;
     (spans.len() - first_steady >= 2 && !quiet_tail).then(|| onsets[first_steady])
+}
+
+/// How far a span between slips may stray from a period of `period` samples and still
+/// count as one: [`PERIOD_JITTER`] of it, or two samples of the model, each onset being
+/// found to within one (the point strings run at 48 kHz whatever the host's rate and the
+/// probe holds their last sample, so above 48 kHz an onset moves in steps of several host
+/// samples).
+fn span_tolerance(period: f32, sample_rate: f32) -> f32 {
+    let model_sample = (sample_rate / INTERNAL_RATE_HZ as f32).max(1.0);
+    (PERIOD_JITTER * period).max(2.0 * model_sample)
 }
 
 /// Whether every onset is followed `n` onsets later by one a period later (see the module
@@ -211,11 +220,7 @@ fn repeats_every_period(onsets: &[usize], n: usize, period: f32, sample_rate: f3
         .collect();
     spans.sort_by(f32::total_cmp);
     let median = spans[spans.len() / 2];
-    // Two samples of the model: each onset is found to within one. The point strings run
-    // at 48 kHz whatever the host's rate and the probe holds their last sample, so above
-    // 48 kHz an onset moves in steps of several host samples.
-    let model_sample = (sample_rate / INTERNAL_RATE_HZ as f32).max(1.0);
-    let tolerance = (PERIOD_JITTER * median).max(2.0 * model_sample);
+    let tolerance = span_tolerance(median, sample_rate);
     (period / PERIOD_RANGE..=period * PERIOD_RANGE).contains(&median)
         && spans.iter().all(|s| (s - median).abs() <= tolerance)
 }

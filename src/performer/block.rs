@@ -55,7 +55,7 @@ pub enum Event {
 
 /// One output sample on every channel: subnormals flushed, the safety limiter applied.
 #[inline]
-pub fn write_frame(channels: &mut [&mut [f32]], sample: usize, audio: f64) {
+fn write_frame(channels: &mut [&mut [f32]], sample: usize, audio: f64) {
     let out = safety_limit(flush_tiny(audio)) as f32;
     for channel in channels.iter_mut() {
         channel[sample] = out;

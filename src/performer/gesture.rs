@@ -419,16 +419,23 @@ mod tests {
             .collect()
     }
 
-    /// Depth (largest offset, cents) and rate (upward zero crossings, Hz) after the fade-in.
-    fn depth_and_rate(cents: &[f64]) -> (f64, f64) {
+    /// The finger's offset after the vibrato's fade-in, and the samples where it crosses
+    /// zero upward.
+    fn steady_and_upward_crossings(cents: &[f64]) -> (&[f64], Vec<usize>) {
         let steady = &cents[((VIBRATO_DELAY_S + VIBRATO_FADE_S) * FS) as usize + 64..];
-        let depth = steady.iter().fold(0.0f64, |m, c| m.max(c.abs()));
-        let ups: Vec<usize> = steady
+        let ups = steady
             .windows(2)
             .enumerate()
             .filter(|(_, w)| w[0] < 0.0 && w[1] >= 0.0)
             .map(|(i, _)| i)
             .collect();
+        (steady, ups)
+    }
+
+    /// Depth (largest offset, cents) and rate (upward zero crossings, Hz) after the fade-in.
+    fn depth_and_rate(cents: &[f64]) -> (f64, f64) {
+        let (steady, ups) = steady_and_upward_crossings(cents);
+        let depth = steady.iter().fold(0.0f64, |m, c| m.max(c.abs()));
         let rate = (ups.len() - 1) as f64 * FS / (ups[ups.len() - 1] - ups[0]) as f64;
         (depth, rate)
     }
@@ -468,13 +475,7 @@ mod tests {
         // further than the drift allows (3 %, plus 2 % for cycles counted to a sample
         // and the finger's 64-sample steps).
         let cents = vibrato_cents(&Setup::default(), &[]);
-        let steady = &cents[((VIBRATO_DELAY_S + VIBRATO_FADE_S) * FS) as usize + 64..];
-        let ups: Vec<usize> = steady
-            .windows(2)
-            .enumerate()
-            .filter(|(_, w)| w[0] < 0.0 && w[1] >= 0.0)
-            .map(|(i, _)| i)
-            .collect();
+        let (_, ups) = steady_and_upward_crossings(&cents);
         let periods: Vec<f64> = ups.windows(2).map(|w| (w[1] - w[0]) as f64 / FS).collect();
         let nominal = 1.0 / VIBRATO_RATE_HZ;
         assert!(

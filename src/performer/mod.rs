@@ -58,7 +58,7 @@ use crate::dsp::vocabulary::{
     MIN_NOTE_BETA, PITCH_BEND_SEMITONES,
 };
 use crate::quality::{self, Quality};
-pub use block::{write_frame, Event};
+pub use block::Event;
 use direct::DirectBow;
 use gesture::Gesture;
 pub use gesture::{
