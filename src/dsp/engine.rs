@@ -16,7 +16,7 @@
 
 use super::rubbed::RubbedInstrument;
 use super::strings::{FourStrings, StringBank};
-use super::vocabulary::{BowControl, Frame, NoteExpression};
+use super::vocabulary::{BowControl, Frame, NoteExpression, Pluck};
 
 /// An instrument the notes play.
 pub trait Engine {
@@ -26,6 +26,11 @@ pub trait Engine {
     /// finger there over `glide_s` seconds (portamento); engines without fingers land it.
     fn note_on_gliding(&mut self, note: u8, _glide_s: f64) -> Option<usize> {
         self.note_on(note)
+    }
+    /// Plucks `note` (pizzicato) with `pluck`: the string it went to, `None` if the
+    /// engine cannot pluck it (engines without plucked strings: always).
+    fn pluck(&mut self, _note: u8, _pluck: Pluck) -> Option<usize> {
+        None
     }
     /// Lifts the bow from `note` (and, on strings, the finger that stops it).
     fn note_off(&mut self, note: u8);
@@ -69,6 +74,9 @@ impl<B: StringBank> Engine for FourStrings<B> {
     }
     fn note_on_gliding(&mut self, note: u8, glide_s: f64) -> Option<usize> {
         FourStrings::note_on_gliding(self, note, glide_s)
+    }
+    fn pluck(&mut self, note: u8, pluck: Pluck) -> Option<usize> {
+        FourStrings::pluck(self, note, pluck)
     }
     fn note_off(&mut self, note: u8) {
         FourStrings::note_off(self, note)

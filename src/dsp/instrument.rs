@@ -134,6 +134,14 @@ impl StringBank for WaveguideBank {
         self.voices[i].string.set_finger_reflection(reflection);
     }
 
+    const PLUCKABLE: bool = true;
+
+    fn pluck(&mut self, i: usize, displacement_m: f64, position_beta: f64, width: f64) -> bool {
+        let string = &mut self.voices[i].string;
+        string.pluck(displacement_m, position_beta, width);
+        string.is_playable()
+    }
+
     fn wake(&mut self, i: usize) {
         let voice = &mut self.voices[i];
         voice.awake = voice.string.is_playable();

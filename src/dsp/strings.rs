@@ -37,7 +37,7 @@ use super::fingering::{BowEnvelope, Fingering};
 use super::intonation::IntonationTable;
 use super::resample::Resampler;
 use super::vocabulary::{
-    BowControl, Frame, InstrumentKind, NoteExpression, BOW_RAMP_S, MAX_NOTE_BETA,
+    BowControl, Frame, InstrumentKind, NoteExpression, Pluck, BOW_RAMP_S, MAX_NOTE_BETA,
     MAX_WEIGHTED_FORCE_N, MIN_NOTE_BETA, STRINGS,
 };
 
@@ -91,6 +91,14 @@ pub trait StringBank {
     /// The stopping finger's reflection on string `i`, 0..=1 (1: pressed; less while it
     /// leaves the string). Only takes energy out.
     fn set_finger_reflection(&mut self, i: usize, reflection: f64);
+    /// Whether [`StringBank::pluck`] plucks.
+    const PLUCKABLE: bool = false;
+    /// Plucks string `i` (pizzicato) as [`super::waveguide::WaveguideString::pluck`]:
+    /// `width` is the finger's contact over the vibrating length. False where the bank's
+    /// strings cannot be plucked (nothing changes).
+    fn pluck(&mut self, _i: usize, _displacement_m: f64, _position_beta: f64, _width: f64) -> bool {
+        false
+    }
     /// A bow landed on string `i`: it is computed from the next sample.
     fn wake(&mut self, i: usize);
     /// Whether string `i` is being computed (bowed, or ringing on).
@@ -435,6 +443,41 @@ impl<B: StringBank> FourStrings<B> {
     /// Stops the string for `note` and lands the bow on it. Returns the string, or `None`
     /// if no string can play the note (it is then ignored).
     pub fn note_on(&mut self, note: u8) -> Option<usize> {
+        let index = self.stop_for(note)?;
+        self.hands.bows[index].bowed = true;
+        self.bank.wake(index);
+        self.hands.probed = index;
+        Some(index)
+    }
+
+    /// Stops the string for `note` and plucks it there (pizzicato): no bow lands, and a
+    /// bow on that string lifts. The string rings until the note is released, when the
+    /// finger lifts as after a bowed note. Returns the string, or `None` if no string can
+    /// play the note or the strings cannot be plucked (then nothing sounds).
+    pub fn pluck(&mut self, note: u8, pluck: Pluck) -> Option<usize> {
+        if !B::PLUCKABLE {
+            return None;
+        }
+        let index = self.stop_for(note)?;
+        self.hands.bows[index].bowed = false;
+        let open = self.hands.open_notes[index];
+        let vibrating_m =
+            self.kind.string_length_m() * 2f64.powf(-(note.saturating_sub(open) as f64) / 12.0);
+        let width = pluck.width_m / vibrating_m;
+        if !self
+            .bank
+            .pluck(index, pluck.displacement_m, pluck.position_beta, width)
+        {
+            return None;
+        }
+        self.bank.wake(index);
+        self.hands.probed = index;
+        Some(index)
+    }
+
+    /// Chooses the string for `note` and stops it there (the finger down, the note's
+    /// expression reset); `None`, and nothing changed, if no string can play it.
+    fn stop_for(&mut self, note: u8) -> Option<usize> {
         let index = self.hands.fingering.string_for_note_on(note)?;
         self.hands.keep_finger(&mut self.bank, index);
         let before = (
@@ -448,9 +491,6 @@ impl<B: StringBank> FourStrings<B> {
             return None;
         }
         self.hands.expressive[index] = false;
-        self.hands.bows[index].bowed = true;
-        self.bank.wake(index);
-        self.hands.probed = index;
         Some(index)
     }
 

@@ -354,6 +354,19 @@ impl Default for BowControl {
     }
 }
 
+/// A finger's pluck (pizzicato): the string pulled aside at one point and let go from rest.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pluck {
+    /// How far the finger pulls the string aside, m.
+    pub displacement_m: f64,
+    /// Where, from the bridge over the vibrating length (0..1).
+    pub position_beta: f64,
+    /// The finger's contact width, m: the kink the finger leaves is rounded over it (a
+    /// fingertip's pad about a centimetre, a nail a few millimetres), which takes the
+    /// partials whose half-wavelength is shorter than it out of the pluck.
+    pub width_m: f64,
+}
+
 /// One sample of output with the probed string's contact signals.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Frame {
