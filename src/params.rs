@@ -116,6 +116,26 @@ impl ResonatorChoice {
     }
 }
 
+/// How notes are played ([`crate::performer::articulation`]).
+#[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ArticulationChoice {
+    #[id = "arco"]
+    #[name = "Arco"]
+    Arco,
+    #[id = "pizzicato"]
+    #[name = "Pizzicato"]
+    Pizzicato,
+}
+
+impl From<ArticulationChoice> for crate::performer::Articulation {
+    fn from(choice: ArticulationChoice) -> Self {
+        match choice {
+            ArticulationChoice::Arco => Self::Arco,
+            ArticulationChoice::Pizzicato => Self::Pizzicato,
+        }
+    }
+}
+
 /// The direction of each new bow stroke ([`crate::performer::stroke`]): alternating, as
 /// in détaché, or always one way (the bow velocity parameter's sign is down).
 #[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
@@ -269,6 +289,10 @@ pub struct ColophonyParams {
     /// The strings weighted by their impedance ([`crate::performer::Setup`]).
     #[id = "string_weight"]
     pub string_weight: BoolParam,
+    #[id = "articulation"]
+    pub articulation: EnumParam<ArticulationChoice>,
+    #[id = "keyswitch_octave"]
+    pub keyswitch_octave: IntParam,
     /// The editor window's size, saved with the plugin state (not a parameter).
     #[persist = "editor-state"]
     pub editor_state: crate::editor_state::EditorState,
@@ -420,6 +444,21 @@ impl Default for ColophonyParams {
             dynamics_guard: BoolParam::new("Dynamics Guard", true),
             // Read once per block.
             string_weight: BoolParam::new("String Weight", true),
+            // Read at each note-on; a keyswitch or controller holds another until it moves.
+            articulation: EnumParam::new("Articulation", ArticulationChoice::Arco),
+            // Read at each note-on: C of this octave and the keys above it are keyswitches.
+            keyswitch_octave: IntParam::new(
+                "Keyswitch Octave",
+                crate::performer::articulation::KEYSWITCH_OCTAVE_DEFAULT as i32,
+                IntRange::Linear {
+                    min: *crate::performer::articulation::KEYSWITCH_OCTAVES.start() as i32,
+                    max: *crate::performer::articulation::KEYSWITCH_OCTAVES.end() as i32,
+                },
+            )
+            .with_value_to_string(std::sync::Arc::new(|octave| format!("C{octave}")))
+            .with_string_to_value(std::sync::Arc::new(|text| {
+                text.trim().trim_start_matches(['C', 'c']).parse().ok()
+            })),
             editor_state: Default::default(),
             user_bridges: Default::default(),
             state_version: StateVersion,
@@ -460,6 +499,8 @@ impl ColophonyParams {
             vibrato_rate_hz: self.vibrato_rate.value() as f64,
             dynamics_guard: self.dynamics_guard.value(),
             string_weight: self.string_weight.value(),
+            articulation: self.articulation.value().into(),
+            keyswitch_octave: self.keyswitch_octave.value() as i8,
         }
     }
 

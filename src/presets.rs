@@ -94,6 +94,14 @@ const FACTORY: &[(&str, &str)] = &[
         include_str!("../assets/presets/double-bass-arco.json"),
     ),
     (
+        "cello-pizzicato",
+        include_str!("../assets/presets/cello-pizzicato.json"),
+    ),
+    (
+        "double-bass-pizzicato",
+        include_str!("../assets/presets/double-bass-pizzicato.json"),
+    ),
+    (
         "thermal-cello",
         include_str!("../assets/presets/thermal-cello.json"),
     ),

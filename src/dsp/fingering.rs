@@ -84,6 +84,9 @@ pub struct Fingering {
     intonation: Option<&'static IntonationTable>,
     /// The intonation table's row (the friction model).
     intonation_row: usize,
+    /// Whether each string was plucked: it sounds its free pitch, which the table (made
+    /// for the bowed sound) does not move.
+    plucked: [bool; STRINGS],
 }
 
 impl Fingering {
@@ -104,6 +107,7 @@ impl Fingering {
             reference_semitones: 0.0,
             intonation: intonation_row.map(|_| intonation::shipped()),
             intonation_row: intonation_row.unwrap_or(0),
+            plucked: [false; STRINGS],
         }
     }
 
@@ -131,6 +135,13 @@ impl Fingering {
     /// them; `None` restores the usual choice. Notes already sounding stay where they are.
     pub fn set_preferred_string(&mut self, preferred: Option<usize>) {
         self.preferred_string = preferred.filter(|&p| p < STRINGS);
+    }
+
+    /// Whether `string` is plucked (tuned by its free pitch) or bowed, until set again.
+    pub fn set_plucked(&mut self, string: usize, plucked: bool) {
+        if let Some(p) = self.plucked.get_mut(string) {
+            *p = plucked;
+        }
     }
 
     /// A new note on `string`: neutral expression, no glide.
@@ -297,7 +308,7 @@ impl Fingering {
 
     /// The free-decay pitch `string` is stopped at for its note (0 Hz for none): equal
     /// temperament under the bend, the note's own bend, the glide and the reference,
-    /// moved by the intonation table ([`intonation::tuned_hz`]).
+    /// moved by the intonation table ([`intonation::tuned_hz`]) unless it is plucked.
     pub fn tuned_hz(&self, string: usize) -> f64 {
         match self.notes[string] {
             Some(note) => self.tuned_hz_for(string, note),
@@ -307,8 +318,11 @@ impl Fingering {
 
     /// As [`Fingering::tuned_hz`] for `note` on `string`.
     pub fn tuned_hz_for(&self, string: usize, note: u8) -> f64 {
+        let table = self
+            .intonation
+            .filter(|_| !self.plucked[string.min(STRINGS - 1)]);
         intonation::tuned_hz(
-            self.intonation,
+            table,
             self.intonation_row,
             self.kind,
             string,

@@ -443,7 +443,7 @@ impl<B: StringBank> FourStrings<B> {
     /// Stops the string for `note` and lands the bow on it. Returns the string, or `None`
     /// if no string can play the note (it is then ignored).
     pub fn note_on(&mut self, note: u8) -> Option<usize> {
-        let index = self.stop_for(note)?;
+        let index = self.stop_for(note, false)?;
         self.hands.bows[index].bowed = true;
         self.bank.wake(index);
         self.hands.probed = index;
@@ -458,16 +458,15 @@ impl<B: StringBank> FourStrings<B> {
         if !B::PLUCKABLE {
             return None;
         }
-        let index = self.stop_for(note)?;
+        let index = self.stop_for(note, true)?;
         self.hands.bows[index].bowed = false;
         let open = self.hands.open_notes[index];
         let vibrating_m =
             self.kind.string_length_m() * 2f64.powf(-(note.saturating_sub(open) as f64) / 12.0);
         let width = pluck.width_m / vibrating_m;
-        if !self
-            .bank
-            .pluck(index, pluck.displacement_m, pluck.position_beta, width)
-        {
+        // Past the middle of a short stopped string the hand plucks its middle.
+        let beta = (pluck.from_bridge_m / vibrating_m).clamp(MIN_NOTE_BETA, 0.5);
+        if !self.bank.pluck(index, pluck.displacement_m, beta, width) {
             return None;
         }
         self.bank.wake(index);
@@ -476,8 +475,9 @@ impl<B: StringBank> FourStrings<B> {
     }
 
     /// Chooses the string for `note` and stops it there (the finger down, the note's
-    /// expression reset); `None`, and nothing changed, if no string can play it.
-    fn stop_for(&mut self, note: u8) -> Option<usize> {
+    /// expression reset; `plucked`, tuned by its free pitch); `None`, and nothing changed,
+    /// if no string can play it.
+    fn stop_for(&mut self, note: u8, plucked: bool) -> Option<usize> {
         let index = self.hands.fingering.string_for_note_on(note)?;
         self.hands.keep_finger(&mut self.bank, index);
         let before = (
@@ -485,6 +485,7 @@ impl<B: StringBank> FourStrings<B> {
             self.hands.fingering.expression(index),
         );
         self.hands.fingering.start(index, note);
+        self.hands.fingering.set_plucked(index, plucked);
         let hz = self.hands.fingering.tuned_hz(index);
         if !self.bank.stop(index, hz) {
             self.hands.fingering.restore(index, before.0, before.1);

@@ -359,8 +359,9 @@ impl Default for BowControl {
 pub struct Pluck {
     /// How far the finger pulls the string aside, m.
     pub displacement_m: f64,
-    /// Where, from the bridge over the vibrating length (0..1).
-    pub position_beta: f64,
+    /// Where, as a distance from the bridge, m (the plucking hand stays near the
+    /// fingerboard's end whatever note the other hand stops).
+    pub from_bridge_m: f64,
     /// The finger's contact width, m: the kink the finger leaves is rounded over it (a
     /// fingertip's pad about a centimetre, a nail a few millimetres), which takes the
     /// partials whose half-wavelength is shorter than it out of the pluck.

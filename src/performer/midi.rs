@@ -135,6 +135,11 @@ impl Performer {
                 self.direct.set_controller(direct::CC_BOW_POSITION, x);
             }
             Target::Portamento => self.gesture.portamento_pedal = (x * 127.0).round() >= 64.0,
+            Target::Pizzicato => self.set_articulation(if (x * 127.0).round() >= 64.0 {
+                Articulation::Pizzicato
+            } else {
+                Articulation::Arco
+            }),
             Target::Sustain => {
                 let held = (x * 127.0).round() >= 64.0;
                 for engine in self.engines() {

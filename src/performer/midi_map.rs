@@ -12,6 +12,7 @@
 //! | 21, 22, 23 | bow speed, force, position ([`super::direct`]) |
 //! | 65 (portamento pedal) | portamento (on at 64 and up) |
 //! | 64 (sustain pedal) | sustain: released notes keep their fingers down (at 64 and up) |
+//! | 102 | pizzicato (at 64 and up; arco below) |
 //!
 //! Each mapping turns the controller's value `x` (0..=1) into `min + (max - min) x^e` with
 //! `e = 3^-curve` (`curve` in -1..=1: 0 is linear, 1 rises fast from the bottom, -1 slowly);
@@ -28,6 +29,10 @@
 //! ```
 
 use serde::{Deserialize, Serialize};
+
+/// The controller that switches pizzicato in the default map (an undefined one in the
+/// MIDI specification).
+pub const PIZZICATO_CC: u8 = 102;
 
 /// Most mappings a map holds.
 pub const MAX_MAPPINGS: usize = 16;
@@ -53,10 +58,13 @@ pub enum Target {
     /// The sustain pedal: while the value is 0.5 or more, released notes keep their
     /// fingers down and ring on at their stopped pitch; below it, the fingers lift.
     Sustain,
+    /// Pizzicato while the value is 0.5 or more, arco below it
+    /// ([`super::articulation`]).
+    Pizzicato,
 }
 
 impl Target {
-    pub const ALL: [Target; 8] = [
+    pub const ALL: [Target; 9] = [
         Target::Dynamics,
         Target::VibratoDepth,
         Target::VibratoRate,
@@ -65,6 +73,7 @@ impl Target {
         Target::BowPosition,
         Target::Portamento,
         Target::Sustain,
+        Target::Pizzicato,
     ];
 
     /// The name the editor shows.
@@ -78,6 +87,7 @@ impl Target {
             Target::BowPosition => "Bow position",
             Target::Portamento => "Portamento",
             Target::Sustain => "Sustain (fingers down)",
+            Target::Pizzicato => "Pizzicato",
         }
     }
 
@@ -173,6 +183,7 @@ impl Default for MidiMap {
             Mapping::new(23, Target::BowPosition),
             Mapping::new(65, Target::Portamento),
             Mapping::new(64, Target::Sustain),
+            Mapping::new(PIZZICATO_CC, Target::Pizzicato),
         ] {
             map.add(m);
         }

@@ -16,7 +16,8 @@
 //! `routing` (keys to strings, legato, double stops, per-note expression), `midi` (the
 //! wheel, pressure, RPN and controllers through [`midi_map`]), `gesture` (dynamics,
 //! vibrato, the bow as played), [`stroke`] (bow direction and attack), [`direct`] (bow
-//! controllers), [`mpe`], `render` (a sample, a block, a run) and `tail`.
+//! controllers), [`mpe`], [`articulation`] (arco, pizzicato, keyswitches), `render` (a
+//! sample, a block, a run) and `tail`.
 //!
 //! ```
 //! use colophony::dsp::vocabulary::{BowControl, InstrumentKind};
@@ -31,6 +32,7 @@
 //! assert!(peak > 0.0);
 //! ```
 
+pub mod articulation;
 mod block;
 pub mod direct;
 mod gesture;
@@ -58,6 +60,7 @@ use crate::dsp::vocabulary::{
     MIN_NOTE_BETA, PITCH_BEND_SEMITONES,
 };
 use crate::quality::{self, Quality};
+pub use articulation::Articulation;
 pub use block::Event;
 use direct::DirectBow;
 use gesture::Gesture;
@@ -151,6 +154,9 @@ pub struct Performer {
     /// Per key: the channel it was played on, the string it went to, and its own note
     /// expressions.
     notes: [NoteSlot; 128],
+    /// The articulation a keyswitch or controller chose, until the parameter moves
+    /// ([`articulation`]).
+    articulation_midi: Option<Articulation>,
 }
 
 impl Performer {
@@ -182,6 +188,7 @@ impl Performer {
             bow_now: BowControl::default(),
             mpe: Mpe::default(),
             notes: [NoteSlot::default(); 128],
+            articulation_midi: None,
         }
     }
 

@@ -25,12 +25,20 @@ impl Performer {
     /// A note on MIDI channel `channel` (0..=15): on an MPE member channel it takes that
     /// channel's bend, pressure and timbre as its own ([`mpe`]).
     pub fn note_on_channel(&mut self, channel: u8, note: u8, velocity: f32) {
+        if self.take_keyswitch(note) {
+            return;
+        }
         self.notes[note as usize & 127] = NoteSlot {
             channel: channel & 15,
             string: None,
             state: NoteState::default(),
         };
         self.steady = None;
+        if self.articulation() == Articulation::Pizzicato
+            && !matches!(self.source, Source::Rubbed(_))
+        {
+            return self.pluck_note(note, velocity);
+        }
         let separate = !self.held.iter().any(|&h| h);
         // Portamento: a legato note played softly, or any legato note with CC65 down,
         // slides the finger there on the waveguide strings.
@@ -187,6 +195,8 @@ impl Performer {
                 if let Some(engine) = self.thermal.get_mut(k) {
                     engine.note_off(note);
                 }
+                // A pizzicato note plays the waveguide strings ([`articulation`]).
+                self.instrument.note_off(note);
             }
             Source::Rubbed(_) if was_held => self.rubbed.note_off(),
             Source::Rubbed(_) => {}

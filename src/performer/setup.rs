@@ -50,6 +50,10 @@ pub struct Setup {
     /// ([`crate::dsp::thermal_instrument::THERMAL_WEIGHT_REFERENCE_Z0`]); the rubbed
     /// objects take the force as set.
     pub string_weight: bool,
+    /// How notes are played (a keyswitch or controller holds another until this changes).
+    pub articulation: Articulation,
+    /// The octave whose keys are keyswitches (C-1 = -1; [`super::articulation`]).
+    pub keyswitch_octave: i8,
 }
 
 impl Default for Setup {
@@ -70,6 +74,8 @@ impl Default for Setup {
             vibrato_rate_hz: VIBRATO_RATE_HZ,
             dynamics_guard: true,
             string_weight: true,
+            articulation: Articulation::Arco,
+            keyswitch_octave: super::articulation::KEYSWITCH_OCTAVE_DEFAULT,
         }
     }
 }

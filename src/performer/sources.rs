@@ -90,6 +90,9 @@ impl Performer {
         if setup.vibrato_rate_hz != self.setup.vibrato_rate_hz {
             self.gesture.cc_rate_hz = None;
         }
+        if setup.articulation != self.setup.articulation {
+            self.articulation_midi = None;
+        }
         let range_was = self.bend_range();
         self.setup = *setup;
         if self.bend_range() != range_was {

@@ -1,0 +1,281 @@
+//! Articulations: how a note is played. Arco (the bow) or pizzicato (the finger plucks
+//! the string, [`crate::dsp::waveguide::WaveguideString::pluck`]), chosen by the
+//! Articulation parameter, a keyswitch or a controller; the last to move wins.
+//!
+//! **Keyswitches.** The twelve keys of one octave below the instrument's range
+//! ([`Setup::keyswitch_octave`], C0 by default) choose the articulation and play nothing:
+//! C arco, C# pizzicato. A key of that octave the instrument can play (the double bass's
+//! E1 with the keyswitches on C1) stays a note.
+//!
+//! **The pluck.** The finger pulls the string aside at [`PLUCK_FROM_BRIDGE`] of the open
+//! string's length from the bridge (just over the fingerboard's end) with a fingertip's
+//! pad [`FINGER_PAD_WIDTH_M`] wide, and lets go; the note's velocity sets how far it
+//! pulls, over [`PLUCK_RANGE_DB`]. Pizzicato plays the waveguide strings whatever the
+//! friction law (no bow touches the string), through the same body.
+
+use super::*;
+use crate::dsp::vocabulary::Pluck;
+
+/// How a note is played.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Articulation {
+    /// With the bow.
+    #[default]
+    Arco,
+    /// Plucked by a finger.
+    Pizzicato,
+}
+
+impl Articulation {
+    /// In the order of their keyswitches (from C of the keyswitch octave).
+    pub const ALL: [Articulation; 2] = [Articulation::Arco, Articulation::Pizzicato];
+
+    /// The name a score uses.
+    pub fn name(self) -> &'static str {
+        match self {
+            Articulation::Arco => "arco",
+            Articulation::Pizzicato => "pizz.",
+        }
+    }
+}
+
+/// The keyswitch octave by default: C0 (notes 12-23), under every instrument's range.
+pub const KEYSWITCH_OCTAVE_DEFAULT: i8 = 0;
+/// The keyswitch octaves a player may choose, C-1 to C1.
+pub const KEYSWITCH_OCTAVES: std::ops::RangeInclusive<i8> = -1..=1;
+
+/// The articulation key `note` chooses with the keyswitches on `octave` (C-1 = octave -1,
+/// MIDI note 0), `None` for a key that plays: outside the octave, past its last
+/// articulation, or one `kind` can play.
+pub fn keyswitch(note: u8, octave: i8, kind: InstrumentKind) -> Option<Articulation> {
+    let c = 12 * (octave.clamp(*KEYSWITCH_OCTAVES.start(), *KEYSWITCH_OCTAVES.end()) as i32 + 1);
+    let offset = note as i32 - c;
+    if !(0..12).contains(&offset) || note >= kind.open_notes()[0] {
+        return None;
+    }
+    Articulation::ALL.get(offset as usize).copied()
+}
+
+/// Where the finger plucks, over the open string's length from the bridge: just over the
+/// fingerboard's end (a violin's 270 mm fingerboard ends 58 mm, 0.18 of its 328 mm
+/// string, from the bridge; a cello's 580 mm one 0.16 of its 690 mm).
+pub const PLUCK_FROM_BRIDGE: f64 = 0.2;
+/// The fingertip pad's contact with the string, m.
+pub const FINGER_PAD_WIDTH_M: f64 = 0.01;
+/// How far the finger pulls the string at velocity 127, over the open string's length
+/// (a violin's A string 1.3 mm, a cello's 2.8 mm).
+pub const PLUCK_MAX_DISPLACEMENT: f64 = 0.004;
+/// The pluck's level range over the note's velocity, dB (as the bowed dynamics').
+pub const PLUCK_RANGE_DB: f64 = 30.0;
+
+/// The pluck a note of velocity `velocity` (0..=1) makes on `kind`.
+pub fn pluck_for(kind: InstrumentKind, velocity: f32) -> Pluck {
+    let v = stroke::velocity_step(velocity);
+    let length = kind.string_length_m();
+    Pluck {
+        displacement_m: PLUCK_MAX_DISPLACEMENT
+            * length
+            * 10f64.powf(-PLUCK_RANGE_DB / 20.0 * (1.0 - v)),
+        from_bridge_m: PLUCK_FROM_BRIDGE * length,
+        width_m: FINGER_PAD_WIDTH_M,
+    }
+}
+
+impl Performer {
+    /// The articulation notes play now: the last keyswitch or controller's, until the
+    /// Articulation parameter moves.
+    pub fn articulation(&self) -> Articulation {
+        self.articulation_midi.unwrap_or(self.setup.articulation)
+    }
+
+    /// A keyswitch or controller chooses `articulation`.
+    pub fn set_articulation(&mut self, articulation: Articulation) {
+        self.articulation_midi = Some(articulation);
+    }
+
+    /// Whether `note` is a keyswitch key: it chooses its articulation and plays nothing.
+    pub(super) fn take_keyswitch(&mut self, note: u8) -> bool {
+        match keyswitch(note, self.setup.keyswitch_octave, self.setup.instrument) {
+            Some(articulation) => {
+                self.set_articulation(articulation);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Plucks `note` with `velocity` on the waveguide strings of the setup's instrument.
+    pub(super) fn pluck_note(&mut self, note: u8, velocity: f32) {
+        self.tail = None;
+        if self.instrument.kind() != self.setup.instrument {
+            self.instrument.set_kind(self.setup.instrument);
+        }
+        let key = note as usize & 127;
+        if let Some(string) = self
+            .instrument
+            .pluck(note, pluck_for(self.setup.instrument, velocity))
+        {
+            self.held[key] = true;
+            self.last_note = Some(note);
+            self.notes[key].string = Some(string as u8);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analysis::{cents, peak_frequency_hz, rms};
+    use crate::performer::testing::*;
+
+    /// `seconds` of `p`'s output with the default bow.
+    fn play(p: &mut Performer, seconds: f64) -> Vec<f64> {
+        let bow = BowControl::default();
+        (0..(seconds * FS) as usize)
+            .map(|_| p.tick(bow).audio)
+            .collect()
+    }
+
+    fn pizzicato_setup(kind: InstrumentKind) -> Setup {
+        Setup {
+            instrument: kind,
+            articulation: Articulation::Pizzicato,
+            ..Setup::default()
+        }
+    }
+
+    /// A plucked note sounds at its pitch (the free string's: the intonation table, made
+    /// for the bowed sound, does not move a plucked string): every fifth semitone of every
+    /// instrument, each string. Tolerance 5 cents, what a player hears as in tune.
+    #[test]
+    fn a_pizzicato_note_sounds_at_its_pitch_across_every_instruments_range() {
+        for kind in InstrumentKind::ALL {
+            let open = kind.open_notes();
+            for note in (open[0]..=open[3] + 19).step_by(5) {
+                let mut p = Performer::new(kind);
+                let setup = pizzicato_setup(kind);
+                p.activate(&setup, FS).unwrap();
+                p.configure(&setup);
+                p.note_on(note, 0.8);
+                let out = play(&mut p, 1.0);
+                let f = midi_to_hz(note as f64);
+                let heard = peak_frequency_hz(&out[4_800..], FS, f, 40.0);
+                let off = cents(heard, f);
+                assert!(off.abs() < 5.0, "{kind:?} note {note}: {off:+.1} cents");
+            }
+        }
+    }
+
+    /// Pizzicato lands no bow: the probe feels no friction, and the plucked note dies away
+    /// (the level of its second half-second under its first); a stopped note's release
+    /// lifts the finger and damps it at least 12 dB within 100 ms, as a bowed note's does.
+    #[test]
+    fn a_plucked_note_rings_unbowed_and_its_release_damps_the_stopped_string() {
+        let mut p = cello_with(&pizzicato_setup(InstrumentKind::Cello));
+        p.note_on(55, 1.0);
+        let bow = BowControl::default();
+        let mut out = Vec::new();
+        for _ in 0..48_000 {
+            let frame = p.tick(bow);
+            assert_eq!(frame.friction_force_n, 0.0);
+            out.push(frame.audio);
+        }
+        let (first, second) = (rms(&out[..24_000]), rms(&out[24_000..]));
+        assert!(first > 0.0 && second < first, "{first} then {second}");
+        let before = rms(&play(&mut p, 0.05));
+        p.note_off(55);
+        play(&mut p, 0.05);
+        let after = rms(&play(&mut p, 0.05));
+        let drop = 20.0 * (before / after).log10();
+        assert!(drop > 12.0, "the release took {drop:.1} dB off");
+    }
+
+    /// The keyswitch's C# and the pizzicato controller (CC102 at 64 and up) switch to
+    /// pizzicato, C and the controller under 64 back to arco, and moving the parameter
+    /// takes the choice back from MIDI; a keyswitch key plays nothing.
+    #[test]
+    fn keyswitches_the_controller_and_the_parameter_choose_the_articulation() {
+        let mut p = cello();
+        assert_eq!(p.articulation(), Articulation::Arco);
+        p.note_on(13, 1.0);
+        assert_eq!(p.articulation(), Articulation::Pizzicato);
+        assert!(
+            play(&mut p, 0.1).iter().all(|&x| x == 0.0),
+            "a keyswitch plays nothing"
+        );
+        p.note_on(12, 1.0);
+        assert_eq!(p.articulation(), Articulation::Arco);
+        p.set_controller(midi_map::PIZZICATO_CC, 1.0);
+        assert_eq!(p.articulation(), Articulation::Pizzicato);
+        p.set_controller(midi_map::PIZZICATO_CC, 0.0);
+        assert_eq!(p.articulation(), Articulation::Arco);
+        p.note_on(13, 1.0);
+        let moved = pizzicato_setup(InstrumentKind::Cello);
+        p.configure(&Setup {
+            articulation: Articulation::Arco,
+            ..moved
+        });
+        assert_eq!(
+            p.articulation(),
+            Articulation::Pizzicato,
+            "the parameter did not move"
+        );
+        p.configure(&moved);
+        p.configure(&Setup::default());
+        assert_eq!(
+            p.articulation(),
+            Articulation::Arco,
+            "the parameter moved last"
+        );
+    }
+
+    /// Pizzicato plays while paper B's thermal model is chosen (on the waveguide strings:
+    /// no bow touches the string), and its release reaches the plucked string.
+    #[test]
+    fn pizzicato_sounds_with_the_thermal_model_chosen() {
+        let setup = Setup {
+            point_law: None,
+            ..pizzicato_setup(InstrumentKind::Cello)
+        };
+        let mut p = cello_with(&setup);
+        p.note_on(58, 1.0);
+        let ringing = rms(&play(&mut p, 0.2));
+        assert!(ringing > 1e-3, "{ringing}");
+        p.note_off(58);
+        play(&mut p, 0.1);
+        let after = rms(&play(&mut p, 0.1));
+        assert!(after < 0.25 * ringing, "{ringing} then {after}");
+    }
+
+    /// The keyswitch octave's C and C# choose arco and pizzicato and are no notes; the
+    /// other keys of the octave and every key the instrument plays are notes.
+    #[test]
+    fn the_keyswitch_octave_chooses_the_articulation_below_the_range() {
+        for kind in InstrumentKind::ALL {
+            assert_eq!(keyswitch(12, 0, kind), Some(Articulation::Arco));
+            assert_eq!(keyswitch(13, 0, kind), Some(Articulation::Pizzicato));
+            assert_eq!(keyswitch(14, 0, kind), None, "no third articulation yet");
+            assert_eq!(keyswitch(0, -1, kind), Some(Articulation::Arco));
+            assert_eq!(keyswitch(25, 1, kind), Some(Articulation::Pizzicato));
+            for note in kind.open_notes()[0]..128 {
+                for octave in KEYSWITCH_OCTAVES {
+                    assert_eq!(keyswitch(note, octave, kind), None, "{kind:?} {note}");
+                }
+            }
+        }
+    }
+
+    /// The velocity sets the pluck's displacement over [`PLUCK_RANGE_DB`], rising with it.
+    #[test]
+    fn the_velocity_sets_the_plucks_displacement_over_its_range() {
+        let soft = pluck_for(InstrumentKind::Cello, 0.0).displacement_m;
+        let hard = pluck_for(InstrumentKind::Cello, 1.0).displacement_m;
+        assert!((20.0 * (hard / soft).log10() - PLUCK_RANGE_DB).abs() < 1e-9);
+        let mut last = 0.0;
+        for v in 0..=127 {
+            let d = pluck_for(InstrumentKind::Violin, v as f32 / 127.0).displacement_m;
+            assert!(d > last);
+            last = d;
+        }
+    }
+}
