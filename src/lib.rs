@@ -204,6 +204,8 @@ impl Plugin for Colophony {
         );
         self.editor_link.set_note(self.performer.last_note());
         self.editor_link.set_played_bow(self.performer.bowed_bow());
+        self.editor_link
+            .set_articulation(self.performer.articulation());
         host_status(status)
     }
 }

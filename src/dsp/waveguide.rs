@@ -826,6 +826,10 @@ mod tests {
                     + w * (a * a + a * b + b * b) / 3.0;
                 let theory = 0.5 * cello_d().z0_kg_per_s * fs * strain;
                 let e = s.energy_j();
+                eprintln!(
+                    "pluck energy: fs {fs} beta {beta}: {:+.2} % of the strain energy",
+                    100.0 * (e / theory - 1.0)
+                );
                 assert!(
                     (e / theory - 1.0).abs() < 0.03,
                     "fs {fs}, beta {beta}: {e:.3e} J against {theory:.3e} J"
@@ -871,6 +875,9 @@ mod tests {
                 let (t, m) = (theory(n) / theory(1.0), measured(n) / measured(1.0));
                 if t > 0.05 {
                     let db = 20.0 * (m / t).log10();
+                    eprintln!(
+                        "pluck partials: beta {beta} w {width} n {n}: {db:+.2} dB from theory"
+                    );
                     assert!(
                         db.abs() < 1.5,
                         "beta {beta}, w {width}, partial {n}: {db:+.2} dB"
@@ -902,6 +909,7 @@ mod tests {
             let b = crate::analysis::partial_amplitude(&force[60_000..84_000], fs, f);
             let measured = 20.0 * (b / a).log10();
             let tolerance = (0.05 * predicted.abs()).max(0.5);
+            eprintln!("pluck decay: partial {n} ({f:.1} Hz): {measured:.2} dB/s, loop loss {predicted:.2} dB/s");
             assert!(
                 (measured - predicted).abs() < tolerance,
                 "partial {n} ({f:.1} Hz): {measured:.2} dB/s against {predicted:.2}"

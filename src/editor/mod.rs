@@ -36,6 +36,7 @@ pub use crate::editor_state::{EditorSize, EditorState};
 pub use view::EditorUi;
 
 use crate::params::ColophonyParams;
+use crate::performer::Articulation;
 use nice_plug::context::gui::GuiContext;
 use nice_plug::editor::dpi::{LogicalSize, NativeSize, Size};
 use nice_plug::editor::{Editor, HostMethods, ParentWindowHandle, ResizeHint, SpawnedEditor};
@@ -54,6 +55,8 @@ use std::sync::{Arc, Mutex, MutexGuard};
 #[derive(Debug)]
 pub struct EditorLink {
     note: AtomicU8,
+    /// The articulation notes play, its index in [`Articulation::ALL`].
+    articulation: AtomicU8,
     listening: AtomicBool,
     /// The bow as played (after the strokes, the dynamics and the controllers): velocity
     /// and force as f32 bits in one word, [`Self::NO_BOW`] while nothing is bowed.
@@ -102,6 +105,19 @@ impl EditorLink {
         }
     }
 
+    /// Audio thread, once per block: the articulation notes play (the parameter's, or a
+    /// keyswitch's or controller's over it).
+    pub fn set_articulation(&self, articulation: Articulation) {
+        let index = Articulation::ALL.iter().position(|&a| a == articulation);
+        self.articulation
+            .store(index.unwrap_or(0) as u8, Ordering::Relaxed);
+    }
+
+    pub fn articulation(&self) -> Articulation {
+        let index = self.articulation.load(Ordering::Relaxed) as usize;
+        Articulation::ALL.get(index).copied().unwrap_or_default()
+    }
+
     /// Editor: whether it shows the live views (false when it closes).
     pub fn set_listening(&self, on: bool) {
         self.listening.store(on, Ordering::Relaxed);
@@ -117,6 +133,7 @@ impl Default for EditorLink {
     fn default() -> Self {
         Self {
             note: AtomicU8::new(Self::NO_NOTE),
+            articulation: AtomicU8::new(0),
             listening: AtomicBool::new(false),
             played: AtomicU64::new(Self::NO_BOW),
             scope: live::Scope::default(),

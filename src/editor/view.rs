@@ -445,6 +445,9 @@ impl EditorUi {
                 ui.label("String");
                 ui.label(format!("{} string", pitch_class(open)));
                 ui.end_row();
+                ui.label("Articulation");
+                ui.label(self.link.articulation().name());
+                ui.end_row();
                 ui.label("Z0");
                 ui.label(format!("{:.3} kg/s", w.z0_kg_per_s * weight));
                 ui.end_row();

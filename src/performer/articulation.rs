@@ -161,6 +161,7 @@ mod tests {
                 let f = midi_to_hz(note as f64);
                 let heard = peak_frequency_hz(&out[4_800..], FS, f, 40.0);
                 let off = cents(heard, f);
+                eprintln!("pizzicato pitch: {kind:?} note {note}: {off:+.2} cents");
                 assert!(off.abs() < 5.0, "{kind:?} note {note}: {off:+.1} cents");
             }
         }

@@ -218,9 +218,11 @@ impl Performer {
     }
 
     /// The bow as played (velocity m/s, force N, as [`Performer::bow`]) while a key is
-    /// held, `None` otherwise: what the editor marks on its pad.
+    /// held and notes are bowed, `None` otherwise: what the editor marks on its pad.
     pub fn bowed_bow(&self) -> Option<(f32, f32)> {
-        self.held.iter().any(|&h| h).then_some((
+        let bowing =
+            self.articulation() == Articulation::Arco || matches!(self.source, Source::Rubbed(_));
+        (bowing && self.held.iter().any(|&h| h)).then_some((
             self.bow_now.velocity_m_per_s as f32,
             self.bow_now.force_n as f32,
         ))
