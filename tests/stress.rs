@@ -8,7 +8,8 @@
 //! trains of bow reversals every few ms, bow force (0 and max), bow position (both ends),
 //! notes in and out of every range, note storms (up to 32 notes a few samples apart), raw
 //! channel messages on all 16 channels, MPE zones and CLAP tuning expressions,
-//! friction-law, instrument, resonator and thermal-bow switches during notes, pitch bend,
+//! friction-law, instrument, resonator, thermal-bow and articulation (arco, pizzicato)
+//! switches during notes, pitch bend,
 //! output gain, and bow lifts of 60-400 ms with nothing else happening.
 //!
 //! **Two drivers.** The DSP engines (`Instrument` with paper A's four point laws,
@@ -52,7 +53,7 @@ use colophony::dsp::thermal_instrument::{
 };
 use colophony::dsp::vocabulary::{BowControl, InstrumentKind, BOW_RAMP_S, STRINGS};
 use colophony::params::{bow_force_range, bow_position_range, bow_velocity_range};
-use colophony::performer::{Performer, Setup, ThermalNodes};
+use colophony::performer::{Articulation, Performer, Setup, ThermalNodes};
 use colophony::quality::Quality;
 use host::{Event, HostedPlugin, Score};
 use proptest::prelude::*;
@@ -224,6 +225,7 @@ fn action() -> impl Strategy<Value = Action> {
         1 => op((any::<u8>(), prop_oneof![Just(-128.0), Just(128.0), -60.0..=60.0f64])
             .prop_map(|(n, st)| Op::Tuning(n & 127, st)).boxed()),
         2 => (60.0..400.0f64).prop_map(|ms| Action::Lift { ms }),
+        2 => op(any::<bool>().prop_map(Op::Pizzicato).boxed()),
     ]
 }
 
@@ -280,6 +282,8 @@ enum Op {
     MpeZone(u8),
     /// A CLAP tuning expression on a key, semitones.
     Tuning(u8, f64),
+    /// The Articulation parameter: pizzicato (true) or arco.
+    Pizzicato(bool),
 }
 
 impl Op {
@@ -298,6 +302,7 @@ impl Op {
                 | Op::Law(_)
                 | Op::Resonator(_)
                 | Op::GainDb(_)
+                | Op::Pizzicato(_)
         )
     }
 }
@@ -482,6 +487,13 @@ impl Rig {
                 }
             }
             (_, Op::Tuning(n, semitones)) => self.performer.set_note_tuning(n, semitones as f32),
+            (_, Op::Pizzicato(on)) => {
+                self.setup.articulation = if on {
+                    Articulation::Pizzicato
+                } else {
+                    Articulation::Arco
+                }
+            }
             _ => {}
         }
         if self.setup != before {
@@ -1019,6 +1031,9 @@ fn render_plugin(case: &PluginCase) -> Result<Vec<f32>, String> {
                 }
             }
             Op::Tuning(key, semitones) => push(Event::Tuning { key, semitones }),
+            Op::Pizzicato(on) => {
+                push(plugin.text("Articulation", if on { "Pizzicato" } else { "Arco" }))
+            }
         }
     }
     let mut left = Vec::with_capacity(frames);
