@@ -7,7 +7,8 @@
 //! - [`figures`], [`playing_space::figure`]: the papers' figures and the maps, as PNG;
 //! - [`bench`], [`precision`], [`playing_space`], [`intonation_fit`]: real-time ratios, the
 //!   work-precision benchmark, the playing-space map and the intonation table;
-//! - [`admittance_fit`]: fitting a passive modal bridge to measured admittance.
+//! - [`admittance_fit`]: fitting a passive modal bridge to measured admittance;
+//! - [`timbre`]: the played notes' long-term spectrum against a real instrument's.
 
 pub mod admittance_fit;
 pub mod bench;
@@ -18,3 +19,4 @@ pub mod playing_space;
 pub mod precision;
 pub mod render;
 pub mod thermal_constants;
+pub mod timbre;

@@ -121,7 +121,9 @@ enum Command {
     /// candidate constant sets on probe notes across the window; `scenes` times what
     /// skipping silent strings saves; `playing-space --out DIR` maps Helmholtz motion over
     /// the bowing window (see its options); `intonation --out FILE` measures the bowed
-    /// intonation table.
+    /// intonation table; `timbre --out DIR [--models ..] [--rates ..] [--instruments ..]`
+    /// compares each instrument's played notes with a real player's, band by band (default
+    /// the hyperbolic law at 48 kHz).
     Bench {
         what: String,
         /// Output directory (precision).
@@ -138,7 +140,8 @@ enum Command {
         /// playing-space: every Nth semitone (default 1; with --quick 5).
         #[arg(long)]
         step: Option<usize>,
-        /// playing-space, intonation: friction models, comma-separated (default all five).
+        /// playing-space, intonation, timbre: friction models, comma-separated (default all
+        /// five; timbre: hyperbolic).
         #[arg(long, value_delimiter = ',')]
         models: Vec<String>,
         /// playing-space, intonation: instruments, comma-separated (default all four;
@@ -425,8 +428,18 @@ fn main() -> ExitCode {
                 None => Err("bench intonation needs --out FILE (the shipped one: assets/intonation.csv)".into()),
             },
             "thermal-constants" => colophony_lab::thermal_constants::run(),
+            "timbre" => match out {
+                // One model (the default law) at 48 kHz unless asked for more.
+                Some(dir) => colophony_lab::playing_space::Plan::from_options(false, &rates, None, &models, &instruments)
+                    .and_then(|plan| {
+                        let models = if models.is_empty() { vec![colophony_lab::playing_space::Model::ALL[0]] } else { plan.models };
+                        let rates = if rates.is_empty() { vec![48_000.0] } else { plan.rates_hz };
+                        colophony_lab::timbre::run(&dir, &models, &rates, &plan.kinds)
+                    }),
+                None => Err("bench timbre needs --out DIR".into()),
+            },
             other => Err(format!(
-                "unknown bench '{other}': choose friction, table1, scenes, peers, precision, playing-space, intonation or thermal-constants"
+                "unknown bench '{other}': choose friction, table1, scenes, peers, precision, playing-space, intonation, timbre or thermal-constants"
             )),
         }),
         Command::Presets => {
