@@ -150,7 +150,9 @@ impl Plugin for Colophony {
         _aux: &mut AuxiliaryBuffers,
         context: &mut impl ProcessContext<Self>,
     ) -> ProcessStatus {
-        self.performer.configure(&self.params.setup());
+        let mut setup = self.params.setup();
+        setup.tempo_bpm = context.transport().tempo;
+        self.performer.configure(&setup);
         // The editor or a loaded state changed the MIDI map (a read that overlaps a write
         // waits for the next block).
         if let Some(map) = self

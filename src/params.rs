@@ -125,6 +125,33 @@ pub enum ArticulationChoice {
     #[id = "pizzicato"]
     #[name = "Pizzicato"]
     Pizzicato,
+    #[id = "tremolo"]
+    #[name = "Tremolo"]
+    Tremolo,
+}
+
+/// What sets the tremolo's strokes ([`crate::performer::articulation::TremoloSync`]).
+#[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TremoloSyncChoice {
+    #[id = "free"]
+    #[name = "Free (Tremolo Rate)"]
+    Free,
+    #[id = "sixteenths"]
+    #[name = "1/16 of the host tempo"]
+    Sixteenths,
+    #[id = "thirty-seconds"]
+    #[name = "1/32 of the host tempo"]
+    ThirtySeconds,
+}
+
+impl From<TremoloSyncChoice> for crate::performer::articulation::TremoloSync {
+    fn from(choice: TremoloSyncChoice) -> Self {
+        match choice {
+            TremoloSyncChoice::Free => Self::Free,
+            TremoloSyncChoice::Sixteenths => Self::Sixteenths,
+            TremoloSyncChoice::ThirtySeconds => Self::ThirtySeconds,
+        }
+    }
 }
 
 impl From<ArticulationChoice> for crate::performer::Articulation {
@@ -132,6 +159,7 @@ impl From<ArticulationChoice> for crate::performer::Articulation {
         match choice {
             ArticulationChoice::Arco => Self::Arco,
             ArticulationChoice::Pizzicato => Self::Pizzicato,
+            ArticulationChoice::Tremolo => Self::Tremolo,
         }
     }
 }
@@ -293,6 +321,10 @@ pub struct ColophonyParams {
     pub articulation: EnumParam<ArticulationChoice>,
     #[id = "keyswitch_octave"]
     pub keyswitch_octave: IntParam,
+    #[id = "tremolo_rate"]
+    pub tremolo_rate: FloatParam,
+    #[id = "tremolo_sync"]
+    pub tremolo_sync: EnumParam<TremoloSyncChoice>,
     /// The editor window's size, saved with the plugin state (not a parameter).
     #[persist = "editor-state"]
     pub editor_state: crate::editor_state::EditorState,
@@ -459,6 +491,19 @@ impl Default for ColophonyParams {
             .with_string_to_value(std::sync::Arc::new(|text| {
                 text.trim().trim_start_matches(['C', 'c']).parse().ok()
             })),
+            // Read at each block: a held tremolo follows it from its next stroke.
+            tremolo_rate: FloatParam::new(
+                "Tremolo Rate",
+                crate::performer::articulation::TREMOLO_RATE_HZ as f32,
+                FloatRange::Linear {
+                    min: *crate::performer::articulation::TREMOLO_RATES_HZ.start() as f32,
+                    max: *crate::performer::articulation::TREMOLO_RATES_HZ.end() as f32,
+                },
+            )
+            .with_unit(" strokes/s")
+            .with_step_size(0.1)
+            .with_value_to_string(formatters::v2s_f32_rounded(1)),
+            tremolo_sync: EnumParam::new("Tremolo Sync", TremoloSyncChoice::Free),
             editor_state: Default::default(),
             user_bridges: Default::default(),
             state_version: StateVersion,
@@ -501,6 +546,9 @@ impl ColophonyParams {
             string_weight: self.string_weight.value(),
             articulation: self.articulation.value().into(),
             keyswitch_octave: self.keyswitch_octave.value() as i8,
+            tremolo_rate_hz: self.tremolo_rate.value() as f64,
+            tremolo_sync: self.tremolo_sync.value().into(),
+            tempo_bpm: None,
         }
     }
 

@@ -8,8 +8,8 @@
 //! trains of bow reversals every few ms, bow force (0 and max), bow position (both ends),
 //! notes in and out of every range, note storms (up to 32 notes a few samples apart), raw
 //! channel messages on all 16 channels, MPE zones and CLAP tuning expressions,
-//! friction-law, instrument, resonator, thermal-bow and articulation (arco, pizzicato)
-//! switches during notes, pitch bend,
+//! friction-law, instrument, resonator, thermal-bow and articulation (arco, pizzicato,
+//! tremolo) switches during notes, pitch bend,
 //! output gain, and bow lifts of 60-400 ms with nothing else happening.
 //!
 //! **Two drivers.** The DSP engines (`Instrument` with paper A's four point laws,
@@ -225,7 +225,7 @@ fn action() -> impl Strategy<Value = Action> {
         1 => op((any::<u8>(), prop_oneof![Just(-128.0), Just(128.0), -60.0..=60.0f64])
             .prop_map(|(n, st)| Op::Tuning(n & 127, st)).boxed()),
         2 => (60.0..400.0f64).prop_map(|ms| Action::Lift { ms }),
-        2 => op(any::<bool>().prop_map(Op::Pizzicato).boxed()),
+        2 => op((0..Articulation::ALL.len()).prop_map(Op::Articulation).boxed()),
     ]
 }
 
@@ -282,8 +282,8 @@ enum Op {
     MpeZone(u8),
     /// A CLAP tuning expression on a key, semitones.
     Tuning(u8, f64),
-    /// The Articulation parameter: pizzicato (true) or arco.
-    Pizzicato(bool),
+    /// The Articulation parameter: an index into [`Articulation::ALL`].
+    Articulation(usize),
 }
 
 impl Op {
@@ -302,7 +302,7 @@ impl Op {
                 | Op::Law(_)
                 | Op::Resonator(_)
                 | Op::GainDb(_)
-                | Op::Pizzicato(_)
+                | Op::Articulation(_)
         )
     }
 }
@@ -487,13 +487,7 @@ impl Rig {
                 }
             }
             (_, Op::Tuning(n, semitones)) => self.performer.set_note_tuning(n, semitones as f32),
-            (_, Op::Pizzicato(on)) => {
-                self.setup.articulation = if on {
-                    Articulation::Pizzicato
-                } else {
-                    Articulation::Arco
-                }
-            }
+            (_, Op::Articulation(i)) => self.setup.articulation = Articulation::ALL[i],
             _ => {}
         }
         if self.setup != before {
@@ -1031,8 +1025,8 @@ fn render_plugin(case: &PluginCase) -> Result<Vec<f32>, String> {
                 }
             }
             Op::Tuning(key, semitones) => push(Event::Tuning { key, semitones }),
-            Op::Pizzicato(on) => {
-                push(plugin.text("Articulation", if on { "Pizzicato" } else { "Arco" }))
+            Op::Articulation(i) => {
+                push(plugin.text("Articulation", ["Arco", "Pizzicato", "Tremolo"][i]))
             }
         }
     }

@@ -4,7 +4,7 @@
 //!
 //! **Keyswitches.** The twelve keys of one octave below the instrument's range
 //! ([`Setup::keyswitch_octave`], C0 by default) choose the articulation and play nothing:
-//! C arco, C# pizzicato. A key of that octave the instrument can play (the double bass's
+//! C arco, C# pizzicato, D tremolo. A key of that octave the instrument can play (the double bass's
 //! E1 with the keyswitches on C1) stays a note.
 //!
 //! **The pluck.** The finger pulls the string aside at [`PLUCK_FROM_BRIDGE`] of the open
@@ -24,17 +24,59 @@ pub enum Articulation {
     Arco,
     /// Plucked by a finger.
     Pizzicato,
+    /// Bowed with fast reversals ([`Setup::tremolo_rate_hz`], or strokes of the host's
+    /// tempo: [`TremoloSync`]).
+    Tremolo,
+}
+
+/// What sets the tremolo's strokes: its rate, or notes of the host's tempo.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TremoloSync {
+    /// [`Setup::tremolo_rate_hz`] strokes a second.
+    #[default]
+    Free,
+    /// A stroke a sixteenth note.
+    Sixteenths,
+    /// A stroke a thirty-second note.
+    ThirtySeconds,
+}
+
+/// Tremolo strokes a second by default: a measured unmeasured tremolo runs at about 12-16
+/// bow changes a second (a choice within that).
+pub const TREMOLO_RATE_HZ: f64 = 12.0;
+/// The tremolo rates a player may set, strokes a second.
+pub const TREMOLO_RATES_HZ: std::ops::RangeInclusive<f64> = 2.0..=30.0;
+
+/// How long a tremolo stroke lasts, s: from `rate_hz` (clamped to [`TREMOLO_RATES_HZ`]), or
+/// from the host's tempo (`tempo_bpm`, when it gives one) for a synced tremolo; a synced
+/// stroke is never faster than the fastest rate.
+pub fn tremolo_stroke_s(rate_hz: f64, sync: TremoloSync, tempo_bpm: Option<f64>) -> f64 {
+    let free = 1.0 / rate_hz.clamp(*TREMOLO_RATES_HZ.start(), *TREMOLO_RATES_HZ.end());
+    let per_beat = match sync {
+        TremoloSync::Free => return free,
+        TremoloSync::Sixteenths => 4.0,
+        TremoloSync::ThirtySeconds => 8.0,
+    };
+    match tempo_bpm.filter(|t| t.is_finite() && *t > 0.0) {
+        Some(bpm) => (60.0 / bpm / per_beat).max(1.0 / TREMOLO_RATES_HZ.end()),
+        None => free,
+    }
 }
 
 impl Articulation {
     /// In the order of their keyswitches (from C of the keyswitch octave).
-    pub const ALL: [Articulation; 2] = [Articulation::Arco, Articulation::Pizzicato];
+    pub const ALL: [Articulation; 3] = [
+        Articulation::Arco,
+        Articulation::Pizzicato,
+        Articulation::Tremolo,
+    ];
 
     /// The name a score uses.
     pub fn name(self) -> &'static str {
         match self {
             Articulation::Arco => "arco",
             Articulation::Pizzicato => "pizz.",
+            Articulation::Tremolo => "trem.",
         }
     }
 }
@@ -91,6 +133,26 @@ impl Performer {
     /// A keyswitch or controller chooses `articulation`.
     pub fn set_articulation(&mut self, articulation: Articulation) {
         self.articulation_midi = Some(articulation);
+        self.follow_tremolo();
+    }
+
+    /// The bow under held notes starts, follows or stops the tremolo the articulation,
+    /// rate and tempo ask for.
+    pub(super) fn follow_tremolo(&mut self) {
+        if self.held.iter().any(|&h| h) {
+            self.stroke.set_tremolo(self.tremolo_stroke());
+        }
+    }
+
+    /// The tremolo's stroke length now, s, or `None` when the articulation is not tremolo.
+    pub(super) fn tremolo_stroke(&self) -> Option<f64> {
+        (self.articulation() == Articulation::Tremolo).then(|| {
+            tremolo_stroke_s(
+                self.setup.tremolo_rate_hz,
+                self.setup.tremolo_sync,
+                self.setup.tempo_bpm,
+            )
+        })
     }
 
     /// Whether `note` is a keyswitch key: it chooses its articulation and plays nothing.
@@ -126,6 +188,7 @@ impl Performer {
 mod tests {
     use super::*;
     use crate::analysis::{cents, peak_frequency_hz, rms};
+    use crate::dsp::friction::FrictionModel;
     use crate::performer::testing::*;
 
     /// `seconds` of `p`'s output with the default bow.
@@ -165,6 +228,90 @@ mod tests {
                 assert!(off.abs() < 5.0, "{kind:?} note {note}: {off:+.1} cents");
             }
         }
+    }
+
+    /// The signs of the probed string's friction force, averaged over 5 ms windows (the
+    /// bow drags the string its way: the mean friction force points along the bow's
+    /// motion), over `seconds` of `p` with the default bow; counts their changes.
+    fn friction_reversals(p: &mut Performer, seconds: f64) -> usize {
+        let bow = BowControl::default();
+        let window = (0.005 * FS) as usize;
+        let mut signs = Vec::new();
+        let mut sum = 0.0;
+        for i in 0..(seconds * FS) as usize {
+            sum += p.tick(bow).friction_force_n;
+            if (i + 1) % window == 0 {
+                signs.push(sum > 0.0);
+                sum = 0.0;
+            }
+        }
+        signs.windows(2).filter(|w| w[0] != w[1]).count()
+    }
+
+    /// Tremolo reverses the bow at its rate, as the string feels it: the probed string's
+    /// mean friction force changes sign 24 times in 2 s at 12 strokes a second, at 8 and
+    /// 20 as set, on the cello and the violin, with every point law. Tolerance one
+    /// reversal: the count's window edges.
+    #[test]
+    fn tremolo_reverses_the_bow_at_its_rate_on_the_string() {
+        for (kind, note) in [(InstrumentKind::Cello, 50), (InstrumentKind::Violin, 69)] {
+            for law in FrictionModel::ALL {
+                for rate in [8.0, 12.0, 20.0] {
+                    let setup = Setup {
+                        instrument: kind,
+                        point_law: Some(law),
+                        articulation: Articulation::Tremolo,
+                        tremolo_rate_hz: rate,
+                        ..Setup::default()
+                    };
+                    let mut p = Performer::new(kind);
+                    p.activate(&setup, FS).unwrap();
+                    p.configure(&setup);
+                    p.note_on(note, 0.8);
+                    play(&mut p, 0.5);
+                    let reversals = friction_reversals(&mut p, 2.0);
+                    let expected = (2.0 * rate) as usize;
+                    assert!(
+                        reversals.abs_diff(expected) <= 1,
+                        "{kind:?} {law:?} at {rate}: {reversals} reversals in 2 s"
+                    );
+                }
+            }
+        }
+    }
+
+    /// A synced tremolo takes its strokes from the host's tempo: a sixteenth at 120 bpm is
+    /// 0.125 s, a thirty-second 0.0625 s; without a tempo, or free, the rate sets them; a
+    /// tempo too fast is held at the fastest rate. Through the performer at 90 bpm in
+    /// thirty-seconds the string reverses 12 times a second.
+    #[test]
+    fn a_synced_tremolo_follows_the_hosts_tempo() {
+        assert_eq!(
+            tremolo_stroke_s(12.0, TremoloSync::Sixteenths, Some(120.0)),
+            0.125
+        );
+        assert_eq!(
+            tremolo_stroke_s(12.0, TremoloSync::ThirtySeconds, Some(120.0)),
+            0.0625
+        );
+        assert_eq!(tremolo_stroke_s(10.0, TremoloSync::Sixteenths, None), 0.1);
+        assert_eq!(tremolo_stroke_s(10.0, TremoloSync::Free, Some(120.0)), 0.1);
+        let fastest = 1.0 / TREMOLO_RATES_HZ.end();
+        assert_eq!(
+            tremolo_stroke_s(10.0, TremoloSync::ThirtySeconds, Some(900.0)),
+            fastest
+        );
+        let setup = Setup {
+            articulation: Articulation::Tremolo,
+            tremolo_sync: TremoloSync::ThirtySeconds,
+            tempo_bpm: Some(90.0),
+            ..Setup::default()
+        };
+        let mut p = cello_with(&setup);
+        p.note_on(50, 0.8);
+        play(&mut p, 0.5);
+        let reversals = friction_reversals(&mut p, 2.0);
+        assert!(reversals.abs_diff(24) <= 1, "{reversals} reversals in 2 s");
     }
 
     /// Pizzicato lands no bow: the probe feels no friction, and the plucked note dies away
@@ -248,14 +395,15 @@ mod tests {
         assert!(after < 0.25 * ringing, "{ringing} then {after}");
     }
 
-    /// The keyswitch octave's C and C# choose arco and pizzicato and are no notes; the
-    /// other keys of the octave and every key the instrument plays are notes.
+    /// The keyswitch octave's C, C# and D choose arco, pizzicato and tremolo and are no
+    /// notes; the other keys of the octave and every key the instrument plays are notes.
     #[test]
     fn the_keyswitch_octave_chooses_the_articulation_below_the_range() {
         for kind in InstrumentKind::ALL {
             assert_eq!(keyswitch(12, 0, kind), Some(Articulation::Arco));
             assert_eq!(keyswitch(13, 0, kind), Some(Articulation::Pizzicato));
-            assert_eq!(keyswitch(14, 0, kind), None, "no third articulation yet");
+            assert_eq!(keyswitch(14, 0, kind), Some(Articulation::Tremolo));
+            assert_eq!(keyswitch(15, 0, kind), None, "no fourth articulation yet");
             assert_eq!(keyswitch(0, -1, kind), Some(Articulation::Arco));
             assert_eq!(keyswitch(25, 1, kind), Some(Articulation::Pizzicato));
             for note in kind.open_notes()[0]..128 {

@@ -135,11 +135,15 @@ impl Performer {
                 self.direct.set_controller(direct::CC_BOW_POSITION, x);
             }
             Target::Portamento => self.gesture.portamento_pedal = (x * 127.0).round() >= 64.0,
-            Target::Pizzicato => self.set_articulation(if (x * 127.0).round() >= 64.0 {
-                Articulation::Pizzicato
-            } else {
-                Articulation::Arco
-            }),
+            Target::Pizzicato | Target::Tremolo => {
+                let on = if target == Target::Pizzicato {
+                    Articulation::Pizzicato
+                } else {
+                    Articulation::Tremolo
+                };
+                let down = (x * 127.0).round() >= 64.0;
+                self.set_articulation(if down { on } else { Articulation::Arco })
+            }
             Target::Sustain => {
                 let held = (x * 127.0).round() >= 64.0;
                 for engine in self.engines() {

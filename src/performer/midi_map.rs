@@ -13,6 +13,7 @@
 //! | 65 (portamento pedal) | portamento (on at 64 and up) |
 //! | 64 (sustain pedal) | sustain: released notes keep their fingers down (at 64 and up) |
 //! | 102 | pizzicato (at 64 and up; arco below) |
+//! | 103 | tremolo (at 64 and up; arco below) |
 //!
 //! Each mapping turns the controller's value `x` (0..=1) into `min + (max - min) x^e` with
 //! `e = 3^-curve` (`curve` in -1..=1: 0 is linear, 1 rises fast from the bottom, -1 slowly);
@@ -33,6 +34,8 @@ use serde::{Deserialize, Serialize};
 /// The controller that switches pizzicato in the default map (an undefined one in the
 /// MIDI specification).
 pub const PIZZICATO_CC: u8 = 102;
+/// The controller that switches tremolo in the default map (undefined in MIDI too).
+pub const TREMOLO_CC: u8 = 103;
 
 /// Most mappings a map holds.
 pub const MAX_MAPPINGS: usize = 16;
@@ -61,10 +64,12 @@ pub enum Target {
     /// Pizzicato while the value is 0.5 or more, arco below it
     /// ([`super::articulation`]).
     Pizzicato,
+    /// Tremolo while the value is 0.5 or more, arco below it.
+    Tremolo,
 }
 
 impl Target {
-    pub const ALL: [Target; 9] = [
+    pub const ALL: [Target; 10] = [
         Target::Dynamics,
         Target::VibratoDepth,
         Target::VibratoRate,
@@ -74,6 +79,7 @@ impl Target {
         Target::Portamento,
         Target::Sustain,
         Target::Pizzicato,
+        Target::Tremolo,
     ];
 
     /// The name the editor shows.
@@ -88,6 +94,7 @@ impl Target {
             Target::Portamento => "Portamento",
             Target::Sustain => "Sustain (fingers down)",
             Target::Pizzicato => "Pizzicato",
+            Target::Tremolo => "Tremolo",
         }
     }
 
@@ -184,6 +191,7 @@ impl Default for MidiMap {
             Mapping::new(65, Target::Portamento),
             Mapping::new(64, Target::Sustain),
             Mapping::new(PIZZICATO_CC, Target::Pizzicato),
+            Mapping::new(TREMOLO_CC, Target::Tremolo),
         ] {
             map.add(m);
         }

@@ -50,6 +50,7 @@ impl Performer {
         if separate && self.held[note as usize & 127] {
             self.stroke
                 .start(self.setup.bow_strokes, stroke::velocity_step(velocity));
+            self.stroke.set_tremolo(self.tremolo_stroke());
         }
     }
 
@@ -189,6 +190,9 @@ impl Performer {
 
     pub fn note_off(&mut self, note: u8) {
         let was_held = std::mem::replace(&mut self.held[note as usize & 127], false);
+        if !self.held.iter().any(|&h| h) {
+            self.stroke.set_tremolo(None);
+        }
         match self.source {
             Source::Strings => self.instrument.note_off(note),
             Source::Thermal(k) => {

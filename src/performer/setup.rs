@@ -54,6 +54,12 @@ pub struct Setup {
     pub articulation: Articulation,
     /// The octave whose keys are keyswitches (C-1 = -1; [`super::articulation`]).
     pub keyswitch_octave: i8,
+    /// Tremolo strokes a second ([`super::articulation::TREMOLO_RATES_HZ`]).
+    pub tremolo_rate_hz: f64,
+    /// Whether the tremolo's strokes follow the host's tempo.
+    pub tremolo_sync: super::articulation::TremoloSync,
+    /// The host's tempo, beats a minute, where it gives one.
+    pub tempo_bpm: Option<f64>,
 }
 
 impl Default for Setup {
@@ -76,6 +82,9 @@ impl Default for Setup {
             string_weight: true,
             articulation: Articulation::Arco,
             keyswitch_octave: super::articulation::KEYSWITCH_OCTAVE_DEFAULT,
+            tremolo_rate_hz: super::articulation::TREMOLO_RATE_HZ,
+            tremolo_sync: super::articulation::TremoloSync::Free,
+            tempo_bpm: None,
         }
     }
 }

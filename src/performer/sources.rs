@@ -93,6 +93,7 @@ impl Performer {
         if setup.articulation != self.setup.articulation {
             self.articulation_midi = None;
         }
+
         let range_was = self.bend_range();
         self.setup = *setup;
         if self.bend_range() != range_was {
@@ -123,6 +124,7 @@ impl Performer {
             engine.set_string_weighting(setup.string_weight);
             engine.set_settings(settings);
         }
+        self.follow_tremolo();
         self.apply_source(wanted);
         for engine in self.engines() {
             engine.update_sleep();

@@ -98,7 +98,16 @@ pub struct Stroke {
     onset_decay: f64,
     /// Whether a stroke has started since activation (the first is down).
     started: bool,
+    /// Tremolo: samples per stroke (0: none), samples left of this one, and the speed's
+    /// step per sample through a reversal.
+    tremolo_samples: u32,
+    tremolo_left: u32,
+    tremolo_step: f64,
 }
+
+/// A tremolo reversal takes this share of a stroke: the bow slows, stops and speeds up
+/// the other way over it, and travels at the asked speed for the rest.
+pub const TREMOLO_REVERSAL_SHARE: f64 = 0.3;
 
 impl Stroke {
     /// At rest before any note: the bow moves as the parameters say (speed 1, down).
@@ -114,7 +123,38 @@ impl Stroke {
             onset: 0.0,
             onset_decay: (-1.0 / (ONSET_RISE_S * fs)).exp(),
             started: false,
+            tremolo_samples: 0,
+            tremolo_left: 0,
+            tremolo_step: 0.0,
         }
+    }
+
+    /// Tremolo: the bow reverses every `stroke_s` seconds (each reversal through
+    /// [`TREMOLO_REVERSAL_SHARE`] of a stroke) until called with `None`. Counted from now;
+    /// a stroke length already under way is kept.
+    pub fn set_tremolo(&mut self, stroke_s: Option<f64>) {
+        match stroke_s.filter(|s| s.is_finite() && *s > 0.0) {
+            Some(s) => {
+                let samples = (s * self.sample_rate_hz)
+                    .round()
+                    .clamp(2.0, u32::MAX as f64) as u32;
+                if samples != self.tremolo_samples {
+                    self.tremolo_samples = samples;
+                    self.tremolo_left = samples;
+                    // A reversal goes from +1 to -1: twice the speed in its share.
+                    self.tremolo_step = 2.0 / (TREMOLO_REVERSAL_SHARE * samples as f64).max(1.0);
+                }
+            }
+            None => {
+                self.tremolo_samples = 0;
+                self.tremolo_left = 0;
+            }
+        }
+    }
+
+    /// Whether the bow is in tremolo.
+    pub fn is_tremolo(&self) -> bool {
+        self.tremolo_samples != 0
     }
 
     /// A separate note with velocity `velocity` (a [`velocity_step`]): a new stroke from
@@ -126,6 +166,7 @@ impl Stroke {
             StrokeMode::Up => -1.0,
         };
         self.started = true;
+        self.tremolo_left = self.tremolo_samples;
         let v = velocity.clamp(0.0, 1.0);
         let attack_s = ATTACK_SLOWEST_S * (ATTACK_FASTEST_S / ATTACK_SLOWEST_S).powf(v);
         self.step = 1.0 / (attack_s * self.sample_rate_hz).max(1.0);
@@ -144,6 +185,9 @@ impl Stroke {
     /// the asked force). Three comparisons once the attack is over.
     #[inline]
     pub fn tick(&mut self) -> (f64, f64) {
+        if self.tremolo_samples != 0 {
+            self.tremolo_tick();
+        }
         let (speed, force) = self.tick_ramp();
         if self.onset == 0.0 {
             return (speed, force);
@@ -157,6 +201,18 @@ impl Stroke {
         }
         let level = 1.0 + self.onset;
         (speed * level, force * level)
+    }
+
+    /// One sample of tremolo: at each stroke's end the bow turns, at the reversal's rate
+    /// (or the attack's, if faster).
+    #[cold]
+    fn tremolo_tick(&mut self) {
+        self.tremolo_left = self.tremolo_left.saturating_sub(1);
+        if self.tremolo_left == 0 {
+            self.tremolo_left = self.tremolo_samples;
+            self.direction = -self.direction;
+            self.step = self.step.max(self.tremolo_step);
+        }
     }
 
     /// The ramp to full speed and the landing accent, one sample.
@@ -184,7 +240,10 @@ impl Stroke {
     /// [`Stroke::tick`] would return `(direction, 1)` and change nothing.
     #[inline]
     pub fn is_settled(&self) -> bool {
-        self.speed == self.direction && self.accent == 0.0 && self.onset == 0.0
+        self.speed == self.direction
+            && self.accent == 0.0
+            && self.onset == 0.0
+            && self.tremolo_samples == 0
     }
 }
 

@@ -1,0 +1,58 @@
+#!/usr/bin/env python3
+"""Writes the articulation demos' MIDI files into assets/demos/midi/ (standard MIDI files,
+format 0, 480 ticks a beat, 60 bpm), each switching articulation by keyswitch (C0 arco,
+C#0 pizzicato, D0 tremolo):
+
+- pachelbel-ground-keyswitch.mid: J. Pachelbel's canon in D, the ground bass (public
+  domain) on the double bass, played twice: pizzicato, then arco;
+- cello-tremolo-keyswitch.mid: a cello line in half notes under tremolo."""
+import struct
+import sys
+from pathlib import Path
+
+TPB = 480
+
+
+def vlq(n):
+    out = [n & 0x7F]
+    n >>= 7
+    while n:
+        out.insert(0, (n & 0x7F) | 0x80)
+        n >>= 7
+    return bytes(out)
+
+
+def write(path, events):
+    events = [(0, b"\xff\x51\x03" + (1_000_000).to_bytes(3, "big"))] + events
+    events.sort(key=lambda e: (e[0], e[1][0] != 0x80))
+    track, last = b"", 0
+    for tick, data in events:
+        track += vlq(tick - last) + data
+        last = tick
+    track += b"\x00\xff\x2f\x00"
+    header = b"MThd" + struct.pack(">IHHH", 6, 0, 1, TPB)
+    path.write_bytes(header + b"MTrk" + struct.pack(">I", len(track)) + track)
+
+
+def keyswitch(t, key):
+    return [(t, bytes([0x90, key, 100])), (t + 10, bytes([0x80, key, 0]))]
+
+
+def notes(t, pitches, beats, held, velocity):
+    events = []
+    for note in pitches:
+        events.append((t, bytes([0x90, note, velocity])))
+        events.append((t + int(held * beats * TPB) - 20, bytes([0x80, note, 0])))
+        t += beats * TPB
+    return events, t
+
+
+out = Path(sys.argv[1] if len(sys.argv) > 1 else "assets/demos/midi")
+GROUND = [38, 33, 35, 30, 31, 38, 31, 33]  # D2 A1 B1 F#1 G1 D2 G1 A1
+events, t = keyswitch(0, 13), 20
+part, t = notes(t, GROUND, 1, 0.9, 100)
+events += part + keyswitch(t + TPB - 20, 12)
+part, t = notes(t + TPB, GROUND, 1, 0.98, 90)
+write(out / "pachelbel-ground-keyswitch.mid", events + part)
+part, _ = notes(20, [50, 53, 57, 55, 53, 52, 50], 2, 0.97, 96)
+write(out / "cello-tremolo-keyswitch.mid", keyswitch(0, 14) + part)
