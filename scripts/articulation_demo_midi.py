@@ -1,11 +1,13 @@
 #!/usr/bin/env python3
 """Writes the articulation demos' MIDI files into assets/demos/midi/ (standard MIDI files,
 format 0, 480 ticks a beat, 60 bpm), each switching articulation by keyswitch (C0 arco,
-C#0 pizzicato, D0 tremolo):
+C#0 pizzicato, D0 tremolo, D#0 spiccato):
 
 - pachelbel-ground-keyswitch.mid: J. Pachelbel's canon in D, the ground bass (public
   domain) on the double bass, played twice: pizzicato, then arco;
-- cello-tremolo-keyswitch.mid: a cello line in half notes under tremolo."""
+- cello-tremolo-keyswitch.mid: a cello line in half notes under tremolo;
+- violin-spiccato-keyswitch.mid: a violin scale in sixteenths, spiccato, then the same
+  notes arco (keyswitch C0)."""
 import struct
 import sys
 from pathlib import Path
@@ -43,7 +45,7 @@ def notes(t, pitches, beats, held, velocity):
     for note in pitches:
         events.append((t, bytes([0x90, note, velocity])))
         events.append((t + int(held * beats * TPB) - 20, bytes([0x80, note, 0])))
-        t += beats * TPB
+        t += int(beats * TPB)
     return events, t
 
 
@@ -56,3 +58,8 @@ part, t = notes(t + TPB, GROUND, 1, 0.98, 90)
 write(out / "pachelbel-ground-keyswitch.mid", events + part)
 part, _ = notes(20, [50, 53, 57, 55, 53, 52, 50], 2, 0.97, 96)
 write(out / "cello-tremolo-keyswitch.mid", keyswitch(0, 14) + part)
+SCALE = [67, 69, 71, 72, 74, 76, 78, 79, 78, 76, 74, 72, 71, 69, 67]
+part, t = notes(20, SCALE, 0.25, 0.6, 100)
+events = keyswitch(0, 15) + part + keyswitch(t + TPB // 2, 12)
+part, _ = notes(t + TPB, SCALE, 0.25, 0.95, 100)
+write(out / "violin-spiccato-keyswitch.mid", events + part)

@@ -128,6 +128,9 @@ pub enum ArticulationChoice {
     #[id = "tremolo"]
     #[name = "Tremolo"]
     Tremolo,
+    #[id = "spiccato"]
+    #[name = "Spiccato"]
+    Spiccato,
 }
 
 /// What sets the tremolo's strokes ([`crate::performer::articulation::TremoloSync`]).
@@ -160,6 +163,7 @@ impl From<ArticulationChoice> for crate::performer::Articulation {
             ArticulationChoice::Arco => Self::Arco,
             ArticulationChoice::Pizzicato => Self::Pizzicato,
             ArticulationChoice::Tremolo => Self::Tremolo,
+            ArticulationChoice::Spiccato => Self::Spiccato,
         }
     }
 }

@@ -1025,9 +1025,10 @@ fn render_plugin(case: &PluginCase) -> Result<Vec<f32>, String> {
                 }
             }
             Op::Tuning(key, semitones) => push(Event::Tuning { key, semitones }),
-            Op::Articulation(i) => {
-                push(plugin.text("Articulation", ["Arco", "Pizzicato", "Tremolo"][i]))
-            }
+            Op::Articulation(i) => push(plugin.text(
+                "Articulation",
+                ["Arco", "Pizzicato", "Tremolo", "Spiccato"][i],
+            )),
         }
     }
     let mut left = Vec::with_capacity(frames);

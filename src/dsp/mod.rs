@@ -8,6 +8,7 @@
 //! speak in are [`vocabulary`]'s.
 
 pub mod body;
+pub mod bounce;
 pub mod bridge;
 pub mod bridge_data;
 pub mod delay;

@@ -4,7 +4,7 @@
 //!
 //! **Keyswitches.** The twelve keys of one octave below the instrument's range
 //! ([`Setup::keyswitch_octave`], C0 by default) choose the articulation and play nothing:
-//! C arco, C# pizzicato, D tremolo. A key of that octave the instrument can play (the double bass's
+//! C arco, C# pizzicato, D tremolo, D# spiccato. A key of that octave the instrument can play (the double bass's
 //! E1 with the keyswitches on C1) stays a note.
 //!
 //! **The pluck.** The finger pulls the string aside at [`PLUCK_FROM_BRIDGE`] of the open
@@ -27,6 +27,9 @@ pub enum Articulation {
     /// Bowed with fast reversals ([`Setup::tremolo_rate_hz`], or strokes of the host's
     /// tempo: [`TremoloSync`]).
     Tremolo,
+    /// Each separate note drops the bow onto the string and it bounces
+    /// ([`crate::dsp::bounce`]).
+    Spiccato,
 }
 
 /// What sets the tremolo's strokes: its rate, or notes of the host's tempo.
@@ -65,10 +68,11 @@ pub fn tremolo_stroke_s(rate_hz: f64, sync: TremoloSync, tempo_bpm: Option<f64>)
 
 impl Articulation {
     /// In the order of their keyswitches (from C of the keyswitch octave).
-    pub const ALL: [Articulation; 3] = [
+    pub const ALL: [Articulation; 4] = [
         Articulation::Arco,
         Articulation::Pizzicato,
         Articulation::Tremolo,
+        Articulation::Spiccato,
     ];
 
     /// The name a score uses.
@@ -77,6 +81,7 @@ impl Articulation {
             Articulation::Arco => "arco",
             Articulation::Pizzicato => "pizz.",
             Articulation::Tremolo => "trem.",
+            Articulation::Spiccato => "spicc.",
         }
     }
 }
@@ -314,6 +319,69 @@ mod tests {
         assert!(reversals.abs_diff(24) <= 1, "{reversals} reversals in 2 s");
     }
 
+    /// Spiccato drops the bow on each separate note: the force the string gets is the
+    /// bouncing bow's (0 while it flies, so the string rings free between landings), its
+    /// first contact as long as the bounce model's (within a sample of the performer's
+    /// 48 kHz), it lands with the note (within 1 ms: the drop is taken to have happened
+    /// before), a harder note lands harder (more force at its first peak), and the bow
+    /// comes to rest on the string by the end of a 2 s note.
+    #[test]
+    fn spiccato_bounces_the_bow_on_the_string() {
+        let setup = Setup {
+            articulation: Articulation::Spiccato,
+            ..Setup::default()
+        };
+        let mut peaks = Vec::new();
+        for velocity in [0.7, 1.0] {
+            let mut p = cello_with(&setup);
+            p.note_on(50, velocity);
+            let bow = BowControl::default();
+            let force: Vec<f64> = (0..96_000)
+                .map(|_| {
+                    p.tick(bow);
+                    p.bow().force_n
+                })
+                .collect();
+            let first = force.iter().position(|&f| f > 0.0).expect("it lands");
+            assert!(first < 48, "it lands with the note ({first} samples)");
+            let lifts = first
+                + force[first..]
+                    .iter()
+                    .position(|&f| f == 0.0)
+                    .expect("it leaves");
+            let back = lifts
+                + force[lifts..]
+                    .iter()
+                    .position(|&f| f > 0.0)
+                    .expect("it lands again");
+            assert!(
+                back - lifts > 480,
+                "it flies at least 10 ms ({} samples)",
+                back - lifts
+            );
+            let mut bouncing = crate::dsp::bounce::BouncingBow::new(
+                crate::dsp::bounce::BounceParams::default(),
+                stroke::SPICCATO_PULL_N,
+                FS,
+            );
+            let v = velocity as f64;
+            bouncing.land_from(stroke::SPICCATO_DROP_M * v * v);
+            let model: Vec<f64> = (0..96_000).map(|_| bouncing.tick()).collect();
+            let m_first = model.iter().position(|&f| f > 0.0).unwrap();
+            let m_lifts = m_first + model[m_first..].iter().position(|&f| f == 0.0).unwrap();
+            assert!((lifts - first).abs_diff(m_lifts - m_first) <= 1);
+            peaks.push(force[first..lifts].iter().copied().fold(0.0, f64::max));
+            let rest = force[95_000];
+            assert!(
+                (rest / stroke::SPICCATO_PULL_N - 1.0).abs() < 0.01,
+                "rests at {rest} N"
+            );
+        }
+        // Landing speed goes as the velocity (1.43x from 0.7 to 1), the pull's share of
+        // the peak does not: more than 1.2x.
+        assert!(peaks[1] > 1.2 * peaks[0], "peaks {peaks:?}");
+    }
+
     /// Pizzicato lands no bow: the probe feels no friction, and the plucked note dies away
     /// (the level of its second half-second under its first); a stopped note's release
     /// lifts the finger and damps it at least 12 dB within 100 ms, as a bowed note's does.
@@ -395,15 +463,16 @@ mod tests {
         assert!(after < 0.25 * ringing, "{ringing} then {after}");
     }
 
-    /// The keyswitch octave's C, C# and D choose arco, pizzicato and tremolo and are no
-    /// notes; the other keys of the octave and every key the instrument plays are notes.
+    /// The keyswitch octave's C, C#, D and D# choose arco, pizzicato, tremolo and
+    /// spiccato and are no notes; the other keys of the octave and every key the instrument plays are notes.
     #[test]
     fn the_keyswitch_octave_chooses_the_articulation_below_the_range() {
         for kind in InstrumentKind::ALL {
             assert_eq!(keyswitch(12, 0, kind), Some(Articulation::Arco));
             assert_eq!(keyswitch(13, 0, kind), Some(Articulation::Pizzicato));
             assert_eq!(keyswitch(14, 0, kind), Some(Articulation::Tremolo));
-            assert_eq!(keyswitch(15, 0, kind), None, "no fourth articulation yet");
+            assert_eq!(keyswitch(15, 0, kind), Some(Articulation::Spiccato));
+            assert_eq!(keyswitch(16, 0, kind), None, "no fifth articulation yet");
             assert_eq!(keyswitch(0, -1, kind), Some(Articulation::Arco));
             assert_eq!(keyswitch(25, 1, kind), Some(Articulation::Pizzicato));
             for note in kind.open_notes()[0]..128 {

@@ -135,11 +135,11 @@ impl Performer {
                 self.direct.set_controller(direct::CC_BOW_POSITION, x);
             }
             Target::Portamento => self.gesture.portamento_pedal = (x * 127.0).round() >= 64.0,
-            Target::Pizzicato | Target::Tremolo => {
-                let on = if target == Target::Pizzicato {
-                    Articulation::Pizzicato
-                } else {
-                    Articulation::Tremolo
+            Target::Pizzicato | Target::Tremolo | Target::Spiccato => {
+                let on = match target {
+                    Target::Pizzicato => Articulation::Pizzicato,
+                    Target::Tremolo => Articulation::Tremolo,
+                    _ => Articulation::Spiccato,
                 };
                 let down = (x * 127.0).round() >= 64.0;
                 self.set_articulation(if down { on } else { Articulation::Arco })

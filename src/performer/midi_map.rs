@@ -14,6 +14,7 @@
 //! | 64 (sustain pedal) | sustain: released notes keep their fingers down (at 64 and up) |
 //! | 102 | pizzicato (at 64 and up; arco below) |
 //! | 103 | tremolo (at 64 and up; arco below) |
+//! | 104 | spiccato (at 64 and up; arco below) |
 //!
 //! Each mapping turns the controller's value `x` (0..=1) into `min + (max - min) x^e` with
 //! `e = 3^-curve` (`curve` in -1..=1: 0 is linear, 1 rises fast from the bottom, -1 slowly);
@@ -36,6 +37,8 @@ use serde::{Deserialize, Serialize};
 pub const PIZZICATO_CC: u8 = 102;
 /// The controller that switches tremolo in the default map (undefined in MIDI too).
 pub const TREMOLO_CC: u8 = 103;
+/// The controller that switches spiccato in the default map (undefined in MIDI too).
+pub const SPICCATO_CC: u8 = 104;
 
 /// Most mappings a map holds.
 pub const MAX_MAPPINGS: usize = 16;
@@ -66,10 +69,12 @@ pub enum Target {
     Pizzicato,
     /// Tremolo while the value is 0.5 or more, arco below it.
     Tremolo,
+    /// Spiccato while the value is 0.5 or more, arco below it.
+    Spiccato,
 }
 
 impl Target {
-    pub const ALL: [Target; 10] = [
+    pub const ALL: [Target; 11] = [
         Target::Dynamics,
         Target::VibratoDepth,
         Target::VibratoRate,
@@ -80,6 +85,7 @@ impl Target {
         Target::Sustain,
         Target::Pizzicato,
         Target::Tremolo,
+        Target::Spiccato,
     ];
 
     /// The name the editor shows.
@@ -95,6 +101,7 @@ impl Target {
             Target::Sustain => "Sustain (fingers down)",
             Target::Pizzicato => "Pizzicato",
             Target::Tremolo => "Tremolo",
+            Target::Spiccato => "Spiccato",
         }
     }
 
@@ -192,6 +199,7 @@ impl Default for MidiMap {
             Mapping::new(64, Target::Sustain),
             Mapping::new(PIZZICATO_CC, Target::Pizzicato),
             Mapping::new(TREMOLO_CC, Target::Tremolo),
+            Mapping::new(SPICCATO_CC, Target::Spiccato),
         ] {
             map.add(m);
         }

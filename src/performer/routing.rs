@@ -51,6 +51,9 @@ impl Performer {
             self.stroke
                 .start(self.setup.bow_strokes, stroke::velocity_step(velocity));
             self.stroke.set_tremolo(self.tremolo_stroke());
+            let spiccato = self.articulation() == Articulation::Spiccato;
+            self.stroke
+                .set_spiccato(spiccato, stroke::velocity_step(velocity));
         }
     }
 

@@ -43,6 +43,8 @@
 //! assert_eq!(stroke.tick().0, -1.0);
 //! ```
 
+use crate::dsp::bounce::{BounceParams, BouncingBow};
+
 /// The direction of each new stroke.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum StrokeMode {
@@ -103,7 +105,18 @@ pub struct Stroke {
     tremolo_samples: u32,
     tremolo_left: u32,
     tremolo_step: f64,
+    /// Spiccato: the bow bouncing on the string, its force over [`BOUNCE_REFERENCE_N`]
+    /// multiplying the asked force.
+    bounce: Option<BouncingBow>,
 }
+
+/// The bouncing bow's pull toward the string, N: half a violin bow's 60 g weight at the
+/// contact, the hand holding none of it (a choice).
+pub const SPICCATO_PULL_N: f64 = 0.3;
+/// How high the bow is dropped at velocity 127, m (lower as the square of the velocity).
+pub const SPICCATO_DROP_M: f64 = 0.015;
+/// The bouncing bow's force that plays the asked bow force, N.
+pub const BOUNCE_REFERENCE_N: f64 = 1.0;
 
 /// A tremolo reversal takes this share of a stroke: the bow slows, stops and speeds up
 /// the other way over it, and travels at the asked speed for the rest.
@@ -126,7 +139,25 @@ impl Stroke {
             tremolo_samples: 0,
             tremolo_left: 0,
             tremolo_step: 0.0,
+            bounce: None,
         }
+    }
+
+    /// Spiccato (`true`): the stroke just started lands the bow on the string as if
+    /// dropped from a height its velocity `velocity` (0..=1) sets (the drop before the
+    /// note, so the note lands on time), and it bounces
+    /// ([`crate::dsp::bounce`]) until the next stroke; `false`: the bow stays on.
+    pub fn set_spiccato(&mut self, spiccato: bool, velocity: f64) {
+        self.bounce = spiccato.then(|| {
+            let mut bow = BouncingBow::new(
+                BounceParams::default(),
+                SPICCATO_PULL_N,
+                self.sample_rate_hz,
+            );
+            let v = velocity.clamp(0.1, 1.0);
+            bow.land_from(SPICCATO_DROP_M * v * v);
+            bow
+        });
     }
 
     /// Tremolo: the bow reverses every `stroke_s` seconds (each reversal through
@@ -188,7 +219,10 @@ impl Stroke {
         if self.tremolo_samples != 0 {
             self.tremolo_tick();
         }
-        let (speed, force) = self.tick_ramp();
+        let (speed, mut force) = self.tick_ramp();
+        if let Some(bow) = &mut self.bounce {
+            force *= bow.tick() / BOUNCE_REFERENCE_N;
+        }
         if self.onset == 0.0 {
             return (speed, force);
         }
@@ -244,6 +278,7 @@ impl Stroke {
             && self.accent == 0.0
             && self.onset == 0.0
             && self.tremolo_samples == 0
+            && self.bounce.is_none()
     }
 }
 
