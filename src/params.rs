@@ -329,6 +329,8 @@ pub struct ColophonyParams {
     pub tremolo_rate: FloatParam,
     #[id = "tremolo_sync"]
     pub tremolo_sync: EnumParam<TremoloSyncChoice>,
+    #[id = "con_sordino"]
+    pub con_sordino: BoolParam,
     /// The editor window's size, saved with the plugin state (not a parameter).
     #[persist = "editor-state"]
     pub editor_state: crate::editor_state::EditorState,
@@ -508,6 +510,8 @@ impl Default for ColophonyParams {
             .with_step_size(0.1)
             .with_value_to_string(formatters::v2s_f32_rounded(1)),
             tremolo_sync: EnumParam::new("Tremolo Sync", TremoloSyncChoice::Free),
+            // Read once per block: the bridge's modes take the mute's mass.
+            con_sordino: BoolParam::new("Con Sordino", false),
             editor_state: Default::default(),
             user_bridges: Default::default(),
             state_version: StateVersion,
@@ -553,6 +557,7 @@ impl ColophonyParams {
             tremolo_rate_hz: self.tremolo_rate.value() as f64,
             tremolo_sync: self.tremolo_sync.value().into(),
             tempo_bpm: None,
+            con_sordino: self.con_sordino.value(),
         }
     }
 

@@ -94,6 +94,10 @@ const FACTORY: &[(&str, &str)] = &[
         include_str!("../assets/presets/double-bass-arco.json"),
     ),
     (
+        "violin-con-sordino",
+        include_str!("../assets/presets/violin-con-sordino.json"),
+    ),
+    (
         "cello-pizzicato",
         include_str!("../assets/presets/cello-pizzicato.json"),
     ),

@@ -18,6 +18,31 @@ use std::f64::consts::PI;
 
 pub const MAX_BODY_MODES: usize = 6;
 
+/// A mute's mass over the bridge's effective mass in its rocking mode (the bridge hill):
+/// a 1.5 g rubber mute on a violin bridge whose rocking mode moves about 0.5 g (a
+/// choice; the same ratio for the larger instruments, whose mutes and bridges grow
+/// together).
+pub const MUTE_MASS_RATIO: f64 = 3.0;
+/// The bridge's own modes (the hill) start here, over the violin's frequencies (times
+/// the instrument's body scale), Hz: the modes a mute loads.
+pub const BRIDGE_MODES_FROM_HZ: f64 = 1500.0;
+
+/// `modes` with a mute on the bridge (con sordino): each bridge mode (from
+/// [`BRIDGE_MODES_FROM_HZ`] times `scale` up), a mass on a spring, carries the mute's
+/// mass too, so its frequency falls by `sqrt(1 / (1 + r))` and its amplitude by
+/// `1 / (1 + r)` (`r` = [`MUTE_MASS_RATIO`]); the body's own modes below are unchanged.
+pub fn muted(mode: BodyMode, scale: f64) -> BodyMode {
+    if mode.freq_hz < BRIDGE_MODES_FROM_HZ * scale {
+        return mode;
+    }
+    let loaded = 1.0 + MUTE_MASS_RATIO;
+    BodyMode {
+        freq_hz: mode.freq_hz / loaded.sqrt(),
+        q: mode.q,
+        gain: mode.gain / loaded,
+    }
+}
+
 pub use super::vocabulary::BodyMode;
 
 #[derive(Debug, Clone)]
@@ -115,6 +140,26 @@ pub fn body_from_bridge(bridge: &[BridgeMode]) -> (Vec<BodyMode>, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A mute loads the bridge's modes only: the bridge hill's frequency falls by
+    /// `sqrt(1 / (1 + r))` (half, for `r` = 3) and its amplitude by `1 / (1 + r)`; the
+    /// body's modes below the bridge's, A0 and the B1 pair, are the same for every
+    /// instrument.
+    #[test]
+    fn a_mute_loads_the_bridge_hill_and_leaves_the_body_modes() {
+        for kind in crate::dsp::vocabulary::InstrumentKind::ALL {
+            let scale = kind.spec().body_scale;
+            for mode in kind.body_modes() {
+                let m = muted(mode, scale);
+                if mode.freq_hz >= BRIDGE_MODES_FROM_HZ * scale {
+                    assert!((m.freq_hz / mode.freq_hz - 0.5).abs() < 1e-12);
+                    assert!((m.gain / mode.gain - 0.25).abs() < 1e-12);
+                } else {
+                    assert_eq!(m, mode, "{kind:?}");
+                }
+            }
+        }
+    }
     use crate::dsp::bridge_data::{
         shipped_cello_bridge, shipped_viola_bridge, shipped_violin_bridge,
     };

@@ -38,6 +38,8 @@ pub trait Engine {
     /// Whether released notes keep their fingers down (the sustain pedal): their strings
     /// ring on at the stopped pitch until it is let go (engines without fingers ignore it).
     fn set_fingers_held(&mut self, _held: bool) {}
+    /// A mute on the bridge (con sordino) or none (engines without one ignore it).
+    fn set_mute(&mut self, _on: bool) {}
     /// Pitch bend, semitones (engines without pitch ignore it).
     fn set_pitch_bend(&mut self, _semitones: f64) {}
     /// String `string`'s note's own expression (engines without strings ignore it).
@@ -89,6 +91,9 @@ impl<B: StringBank> Engine for FourStrings<B> {
     }
     fn set_pitch_bend(&mut self, semitones: f64) {
         FourStrings::set_pitch_bend(self, semitones)
+    }
+    fn set_mute(&mut self, on: bool) {
+        FourStrings::set_mute(self, on)
     }
     fn set_note_expression(&mut self, string: usize, expression: NoteExpression) {
         FourStrings::set_note_expression(self, string, expression)

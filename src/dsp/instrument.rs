@@ -82,6 +82,8 @@ pub struct WaveguideBank {
     skipping: bool,
     /// No string awake and the body rung out: a sample costs nothing.
     body_asleep: bool,
+    /// A mute on the bridge (con sordino, [`super::body::muted`]).
+    muted: bool,
 }
 
 /// The four waveguide strings of a violin, viola, cello or double bass with a shared bow, note
@@ -97,10 +99,29 @@ impl WaveguideBank {
 
     /// The body `kind` plays: its custom one if set, else the generic one.
     fn body_of(&self, kind: InstrumentKind) -> BodyModes {
-        match &self.custom_bodies[kind.index()] {
-            Some((modes, n)) => BodyModes::new(&modes[..*n], 1.0, self.sample_rate_hz),
-            None => BodyModes::new(&kind.body_modes(), 1.0, self.sample_rate_hz),
+        let mut modes = [BodyMode {
+            freq_hz: 0.0,
+            q: 1.0,
+            gain: 0.0,
+        }; MAX_BODY_MODES];
+        let n = match &self.custom_bodies[kind.index()] {
+            Some((custom, n)) => {
+                modes[..*n].copy_from_slice(&custom[..*n]);
+                *n
+            }
+            None => {
+                let generic = kind.body_modes();
+                modes[..generic.len()].copy_from_slice(&generic);
+                generic.len()
+            }
+        };
+        if self.muted {
+            let scale = kind.spec().body_scale;
+            for mode in &mut modes[..n] {
+                *mode = super::body::muted(*mode, scale);
+            }
         }
+        BodyModes::new(&modes[..n], 1.0, self.sample_rate_hz)
     }
 }
 
@@ -135,6 +156,13 @@ impl StringBank for WaveguideBank {
     }
 
     const PLUCKABLE: bool = true;
+
+    fn set_mute(&mut self, on: bool) {
+        if on != self.muted {
+            self.muted = on;
+            self.body = self.body_of(self.kind);
+        }
+    }
 
     fn pluck(&mut self, i: usize, displacement_m: f64, position_beta: f64, width: f64) -> bool {
         let string = &mut self.voices[i].string;
@@ -371,6 +399,7 @@ impl Instrument {
             decimator: HalfbandDecimator::new(),
             skipping: true,
             body_asleep: true,
+            muted: false,
         };
         Self::from_bank(
             bank,

@@ -91,6 +91,8 @@ pub trait StringBank {
     /// The stopping finger's reflection on string `i`, 0..=1 (1: pressed; less while it
     /// leaves the string). Only takes energy out.
     fn set_finger_reflection(&mut self, i: usize, reflection: f64);
+    /// A mute on the bridge (con sordino) or none; banks without one ignore it.
+    fn set_mute(&mut self, _on: bool) {}
     /// Whether [`StringBank::pluck`] plucks.
     const PLUCKABLE: bool = false;
     /// Plucks string `i` (pizzicato) as [`super::waveguide::WaveguideString::pluck`]:
@@ -448,6 +450,12 @@ impl<B: StringBank> FourStrings<B> {
         self.bank.wake(index);
         self.hands.probed = index;
         Some(index)
+    }
+
+    /// Puts a mute on the bridge (con sordino) or takes it off: the bridge's modes carry
+    /// its mass ([`super::body::muted`]). The thermal model's bridge takes none.
+    pub fn set_mute(&mut self, on: bool) {
+        self.bank.set_mute(on);
     }
 
     /// Stops the string for `note` and plucks it there (pizzicato): no bow lands, and a

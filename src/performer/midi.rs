@@ -144,6 +144,7 @@ impl Performer {
                 let down = (x * 127.0).round() >= 64.0;
                 self.set_articulation(if down { on } else { Articulation::Arco })
             }
+            Target::ConSordino => self.set_con_sordino((x * 127.0).round() >= 64.0),
             Target::Sustain => {
                 let held = (x * 127.0).round() >= 64.0;
                 for engine in self.engines() {

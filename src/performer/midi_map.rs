@@ -15,6 +15,7 @@
 //! | 102 | pizzicato (at 64 and up; arco below) |
 //! | 103 | tremolo (at 64 and up; arco below) |
 //! | 104 | spiccato (at 64 and up; arco below) |
+//! | 105 | con sordino: a mute on the bridge (at 64 and up; none below) |
 //!
 //! Each mapping turns the controller's value `x` (0..=1) into `min + (max - min) x^e` with
 //! `e = 3^-curve` (`curve` in -1..=1: 0 is linear, 1 rises fast from the bottom, -1 slowly);
@@ -39,6 +40,8 @@ pub const PIZZICATO_CC: u8 = 102;
 pub const TREMOLO_CC: u8 = 103;
 /// The controller that switches spiccato in the default map (undefined in MIDI too).
 pub const SPICCATO_CC: u8 = 104;
+/// The controller that puts the mute on in the default map (undefined in MIDI too).
+pub const CON_SORDINO_CC: u8 = 105;
 
 /// Most mappings a map holds.
 pub const MAX_MAPPINGS: usize = 16;
@@ -71,10 +74,12 @@ pub enum Target {
     Tremolo,
     /// Spiccato while the value is 0.5 or more, arco below it.
     Spiccato,
+    /// A mute on the bridge while the value is 0.5 or more (con sordino), none below.
+    ConSordino,
 }
 
 impl Target {
-    pub const ALL: [Target; 11] = [
+    pub const ALL: [Target; 12] = [
         Target::Dynamics,
         Target::VibratoDepth,
         Target::VibratoRate,
@@ -86,6 +91,7 @@ impl Target {
         Target::Pizzicato,
         Target::Tremolo,
         Target::Spiccato,
+        Target::ConSordino,
     ];
 
     /// The name the editor shows.
@@ -102,6 +108,7 @@ impl Target {
             Target::Pizzicato => "Pizzicato",
             Target::Tremolo => "Tremolo",
             Target::Spiccato => "Spiccato",
+            Target::ConSordino => "Con sordino (mute)",
         }
     }
 
@@ -200,6 +207,7 @@ impl Default for MidiMap {
             Mapping::new(PIZZICATO_CC, Target::Pizzicato),
             Mapping::new(TREMOLO_CC, Target::Tremolo),
             Mapping::new(SPICCATO_CC, Target::Spiccato),
+            Mapping::new(CON_SORDINO_CC, Target::ConSordino),
         ] {
             map.add(m);
         }

@@ -157,6 +157,8 @@ pub struct Performer {
     /// The articulation a keyswitch or controller chose, until the parameter moves
     /// ([`articulation`]).
     articulation_midi: Option<Articulation>,
+    /// The mute a controller put on or took off, until the parameter moves.
+    con_sordino_midi: Option<bool>,
 }
 
 impl Performer {
@@ -189,6 +191,7 @@ impl Performer {
             mpe: Mpe::default(),
             notes: [NoteSlot::default(); 128],
             articulation_midi: None,
+            con_sordino_midi: None,
         }
     }
 

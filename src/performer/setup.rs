@@ -60,6 +60,8 @@ pub struct Setup {
     pub tremolo_sync: super::articulation::TremoloSync,
     /// The host's tempo, beats a minute, where it gives one.
     pub tempo_bpm: Option<f64>,
+    /// A mute on the bridge (con sordino); a controller holds another until this changes.
+    pub con_sordino: bool,
 }
 
 impl Default for Setup {
@@ -85,6 +87,7 @@ impl Default for Setup {
             tremolo_rate_hz: super::articulation::TREMOLO_RATE_HZ,
             tremolo_sync: super::articulation::TremoloSync::Free,
             tempo_bpm: None,
+            con_sordino: false,
         }
     }
 }

@@ -93,6 +93,9 @@ impl Performer {
         if setup.articulation != self.setup.articulation {
             self.articulation_midi = None;
         }
+        if setup.con_sordino != self.setup.con_sordino {
+            self.con_sordino_midi = None;
+        }
 
         let range_was = self.bend_range();
         self.setup = *setup;
@@ -125,6 +128,7 @@ impl Performer {
             engine.set_settings(settings);
         }
         self.follow_tremolo();
+        self.apply_mute();
         self.apply_source(wanted);
         for engine in self.engines() {
             engine.update_sleep();
