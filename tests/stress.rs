@@ -1220,3 +1220,245 @@ fn paper_modal_exciter_under_a_static_law_does_not_run_away() {
         }
     }
 }
+
+/// A random script (found when the scripts' strategy changed) in which a lifted string
+/// gains energy: cello, hyperbolic law, 96 kHz, draft, one-sample blocks; string 3 (the A
+/// string, its stopped note released at the first lift) grows 0.5 % over one period
+/// 143 ms into a 322 ms lift with bow reversals every 3.6 ms. Not caused by the
+/// articulations (it fails the same with the keyswitches ignored). Ignored until fixed:
+/// `cargo test --test stress -- --ignored` replays it; `DROP=i,j,..` leaves steps out.
+#[test]
+#[ignore = "known: a lifted string gains 0.5 % in this replayed script"]
+fn a_lifted_string_never_gains_energy_in_a_replayed_random_script() {
+    let case = DspCase {
+        rate_hz: 96_000.0,
+        engine: Engine::Strings(InstrumentKind::Cello, FrictionModel::Hyperbolic),
+        quality: Quality::Draft,
+        blocks: vec![1],
+        seconds: 1.0,
+        script: vec![
+            Step {
+                gap_ms: 22.25810772896725,
+                action: Action::Op(Op::Midi([181, 1, 38])),
+            },
+            Step {
+                gap_ms: 0.024110630858828412,
+                action: Action::Op(Op::Midi([189, 58, 10])),
+            },
+            Step {
+                gap_ms: 13.18881987459375,
+                action: Action::Op(Op::Force(2.3380911721244066)),
+            },
+            Step {
+                gap_ms: 9.252891920138493,
+                action: Action::Op(Op::Velocity(1.5)),
+            },
+            Step {
+                gap_ms: 29.931979300091207,
+                action: Action::Op(Op::NoteOn(29)),
+            },
+            Step {
+                gap_ms: 14.512998616925177,
+                action: Action::Op(Op::Velocity(1.0613575246729638)),
+            },
+            Step {
+                gap_ms: 23.014693109858626,
+                action: Action::Op(Op::Law(Law::Point(FrictionModel::ElastoPlastic))),
+            },
+            Step {
+                gap_ms: 0.006252841260255705,
+                action: Action::Op(Op::NoteOn(31)),
+            },
+            Step {
+                gap_ms: 15.376837913085891,
+                action: Action::Op(Op::Force(0.0)),
+            },
+            Step {
+                gap_ms: 0.026162222276900543,
+                action: Action::Op(Op::Beta(0.17789529492172304)),
+            },
+            Step {
+                gap_ms: 0.017386994914582666,
+                action: Action::Op(Op::Force(8.136840585946977)),
+            },
+            Step {
+                gap_ms: 20.13231328002983,
+                action: Action::Op(Op::NoteOn(2)),
+            },
+            Step {
+                gap_ms: 11.032594465386135,
+                action: Action::Op(Op::Midi([191, 9, 15])),
+            },
+            Step {
+                gap_ms: 0.026400923269669828,
+                action: Action::Op(Op::Beta(0.45834151295499836)),
+            },
+            Step {
+                gap_ms: 16.701294873629013,
+                action: Action::Op(Op::Velocity(0.34937245764046837)),
+            },
+            Step {
+                gap_ms: 10.879345911468096,
+                action: Action::Op(Op::Resonator(Some(RubbedPreset::BrakeSqueal))),
+            },
+            Step {
+                gap_ms: 0.041535260412681296,
+                action: Action::Op(Op::Velocity(-1.2078090098674268)),
+            },
+            Step {
+                gap_ms: 19.55849984132769,
+                action: Action::Op(Op::Law(Law::Point(FrictionModel::Stribeck))),
+            },
+            Step {
+                gap_ms: 3.5951754916832197,
+                action: Action::Op(Op::Resonator(Some(RubbedPreset::Chalk))),
+            },
+            Step {
+                gap_ms: 0.009213519630742401,
+                action: Action::Op(Op::NoteOn(103)),
+            },
+            Step {
+                gap_ms: 22.301796183651874,
+                action: Action::Storm {
+                    first: 69,
+                    step: 2,
+                    count: 13,
+                    spacing: 2,
+                    release: true,
+                },
+            },
+            Step {
+                gap_ms: 19.856557802046655,
+                action: Action::Op(Op::NoteOn(100)),
+            },
+            Step {
+                gap_ms: 24.871281792380298,
+                action: Action::Op(Op::Beta(0.4358619978156424)),
+            },
+            Step {
+                gap_ms: 6.861140308270561,
+                action: Action::Storm {
+                    first: 127,
+                    step: 6,
+                    count: 21,
+                    spacing: 3,
+                    release: false,
+                },
+            },
+            Step {
+                gap_ms: 0.006614550781138204,
+                action: Action::Op(Op::NoteOn(55)),
+            },
+            Step {
+                gap_ms: 21.114815418961378,
+                action: Action::Op(Op::Tuning(11, 128.0)),
+            },
+            Step {
+                gap_ms: 26.058820441476577,
+                action: Action::Lift {
+                    ms: 144.9673219762818,
+                },
+            },
+            Step {
+                gap_ms: 0.04679142447666171,
+                action: Action::Op(Op::Force(3.539780860805667)),
+            },
+            Step {
+                gap_ms: 0.018110569853859726,
+                action: Action::Op(Op::Articulation(3)),
+            },
+            Step {
+                gap_ms: 20.523670506915895,
+                action: Action::Reversals {
+                    every_ms: 3.57130888581841,
+                    count: 50,
+                },
+            },
+            Step {
+                gap_ms: 18.02467687099325,
+                action: Action::Lift {
+                    ms: 322.8142453828874,
+                },
+            },
+            Step {
+                gap_ms: 0.013130127972079382,
+                action: Action::Op(Op::Beta(0.019999999552965164)),
+            },
+            Step {
+                gap_ms: 0.046087839898096714,
+                action: Action::Op(Op::ThermalBow(ThermalSettings {
+                    nodes: 14,
+                    width_m: 0.015622909092799791,
+                })),
+            },
+            Step {
+                gap_ms: 14.109171133810099,
+                action: Action::Op(Op::NoteOff(91)),
+            },
+            Step {
+                gap_ms: 6.746677310746337,
+                action: Action::Op(Op::Kind(InstrumentKind::Cello)),
+            },
+            Step {
+                gap_ms: 15.22831658135571,
+                action: Action::Op(Op::Velocity(0.5690144020647679)),
+            },
+            Step {
+                gap_ms: 0.019578117130584365,
+                action: Action::Storm {
+                    first: 62,
+                    step: 3,
+                    count: 5,
+                    spacing: 1,
+                    release: false,
+                },
+            },
+            Step {
+                gap_ms: 0.008900160351395849,
+                action: Action::Op(Op::Force(1.7913410887565047)),
+            },
+            Step {
+                gap_ms: 27.296349511945124,
+                action: Action::Op(Op::Beta(0.5)),
+            },
+            Step {
+                gap_ms: 19.90105297790056,
+                action: Action::Op(Op::Velocity(-1.2552483267376096)),
+            },
+            Step {
+                gap_ms: 4.540206631495378,
+                action: Action::Op(Op::Beta(0.019999999552965164)),
+            },
+            Step {
+                gap_ms: 19.529455510083803,
+                action: Action::Op(Op::Beta(0.059857003017666006)),
+            },
+            Step {
+                gap_ms: 14.87765926151678,
+                action: Action::Op(Op::NoteOn(109)),
+            },
+            Step {
+                gap_ms: 21.49838487637704,
+                action: Action::Op(Op::NoteOn(43)),
+            },
+            Step {
+                gap_ms: 0.9035624224576999,
+                action: Action::Op(Op::Bend(2.0)),
+            },
+        ],
+    };
+    let mut case = case;
+    if let Ok(drop) = std::env::var("DROP") {
+        let drop: Vec<usize> = drop.split(',').filter_map(|x| x.parse().ok()).collect();
+        case.script = case
+            .script
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| !drop.contains(i))
+            .map(|(_, s)| s.clone())
+            .collect();
+    }
+    if let Err(e) = render_dsp(&case) {
+        panic!("{e}");
+    }
+}
