@@ -203,6 +203,9 @@ pub(super) struct Hands {
     open_notes: [u8; STRINGS],
     /// Whether released notes keep their fingers down ([`FourStrings::set_fingers_held`]).
     fingers_held: bool,
+    /// Whether each string rings free: released, no finger on it (lifted, or an open
+    /// string's note): the left hand's bend and vibrato no longer reach it.
+    free: [bool; STRINGS],
 }
 
 /// One internal sample's work, handed to [`StringBank::render`]: a type with an
@@ -265,6 +268,7 @@ impl Hands {
             let left = left - 1;
             self.lifts[i] = left;
             if left == 0 {
+                self.free[i] = true;
                 bank.set_finger_reflection(i, 1.0);
                 self.fingering.start(i, self.open_notes[i]);
                 self.expressive[i] = false;
@@ -281,18 +285,28 @@ impl Hands {
         self.lifting = any;
     }
 
-    /// Starts lifting the finger from string `i` if a released stopped note holds it.
+    /// Starts lifting the finger from string `i` if a released stopped note holds it; a
+    /// released open string rings free at once.
     fn lift_finger(&mut self, i: usize) {
-        let stopped = matches!(self.fingering.note(i), Some(n) if n != self.open_notes[i]);
-        if stopped && !self.bows[i].bowed && self.lifts[i] == 0 {
-            self.lifts[i] = self.lift_samples;
-            self.lifting = true;
+        if self.bows[i].bowed {
+            return;
+        }
+        match self.fingering.note(i) {
+            Some(n) if n != self.open_notes[i] => {
+                if self.lifts[i] == 0 {
+                    self.lifts[i] = self.lift_samples;
+                    self.lifting = true;
+                }
+            }
+            Some(_) => self.free[i] = true,
+            None => {}
         }
     }
 
     /// Ends a finger lift under way on string `i` (a new note stops the string there):
     /// the finger presses again.
     fn keep_finger<B: StringBank>(&mut self, bank: &mut B, i: usize) {
+        self.free[i] = false;
         if self.lifts[i] != 0 {
             self.lifts[i] = 0;
             bank.set_finger_reflection(i, 1.0);
@@ -377,6 +391,7 @@ impl<B: StringBank> FourStrings<B> {
                 lift_samples: lift_samples(internal_rate_hz),
                 open_notes: kind.open_notes(),
                 fingers_held: false,
+                free: [false; STRINGS],
             },
             resampler,
             host_rate_hz,
@@ -431,6 +446,7 @@ impl<B: StringBank> FourStrings<B> {
         self.hands.weights =
             std::array::from_fn(|i| kind.string_weight_for(i, B::WEIGHT_REFERENCE_Z0));
         self.hands.open_notes = kind.open_notes();
+        self.hands.free = [false; STRINGS];
         self.press_every_finger();
     }
 
@@ -565,10 +581,16 @@ impl<B: StringBank> FourStrings<B> {
         }
     }
 
-    /// Lifts the bow from every string.
+    /// Lifts the bow from every string, and the fingers as [`FourStrings::note_off`] does
+    /// (unless they are held down).
     pub fn all_notes_off(&mut self) {
         for bow in &mut self.hands.bows {
             bow.bowed = false;
+        }
+        if !self.hands.fingers_held {
+            for i in 0..STRINGS {
+                self.hands.lift_finger(i);
+            }
         }
     }
 
@@ -630,7 +652,7 @@ impl<B: StringBank> FourStrings<B> {
     /// string that cannot follow has its bow lifted and rings on.
     pub(super) fn retune(&mut self) {
         for i in 0..STRINGS {
-            if self.hands.fingering.note(i).is_some() {
+            if self.hands.fingering.note(i).is_some() && !self.hands.free[i] {
                 let hz = self.hands.fingering.tuned_hz(i);
                 if !self.bank.bend(i, hz) {
                     self.hands.bows[i].bowed = false;
@@ -695,6 +717,7 @@ impl<B: StringBank> FourStrings<B> {
         self.hands.bows = [BowEnvelope::default(); STRINGS];
         self.hands.expressive = [false; STRINGS];
         self.hands.fingering.clear();
+        self.hands.free = [false; STRINGS];
         self.press_every_finger();
         if let Some(r) = &mut self.resampler {
             r.reset();
