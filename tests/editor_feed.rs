@@ -5,7 +5,7 @@
 //! (`assert_no_alloc`, the global allocator of the test build: Cargo.toml's
 //! dev-dependencies), which aborts the test binary on any allocation.
 
-use colophony::dsp::bridge_data::shipped_cello_bridge;
+use colophony::dsp::bridge_data::shipped_bridge;
 use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
 use colophony::dsp::vocabulary::{BowControl, InstrumentKind};
 use colophony::editor::nodes::NodeProbe;
@@ -26,7 +26,7 @@ const CHILD_ENV: &str = "COLOPHONY_EDITOR_FEED_ALLOCATING_CHILD";
 )]
 fn feeding_the_live_and_thermal_views_does_not_allocate() {
     let fs = 48_000.0;
-    let bridge = shipped_cello_bridge().modes;
+    let bridge = shipped_bridge(InstrumentKind::Cello).modes;
     let mut cello = ThermalInstrument::new(
         InstrumentKind::Cello,
         &bridge,

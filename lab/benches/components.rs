@@ -17,7 +17,7 @@ use colophony::dsp::thermal::{
 };
 use colophony::dsp::vocabulary::InstrumentKind;
 use colophony::dsp::waveguide::WaveguideString;
-use colophony_lab::admittance_fit::shipped_cello_bridge;
+use colophony_lab::admittance_fit::shipped_bridge;
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
 
@@ -189,7 +189,7 @@ fn thermal_tick(c: &mut Criterion) {
 }
 
 fn bridge_junction(c: &mut Criterion) {
-    let modes = shipped_cello_bridge().modes;
+    let modes = shipped_bridge(InstrumentKind::Cello).modes;
     let mut bridge = ModalBridge::new(&modes, FS).expect("valid");
     let z = [0.9, 0.7, 0.5, 0.35];
     let mut leaving = [[0.0; 2]; 4];

@@ -150,7 +150,7 @@ fn host_rate_rows() -> Result<Vec<String>, String> {
 /// strings with both polarisations coupled at the shipped generic bridge, the C string
 /// bowed (paper B's Figure 6 bow), resampled to 48 kHz; and a double stop (C and G bowed).
 pub fn table1() -> Result<String, String> {
-    use crate::admittance_fit::shipped_cello_bridge;
+    use crate::admittance_fit::shipped_bridge;
     let paper = [
         (3, 4.3),
         (6, 9.2),
@@ -160,7 +160,7 @@ pub fn table1() -> Result<String, String> {
         (60, 334.0),
     ];
     let bow = FIG6_BOW;
-    let bridge = shipped_cello_bridge().modes;
+    let bridge = shipped_bridge(InstrumentKind::Cello).modes;
     let audio_s = 1.0;
     let mut lines = vec![
         format!("The plugin's thermal cello (4 strings x 2 polarisations, {}-mode bridge, resampled to 48 kHz), 1 s of audio after a 0.2 s onset, best of three, % of one core:", bridge.len()),
@@ -336,7 +336,7 @@ pub fn scenes() -> Result<String, String> {
     ];
     // The point-bow cello (paper A's hyperbolic law) and paper B's thermal cello (default
     // bow: 10 nodes over 1 cm).
-    let bridge = crate::admittance_fit::shipped_cello_bridge().modes;
+    let bridge = crate::admittance_fit::shipped_bridge(InstrumentKind::Cello).modes;
     // Returns the output, the asleep share and the seconds spent playing (building the
     // instrument is the host's activation, not playing: untimed).
     let render =
@@ -625,7 +625,7 @@ pub fn peers(seconds: f64, dir: &std::path::Path) -> Result<String, String> {
     // through the performer, and paper B's whole cello at N_B = 60 (`bench scenes` and
     // `bench table1` measure the same).
     let (silent_s, bowed_s) = performer_silence_cost(4.0);
-    let bridge = crate::admittance_fit::shipped_cello_bridge().modes;
+    let bridge = crate::admittance_fit::shipped_bridge(InstrumentKind::Cello).modes;
     let (table1, _) = thermal_cello_cost(60, &bridge, FIG6_BOW, 1.0)?;
     let goals = [
         (

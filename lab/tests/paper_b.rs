@@ -6,6 +6,7 @@ use colophony::dsp::thermal::{
     HairParams, NodeReal, ThermalBowControl, ThermalParams, ThermalString, ThermalStringSpec,
     FTCS_TARGET,
 };
+use colophony::dsp::vocabulary::InstrumentKind;
 
 /// Paper B's Figure 6 bow on the cello's open C: v_b 0.15 m/s, beta 0.07, 300 N/m.
 const FIG6_BOW: ThermalBowControl = ThermalBowControl {
@@ -344,7 +345,7 @@ fn the_thermal_bow_renders_at_the_host_rate_in_tune_and_bounded() {
 fn bowing_one_string_makes_the_open_strings_ring_through_the_bridge() {
     use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
     use colophony::dsp::vocabulary::{BowControl, InstrumentKind};
-    use colophony_lab::admittance_fit::shipped_cello_bridge;
+    use colophony_lab::admittance_fit::shipped_bridge;
     let run = |bridge: &[colophony::dsp::bridge::BridgeMode]| {
         let settings = ThermalSettings {
             nodes: 6,
@@ -365,7 +366,7 @@ fn bowing_one_string_makes_the_open_strings_ring_through_the_bridge() {
         energies
     };
     // The shipped generic cello bridge (assets/bridges/cello-generic.json).
-    let coupled = run(&shipped_cello_bridge().modes);
+    let coupled = run(&shipped_bridge(InstrumentKind::Cello).modes);
     // A bridge without modes is rigid: no coupling.
     let rigid = run(&[]);
     println!("string energies after 0.5 s bowing C, generic bridge: {coupled:?}; rigid bridge: {rigid:?}");
@@ -385,8 +386,8 @@ fn the_thermal_instrument_rings_in_tune_and_flattens_with_bow_force() {
     use colophony::analysis::{cents, peak_frequency_hz, rms};
     use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
     use colophony::dsp::vocabulary::{midi_to_hz, BowControl, InstrumentKind};
-    use colophony_lab::admittance_fit::shipped_cello_bridge;
-    let bridge = shipped_cello_bridge().modes;
+    use colophony_lab::admittance_fit::shipped_bridge;
+    let bridge = shipped_bridge(InstrumentKind::Cello).modes;
     let mut g_string = Vec::new();
     for (note, force_n) in [
         (36u8, 2.0),
@@ -512,7 +513,7 @@ fn largest_difference_db(a: &[f64], b: &[f64], peak: f64) -> f64 {
 
 #[test]
 fn quiet_polarisations_sleep_while_others_ring_and_waking_matches_never_sleeping() {
-    use colophony_lab::admittance_fit::shipped_cello_bridge;
+    use colophony_lab::admittance_fit::shipped_bridge;
     // On a rigid bridge nothing reaches the open strings: while C is bowed, their six
     // polarisations sleep, and the output is the same bits as computing them.
     let score = [(0, true, 36u8)];
@@ -529,7 +530,7 @@ fn quiet_polarisations_sleep_while_others_ring_and_waking_matches_never_sleeping
     // sounds. A short A-string note rings out; its polarisations and the other strings'
     // fall asleep one by one at the end, the whole instrument last; then C is bowed again
     // and wakes everything.
-    let bridge = shipped_cello_bridge().modes;
+    let bridge = shipped_bridge(InstrumentKind::Cello).modes;
     let fs = 48_000.0;
     let s = |t: f64| (t * fs) as usize;
     let score = [(0, true, 57u8), (s(0.3), false, 57), (s(30.0), true, 36)];
@@ -625,7 +626,7 @@ fn the_lone_strings_fundamental_decays_at_its_q1_terminations_included() {
 fn every_note_speaks_with_every_bow_setting_at_every_host_rate() {
     use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
     use colophony::dsp::vocabulary::{BowControl, InstrumentKind};
-    use colophony_lab::admittance_fit::{shipped_cello_bridge, shipped_violin_bridge};
+    use colophony_lab::admittance_fit::shipped_bridge;
     let bow = BowControl {
         velocity_m_per_s: 0.1,
         force_n: 0.5,
@@ -633,8 +634,8 @@ fn every_note_speaks_with_every_bow_setting_at_every_host_rate() {
     };
     for kind in InstrumentKind::ALL {
         let bridge = match kind {
-            InstrumentKind::Cello => shipped_cello_bridge(),
-            _ => shipped_violin_bridge(),
+            InstrumentKind::Cello => shipped_bridge(InstrumentKind::Cello),
+            _ => shipped_bridge(InstrumentKind::Violin),
         };
         let (low, high) = kind.note_range();
         for (nodes, width_m) in [(1, 0.02), (1, 0.005), (60, 0.005), (60, 0.02)] {
@@ -732,8 +733,8 @@ fn the_thermal_grid_never_cools_below_ambient_or_blows_up_at_the_fastest_slips()
 fn the_thermal_instrument_plays_the_same_motion_and_pitch_at_every_host_rate() {
     use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
     use colophony::dsp::vocabulary::{midi_to_hz, BowControl, InstrumentKind};
-    use colophony_lab::admittance_fit::shipped_cello_bridge;
-    let bridge = shipped_cello_bridge().modes;
+    use colophony_lab::admittance_fit::shipped_bridge;
+    let bridge = shipped_bridge(InstrumentKind::Cello).modes;
     let bow = BowControl::default();
     for note in [50u8, 57] {
         let f0 = midi_to_hz(note as f64);

@@ -140,6 +140,7 @@ pub fn body_from_bridge(bridge: &[BridgeMode]) -> (Vec<BodyMode>, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::dsp::vocabulary::InstrumentKind;
 
     /// A mute loads the bridge's modes only: the bridge hill's frequency falls by
     /// `sqrt(1 / (1 + r))` (half, for `r` = 3) and its amplitude by `1 / (1 + r)`; the
@@ -147,7 +148,7 @@ mod tests {
     /// instrument.
     #[test]
     fn a_mute_loads_the_bridge_hill_and_leaves_the_body_modes() {
-        for kind in crate::dsp::vocabulary::InstrumentKind::ALL {
+        for kind in InstrumentKind::ALL {
             let scale = kind.spec().body_scale;
             for mode in kind.body_modes() {
                 let m = muted(mode, scale);
@@ -160,9 +161,7 @@ mod tests {
             }
         }
     }
-    use crate::dsp::bridge_data::{
-        shipped_cello_bridge, shipped_viola_bridge, shipped_violin_bridge,
-    };
+    use crate::dsp::bridge_data::shipped_bridge;
 
     #[test]
     fn a_bridge_reduces_to_its_strongest_horizontal_modes() {
@@ -205,9 +204,9 @@ mod tests {
     #[test]
     fn the_shipped_bridges_reduce_to_stable_bodies_that_keep_most_of_their_admittance() {
         for bridge in [
-            shipped_cello_bridge(),
-            shipped_viola_bridge(),
-            shipped_violin_bridge(),
+            shipped_bridge(InstrumentKind::Cello),
+            shipped_bridge(InstrumentKind::Viola),
+            shipped_bridge(InstrumentKind::Violin),
         ] {
             let (modes, kept) = body_from_bridge(&bridge.modes);
             println!(

@@ -5,8 +5,9 @@
 //! `admittance_fit`).
 //!
 //! ```
-//! use colophony::dsp::bridge_data::{parse_bridge, shipped_cello_bridge};
-//! let cello = shipped_cello_bridge();
+//! use colophony::dsp::bridge_data::{parse_bridge, shipped_bridge};
+//! use colophony::dsp::vocabulary::InstrumentKind;
+//! let cello = shipped_bridge(InstrumentKind::Cello);
 //! assert!(!cello.modes.is_empty());
 //! let (one, ports) = parse_bridge(
 //!     r#"{"modes": [{"freq_hz": 300, "bandwidth_hz": 20, "gain": [[0.5]]}]}"#,
@@ -208,9 +209,9 @@ mod tests {
         // A larger body: its air mode (the lowest) below the violin's, above the cello's.
         let lowest = |b: BridgeModes| b.modes.iter().map(|m| m.freq_hz).fold(f64::MAX, f64::min);
         let (violin, viola, cello) = (
-            lowest(shipped_violin_bridge()),
-            lowest(shipped_viola_bridge()),
-            lowest(shipped_cello_bridge()),
+            lowest(shipped_bridge(InstrumentKind::Violin)),
+            lowest(shipped_bridge(InstrumentKind::Viola)),
+            lowest(shipped_bridge(InstrumentKind::Cello)),
         );
         assert!(cello < viola && viola < violin, "{cello} {viola} {violin}");
     }
@@ -283,19 +284,4 @@ pub fn shipped_bridge(kind: InstrumentKind) -> BridgeModes {
     parse_bridge(SHIPPED_BRIDGES[kind.index()])
         .unwrap_or_else(|e| panic!("the shipped {} bridge is invalid: {e}", kind.name()))
         .0
-}
-
-/// The shipped cello bridge, `assets/bridges/cello-generic.json`.
-pub fn shipped_cello_bridge() -> BridgeModes {
-    shipped_bridge(InstrumentKind::Cello)
-}
-
-/// The shipped viola bridge, `assets/bridges/viola-generic.json`.
-pub fn shipped_viola_bridge() -> BridgeModes {
-    shipped_bridge(InstrumentKind::Viola)
-}
-
-/// The shipped violin bridge, `assets/bridges/violin-generic.json`.
-pub fn shipped_violin_bridge() -> BridgeModes {
-    shipped_bridge(InstrumentKind::Violin)
 }

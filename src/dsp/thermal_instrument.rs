@@ -39,7 +39,7 @@
 //! ```
 //! use colophony::dsp::vocabulary::{BowControl, InstrumentKind};
 //! use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
-//! let bridge = colophony::dsp::bridge_data::shipped_cello_bridge().modes;
+//! let bridge = colophony::dsp::bridge_data::shipped_bridge(InstrumentKind::Cello).modes;
 //! let mut cello = ThermalInstrument::new(InstrumentKind::Cello, &bridge, 48_000.0, ThermalSettings::default()).unwrap();
 //! cello.note_on(50);
 //! let frame = cello.tick(BowControl::default());

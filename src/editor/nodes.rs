@@ -424,7 +424,7 @@ mod tests {
         use crate::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
         use crate::dsp::vocabulary::{BowControl, InstrumentKind};
         let fs = 48_000.0;
-        let bridge = crate::dsp::bridge_data::shipped_cello_bridge().modes;
+        let bridge = crate::dsp::bridge_data::shipped_bridge(InstrumentKind::Cello).modes;
         let settings = ThermalSettings::default();
         let mut cello =
             ThermalInstrument::new(InstrumentKind::Cello, &bridge, fs, settings).unwrap();

@@ -228,7 +228,7 @@ fn repeats_every_period(onsets: &[usize], n: usize, period: f32, sample_rate: f3
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::dsp::bridge_data::shipped_cello_bridge;
+    use crate::dsp::bridge_data::shipped_bridge;
     use crate::dsp::friction::FrictionModel;
     use crate::dsp::instrument::Instrument;
     use crate::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
@@ -389,7 +389,7 @@ mod tests {
     #[test]
     fn thermal_cello_d3_at_one_newton_is_helmholtz_motion() {
         // Paper B's bow: the middle node's velocity includes the hair's compliance.
-        let bridge = shipped_cello_bridge().modes;
+        let bridge = shipped_bridge(InstrumentKind::Cello).modes;
         let mut cello = ThermalInstrument::new(
             InstrumentKind::Cello,
             &bridge,

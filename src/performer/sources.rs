@@ -218,7 +218,7 @@ mod tests {
             let frames: Vec<Frame> = (0..(0.5 * FS) as usize).map(|_| p.tick(bow)).collect();
             frames
         };
-        let violin = bridge_data::shipped_violin_bridge();
+        let violin = bridge_data::shipped_bridge(InstrumentKind::Violin);
         let (modes, _) = crate::dsp::body::body_from_bridge(&violin.modes);
         let generic = play(None);
         let chosen = play(Some(violin));

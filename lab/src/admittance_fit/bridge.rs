@@ -6,9 +6,8 @@ use nalgebra::Complex;
 use std::f64::consts::TAU;
 
 pub use colophony::dsp::bridge_data::{
-    bridge_json, load_bridge, load_bridge_ports, nearest_psd, parse_bridge, shipped_cello_bridge,
-    shipped_violin_bridge, symmetric_eigenvalues, write_atomically, write_bridge, BridgeMode,
-    BridgeModes,
+    bridge_json, load_bridge, load_bridge_ports, nearest_psd, parse_bridge, shipped_bridge,
+    symmetric_eigenvalues, write_atomically, write_bridge, BridgeMode, BridgeModes,
 };
 
 /// A complex admittance value (s/kg).

@@ -70,9 +70,8 @@ mod fit;
 pub mod synthetic;
 
 pub use bridge::{
-    bridge_json, load_bridge, load_bridge_ports, mode_response, parse_bridge, shipped_cello_bridge,
-    shipped_violin_bridge, symmetric_eigenvalues, write_bridge, Admittance, BridgeMode,
-    BridgeModes, C64,
+    bridge_json, load_bridge, load_bridge_ports, mode_response, parse_bridge, shipped_bridge,
+    symmetric_eigenvalues, write_bridge, Admittance, BridgeMode, BridgeModes, C64,
 };
 pub use data::{
     admittance_csv, entry_names, entry_position, parse_admittance_csv, read_admittance_csv,
