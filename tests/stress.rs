@@ -53,10 +53,13 @@ use colophony::dsp::thermal_instrument::{
     ThermalInstrument, ThermalSettings, MAX_NODES, RECONFIGURE_FADE_S,
 };
 use colophony::dsp::vocabulary::{BowControl, InstrumentKind, BOW_RAMP_S, STRINGS};
-use colophony::params::{bow_force_range, bow_position_range, bow_velocity_range};
+use colophony::params::{
+    bow_force_range, bow_position_range, bow_velocity_range, ArticulationChoice,
+};
 use colophony::performer::{Articulation, Performer, Setup, ThermalNodes};
 use colophony::quality::Quality;
 use host::{Event, HostedPlugin, Score};
+use nice_plug::prelude::Enum;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, RngSeed, TestCaseError, TestError, TestRunner};
 use std::cell::RefCell;
@@ -1034,10 +1037,9 @@ fn render_plugin(case: &PluginCase) -> Result<Vec<f32>, String> {
             }
             Op::Tuning(key, semitones) => push(Event::Tuning { key, semitones }),
             Op::ConSordino(on) => push(plugin.text("Con Sordino", if on { "On" } else { "Off" })),
-            Op::Articulation(i) => push(plugin.text(
-                "Articulation",
-                ["Arco", "Pizzicato", "Tremolo", "Spiccato"][i],
-            )),
+            Op::Articulation(i) => {
+                push(plugin.text("Articulation", ArticulationChoice::variants()[i]))
+            }
         }
     }
     let mut left = Vec::with_capacity(frames);

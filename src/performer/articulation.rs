@@ -197,15 +197,10 @@ impl Performer {
         if self.instrument.kind() != self.setup.instrument {
             self.instrument.set_kind(self.setup.instrument);
         }
-        let key = note as usize & 127;
-        if let Some(string) = self
+        let string = self
             .instrument
-            .pluck(note, pluck_for(self.setup.instrument, velocity))
-        {
-            self.held[key] = true;
-            self.last_note = Some(note);
-            self.notes[key].string = Some(string as u8);
-        }
+            .pluck(note, pluck_for(self.setup.instrument, velocity));
+        self.took(note, string);
     }
 }
 

@@ -71,11 +71,7 @@ impl Performer {
                     Some(seconds) => self.instrument.note_on_gliding(note, seconds),
                     None => self.instrument.note_on(note),
                 };
-                if let Some(string) = landed {
-                    self.held[key] = true;
-                    self.last_note = Some(note);
-                    self.notes[key].string = Some(string as u8);
-                }
+                self.took(note, landed);
             }
             Source::Thermal(k) => {
                 self.choose_auto_nodes(note);
@@ -87,11 +83,7 @@ impl Performer {
                         Some(seconds) => engine.note_on_gliding(note, seconds),
                         None => engine.note_on(note),
                     };
-                    if let Some(string) = landed {
-                        self.held[key] = true;
-                        self.last_note = Some(note);
-                        self.notes[key].string = Some(string as u8);
-                    }
+                    self.took(note, landed);
                 }
             }
             Source::Rubbed(_) => {
@@ -106,6 +98,17 @@ impl Performer {
         }
         self.express(note);
         self.refresh_others();
+    }
+
+    /// The strings took `note` on `string` (nothing if `None`: the note is ignored): its
+    /// key is held and remembers the string.
+    pub(super) fn took(&mut self, note: u8, string: Option<usize>) {
+        if let Some(string) = string {
+            let key = note as usize & 127;
+            self.held[key] = true;
+            self.last_note = Some(note);
+            self.notes[key].string = Some(string as u8);
+        }
     }
 
     /// One bow touches at most two adjacent strings: a note landing on `string` lifts the

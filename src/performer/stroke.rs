@@ -183,11 +183,6 @@ impl Stroke {
         }
     }
 
-    /// Whether the bow is in tremolo.
-    pub fn is_tremolo(&self) -> bool {
-        self.tremolo_samples != 0
-    }
-
     /// A separate note with velocity `velocity` (a [`velocity_step`]): a new stroke from
     /// rest in the direction `mode` gives.
     pub fn start(&mut self, mode: StrokeMode, velocity: f64) {
