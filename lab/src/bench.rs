@@ -543,14 +543,42 @@ fn child_cpu_s(cmd: &mut std::process::Command, what: &str) -> Result<f64, Strin
     Ok(children_cpu_s() - before)
 }
 
-/// `colophony bench peers`: Colophony against its peers (STK's `Bowed`, Faust). Whole processes each render `seconds`
-/// of cello D3 at 48 kHz to a file: this binary's `render` with the hyperbolic (default)
-/// and the elasto-plastic string (paper A), and STK's `stk::Bowed` at 146.8 Hz
-/// (`assets/peers/stk_bowed.cpp`, one render per process, raw f32 out, built with g++ -O2
-/// against libstk-dev: `scripts/install-peers.sh` installs it). User + system CPU of each
-/// process, best of three, the three interleaved in each round so load on a shared machine
-/// hits them alike. Prints each one's CPU seconds and its ratio to STK's. Unix only (the
-/// children's CPU time comes from getrusage).
+/// Rounds of [`peers`]: every process runs this many times, interleaved.
+const PEER_ROUNDS: usize = 5;
+
+/// How a [`peers`] row is judged.
+#[derive(Clone, Copy)]
+enum PeerGoal {
+    /// CPU over STK's, at most this.
+    TimesStk(f64),
+    /// CPU over the audio's length, at most this many % of one core.
+    PercentOfCore(f64),
+    /// Measured for the table, no goal.
+    None,
+}
+
+/// One whole process [`peers`] times: a command for `seconds` of audio.
+struct PeerRow {
+    name: &'static str,
+    /// Seconds of audio the timed process renders.
+    seconds: f64,
+    goal: PeerGoal,
+    command: Box<dyn Fn(f64) -> std::process::Command>,
+}
+
+/// `colophony bench peers`: Colophony against its peers and its speed goals, whole
+/// processes timed in one run. Each row is a separate process rendering cello D3 at
+/// 48 kHz (or a scene of paper B's instrument, through `bench peer-scene:NAME`): STK's
+/// `stk::Bowed` at 146.8 Hz (`assets/peers/stk_bowed.cpp`, built with g++ -O2 against
+/// libstk-dev: `scripts/install-peers.sh` installs it), this binary's `render` with the
+/// hyperbolic string (the default) and with the elasto-plastic string at the plugin's
+/// tolerance (the good preset's) and at the reference's, and paper B's cello and a quartet
+/// of thermal instruments. User + system CPU of each process, [`PEER_ROUNDS`] rounds with
+/// the rows interleaved in each, so load on a shared machine hits them alike; the best,
+/// the spread (worst over best) and, against STK, the ratio of the bests and its range
+/// over the rounds. Where valgrind is installed, instructions per output sample beside
+/// them (callgrind, the difference of two render lengths: setup cancels). Then silence
+/// through the performer, timed in-process. Unix only (children's CPU from getrusage).
 pub fn peers(seconds: f64, dir: &std::path::Path) -> Result<String, String> {
     if !(seconds.is_finite() && seconds > 0.0 && seconds <= 3600.0) {
         return Err(format!("--seconds must be within 0..=3600, got {seconds}"));
@@ -563,110 +591,304 @@ pub fn peers(seconds: f64, dir: &std::path::Path) -> Result<String, String> {
         format!("{e} (STK is needed: scripts/install-peers.sh, or apt-get install libstk-dev g++)")
     })?;
     let me = std::env::current_exe().map_err(|e| e.to_string())?;
-    let secs = format!("{seconds}");
     let d3_hz = format!("{}", colophony::dsp::vocabulary::midi_to_hz(50.0));
-    // `quality`: a solver preset (its Newton tolerance); without one, `render` solves the
-    // bristle laws to the reference's tolerance as well, the precision bench's setting.
-    let ours = |friction: &str, quality: Option<&str>| {
-        let mut c = std::process::Command::new(&me);
-        c.args([
-            "render",
-            "--note",
-            "D3",
-            "--seconds",
-            &secs,
-            "--friction",
-            friction,
-        ]);
-        if let Some(q) = quality {
-            c.args(["--quality", q]);
+    let render_row =
+        |name: &'static str, friction: &'static str, quality: Option<&'static str>, goal| {
+            let (me, dir) = (me.clone(), dir.to_path_buf());
+            PeerRow {
+                name,
+                seconds,
+                goal,
+                command: Box::new(move |secs: f64| {
+                    let mut c = std::process::Command::new(&me);
+                    c.args(["render", "--note", "D3", "--friction", friction])
+                        .args(["--seconds", &format!("{secs}")]);
+                    if let Some(q) = quality {
+                        c.args(["--quality", q]);
+                    }
+                    c.arg("--out").arg(
+                        dir.join(format!("{friction}-{}.wav", quality.unwrap_or("reference"))),
+                    );
+                    c
+                }),
+            }
+        };
+    // Paper B's scenes cost tens of times a point-bow string: a tenth of the audio.
+    let scene_row = |name: &'static str, scene: &'static str, goal| {
+        let me = me.clone();
+        PeerRow {
+            name,
+            seconds: (seconds / 10.0).max(1.0),
+            goal,
+            command: Box::new(move |secs: f64| {
+                let mut c = std::process::Command::new(&me);
+                c.args(["bench", &format!("peer-scene:{scene}")])
+                    .args(["--seconds", &format!("{secs}")]);
+                c
+            }),
         }
-        c.arg("--out")
-            .arg(dir.join(format!("{friction}-{}.wav", quality.unwrap_or("default"))));
-        c
     };
-    let mut rows: Vec<(&str, std::process::Command)> = vec![
-        ("STK Bowed", {
-            let mut c = std::process::Command::new(&stk);
-            c.args([secs.as_str(), "48000", d3_hz.as_str()])
-                .arg(dir.join("stk.f32"))
-                .arg("1");
-            c
-        }),
-        ("hyperbolic string (default)", ours("hyperbolic", None)),
-        (
-            "elasto-plastic string (paper A)",
-            ours("elasto-plastic", None),
+    let rows = vec![
+        PeerRow {
+            name: "STK Bowed",
+            seconds,
+            goal: PeerGoal::None,
+            command: Box::new({
+                let (stk, dir, d3_hz) = (stk.clone(), dir.to_path_buf(), d3_hz.clone());
+                move |secs: f64| {
+                    let mut c = std::process::Command::new(&stk);
+                    c.args([format!("{secs}").as_str(), "48000", d3_hz.as_str()])
+                        .arg(dir.join("stk.f32"))
+                        .arg("1");
+                    c
+                }
+            }),
+        },
+        render_row(
+            "hyperbolic string (default)",
+            "hyperbolic",
+            None,
+            PeerGoal::TimesStk(0.5),
         ),
         // The plugin solves to the good preset's tolerance (1e-4 m/s, src/quality.rs; its
         // error is in docs/precision.md): what the plugin's elasto-plastic string costs.
-        (
+        render_row(
             "elasto-plastic, plugin tolerance",
-            ours("elasto-plastic", Some("good")),
+            "elasto-plastic",
+            Some("good"),
+            PeerGoal::TimesStk(1.5),
+        ),
+        render_row(
+            "elasto-plastic, reference tol.",
+            "elasto-plastic",
+            None,
+            PeerGoal::None,
+        ),
+        scene_row(
+            "thermal cello N_B 60, C bowed",
+            "cello-c",
+            PeerGoal::PercentOfCore(3.0),
+        ),
+        scene_row(
+            "thermal cello N_B 60, C+G",
+            "cello-cg",
+            PeerGoal::PercentOfCore(5.0),
+        ),
+        scene_row(
+            "thermal quartet, plugin quality",
+            "quartet",
+            PeerGoal::PercentOfCore(15.0),
         ),
     ];
-    let mut best = vec![f64::INFINITY; rows.len()];
-    for _round in 0..3 {
-        for (i, (name, cmd)) in rows.iter_mut().enumerate() {
-            best[i] = best[i].min(child_cpu_s(cmd, name)?);
+    let mut cpu = vec![Vec::with_capacity(PEER_ROUNDS); rows.len()];
+    for _round in 0..PEER_ROUNDS {
+        for (row, times) in rows.iter().zip(&mut cpu) {
+            times.push(child_cpu_s(&mut (row.command)(row.seconds), row.name)?);
         }
     }
-    let mut lines = vec![format!(
-        "{seconds} s of cello D3 at 48 kHz to a file, whole process, user + system CPU, best of 3 (interleaved)"
-    )];
-    for ((name, _), cpu) in rows.iter().zip(&best) {
+    let instructions: Vec<Option<f64>> = if valgrind_available() {
+        rows.iter()
+            .map(|row| {
+                // Long enough that the difference is the steady sound, short enough for
+                // valgrind (about 50 times slower).
+                let short = if row.seconds < seconds { 0.25 } else { 2.0 };
+                instructions_per_sample(&*row.command, short, 2.0 * short, row.name).ok()
+            })
+            .collect()
+    } else {
+        vec![None; rows.len()]
+    };
+    let best = |t: &[f64]| t.iter().copied().fold(f64::INFINITY, f64::min);
+    let worst = |t: &[f64]| t.iter().copied().fold(0.0, f64::max);
+    let stk_best = best(&cpu[0]);
+    let mut lines = vec![
+        format!(
+            "Whole processes, user + system CPU, best of {PEER_ROUNDS} (interleaved); spread = worst / best - 1; \
+             cello D3 at 48 kHz ({seconds} s; paper B's scenes {} s)",
+            rows[4].seconds
+        ),
+        String::new(),
+        "| what | CPU best (s) | spread | measured | range over the rounds | instructions a sample | goal | met |".into(),
+        "|---|---|---|---|---|---|---|---|".into(),
+    ];
+    for ((row, times), instr) in rows.iter().zip(&cpu).zip(&instructions) {
+        let (b, w) = (best(times), worst(times));
+        let (measured, range, goal, met) = match row.goal {
+            PeerGoal::TimesStk(_) | PeerGoal::None if row.seconds == seconds => {
+                let per_round: Vec<f64> = times.iter().zip(&cpu[0]).map(|(t, s)| t / s).collect();
+                let ratio = b / stk_best;
+                let goal_text = match row.goal {
+                    PeerGoal::TimesStk(g) => format!("<= {g}x STK"),
+                    _ => String::new(),
+                };
+                let met = match row.goal {
+                    PeerGoal::TimesStk(g) => {
+                        if ratio <= g {
+                            "yes"
+                        } else {
+                            "no"
+                        }
+                    }
+                    _ => "",
+                };
+                (
+                    format!("{ratio:.2}x STK"),
+                    format!("{:.2}-{:.2}x", best(&per_round), worst(&per_round)),
+                    goal_text,
+                    met,
+                )
+            }
+            _ => {
+                let percent = 100.0 * b / row.seconds;
+                let (goal_text, met) = match row.goal {
+                    PeerGoal::PercentOfCore(g) => {
+                        (format!("<= {g} %"), if percent <= g { "yes" } else { "no" })
+                    }
+                    _ => (String::new(), ""),
+                };
+                (
+                    format!("{percent:.1} % of a core"),
+                    format!("{:.1}-{:.1} %", percent, 100.0 * w / row.seconds),
+                    goal_text,
+                    met,
+                )
+            }
+        };
         lines.push(format!(
-            "{name:<32} {cpu:8.3} s  {:6.1}x real time  {:5.2}x STK",
-            seconds / cpu,
-            cpu / best[0]
+            "| {} | {b:.3} | {:.0} % | {measured} | {range} | {} | {goal} | {met} |",
+            row.name,
+            100.0 * (w / b - 1.0),
+            instr.map_or("-".into(), |i| format!("{i:.0}")),
         ));
     }
-    // The comparison table, from this run: the two strings against STK above, silence
-    // through the performer, and paper B's whole cello at N_B = 60 (`bench scenes` and
-    // `bench table1` measure the same).
     let (silent_s, bowed_s) = performer_silence_cost(4.0);
-    let bridge = crate::admittance_fit::shipped_bridge(InstrumentKind::Cello).modes;
-    let (table1, _) = thermal_cello_cost(60, &bridge, FIG6_BOW, 1.0)?;
-    let goals = [
-        (
-            "hyperbolic string (default)",
-            best[1] / best[0],
-            "x STK",
-            0.8,
-        ),
-        (
-            "elasto-plastic string (paper A)",
-            best[2] / best[0],
-            "x STK",
-            3.0,
-        ),
-        (
-            "silence, % of one bowed string",
-            100.0 * silent_s / bowed_s,
-            "%",
-            1.0,
-        ),
-        (
-            "thermal cello N_B 60, C bowed",
-            100.0 * table1[0],
-            "% of a core",
-            10.0,
-        ),
-        (
-            "double stop C+G at N_B 60",
-            100.0 * table1[1],
-            "% of a core",
-            15.0,
-        ),
-    ];
-    lines.push(String::new());
-    lines.push("| what | measured | goal | met |".into());
-    lines.push("|---|---|---|---|".into());
-    for (what, value, unit, goal) in goals {
-        lines.push(format!(
-            "| {what} | {value:.2} {unit} | <= {goal} | {} |",
-            if value <= goal { "yes" } else { "no" }
-        ));
+    let silence = 100.0 * silent_s / bowed_s;
+    lines.push(format!(
+        "| silence through the performer (in-process, best of five) | | | {silence:.2} % of one bowed string | | | <= 1 % | {} |",
+        if silence <= 1.0 { "yes" } else { "no" }
+    ));
+    if instructions.iter().all(Option::is_none) {
+        lines.push(String::new());
+        lines.push("(instruction counts need valgrind: apt-get install valgrind)".into());
     }
     Ok(lines.join("\n"))
+}
+
+/// Whether `valgrind` runs here.
+fn valgrind_available() -> bool {
+    std::process::Command::new("valgrind")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success())
+}
+
+/// Instructions per 48 kHz output sample of `command`: callgrind's totals for `short` and
+/// `long` seconds of audio, their difference over the difference of the samples.
+fn instructions_per_sample(
+    command: &dyn Fn(f64) -> std::process::Command,
+    short: f64,
+    long: f64,
+    what: &str,
+) -> Result<f64, String> {
+    let count = |secs: f64| -> Result<f64, String> {
+        let inner = command(secs);
+        let mut c = std::process::Command::new("valgrind");
+        c.args(["--tool=callgrind", "--callgrind-out-file=/dev/null"])
+            .arg(inner.get_program())
+            .args(inner.get_args());
+        let out = c.output().map_err(|e| format!("valgrind: {e}"))?;
+        if !out.status.success() {
+            return Err(format!("valgrind on {what} failed"));
+        }
+        // "==PID== Collected : N" on stderr.
+        String::from_utf8_lossy(&out.stderr)
+            .lines()
+            .find_map(|l| l.split("Collected :").nth(1))
+            .and_then(|n| n.trim().parse::<f64>().ok())
+            .ok_or_else(|| format!("no instruction count from callgrind on {what}"))
+    };
+    let (a, b) = (count(short)?, count(long)?);
+    Ok((b - a) / ((long - short) * 48_000.0))
+}
+
+/// `colophony bench peer-scene:NAME --seconds S`: renders one of [`peers`]' scenes of
+/// paper B's instrument for `seconds` of audio at 48 kHz (the attack included) and
+/// prints nothing (the parent times the process): `cello-c` (the cello's open C, `N_B`
+/// 60 over 1 cm, paper B's Figure 6 bow), `cello-cg` (the double stop C+G, the same) and
+/// `quartet` (two violins, a viola and a cello, each bowing one note at the plugin's
+/// default quality, the plugin's default bow).
+pub fn peer_scene(name: &str, seconds: f64) -> Result<String, String> {
+    use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
+    if !(seconds.is_finite() && seconds > 0.0 && seconds <= 3600.0) {
+        return Err(format!("--seconds must be within 0..=3600, got {seconds}"));
+    }
+    let fs = 48_000.0;
+    let build =
+        |kind: InstrumentKind, nodes: usize, notes: &[u8]| -> Result<ThermalInstrument, String> {
+            let bridge = colophony::dsp::bridge_data::shipped_bridge(kind).modes;
+            let mut i = ThermalInstrument::new(
+                kind,
+                &bridge,
+                fs,
+                ThermalSettings {
+                    nodes,
+                    width_m: 0.01,
+                },
+            )?;
+            for &note in notes {
+                i.note_on(note);
+            }
+            Ok(i)
+        };
+    let good = colophony::quality::Quality::Good
+        .fixed_thermal_nodes()
+        .expect("the good preset fixes its node count");
+    let (mut players, bow) = match name {
+        "cello-c" => (vec![build(InstrumentKind::Cello, 60, &[36])?], FIG6_BOW),
+        "cello-cg" => (vec![build(InstrumentKind::Cello, 60, &[36, 43])?], FIG6_BOW),
+        "quartet" => (
+            vec![
+                build(InstrumentKind::Violin, good, &[76])?,
+                build(InstrumentKind::Violin, good, &[67])?,
+                build(InstrumentKind::Viola, good, &[60])?,
+                build(InstrumentKind::Cello, good, &[48])?,
+            ],
+            BowControl::default(),
+        ),
+        other => {
+            return Err(format!(
+                "unknown peer scene '{other}': cello-c, cello-cg or quartet"
+            ))
+        }
+    };
+    let block = 512;
+    let mut out = vec![0.0; block];
+    let mut mix = vec![0.0; block];
+    let blocks = (seconds * fs / block as f64).ceil() as usize;
+    // Each player's sum of squares over the last second: every one must sound.
+    let mut energy = vec![0.0; players.len()];
+    let last_second = blocks.saturating_sub((fs / block as f64) as usize);
+    for b in 0..blocks {
+        mix.iter_mut().for_each(|x| *x = 0.0);
+        for (p, e) in players.iter_mut().zip(&mut energy) {
+            p.process(bow, &mut out);
+            mix.iter_mut().zip(&out).for_each(|(m, x)| *m += x);
+            if b >= last_second {
+                *e += out.iter().map(|x| x * x).sum::<f64>();
+            }
+        }
+    }
+    let levels: Vec<String> = energy
+        .iter()
+        .map(|e| format!("{:.1}", 10.0 * (e / fs).log10()))
+        .collect();
+    if !energy.iter().all(|e| e.is_finite() && *e > 0.0) {
+        return Err(format!(
+            "peer scene {name}: a player is silent or not finite ({levels:?} dB)"
+        ));
+    }
+    Ok(format!(
+        "{name}: {seconds} s; each player's level over the last second {} dB",
+        levels.join(", ")
+    ))
 }

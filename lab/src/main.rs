@@ -406,6 +406,10 @@ fn main() -> ExitCode {
                 seconds.unwrap_or(300.0),
                 &out.unwrap_or_else(|| std::env::temp_dir().join("colophony-peers")),
             ),
+            scene if scene.starts_with("peer-scene:") => colophony_lab::bench::peer_scene(
+                &scene["peer-scene:".len()..],
+                seconds.unwrap_or(10.0),
+            ),
             "precision" => match out {
                 Some(dir) => colophony_lab::precision::run(&dir, quick),
                 None => Err("bench precision needs --out DIR".into()),

@@ -45,9 +45,19 @@ pub fn muted(mode: BodyMode, scale: f64) -> BodyMode {
 
 pub use super::vocabulary::BodyMode;
 
+/// The modes as parallel band-pass biquads ([`Bandpass`]'s transposed direct form II),
+/// stored lane by lane so that one sample's update of every mode is a few vector
+/// operations. Unused lanes hold zero coefficients and stay at zero.
 #[derive(Debug, Clone)]
 pub struct BodyModes {
-    filters: [Bandpass; MAX_BODY_MODES],
+    b0: [f64; MAX_BODY_MODES],
+    /// `-b0`, `-a1` and `-a2` of each mode's biquad (negation is exact, so the update
+    /// gives the bits [`Bandpass::tick`] gives).
+    neg_b0: [f64; MAX_BODY_MODES],
+    neg_a1: [f64; MAX_BODY_MODES],
+    a2: [f64; MAX_BODY_MODES],
+    s1: [f64; MAX_BODY_MODES],
+    s2: [f64; MAX_BODY_MODES],
     gains: [f64; MAX_BODY_MODES],
     count: usize,
     direct_gain: f64,
@@ -56,16 +66,28 @@ pub struct BodyModes {
 impl BodyModes {
     /// Builds the body at `sample_rate_hz`; modes at or above 0.45 fs are dropped.
     pub fn new(modes: &[BodyMode], direct_gain: f64, sample_rate_hz: f64) -> Self {
+        let zero = [0.0; MAX_BODY_MODES];
         let mut body = Self {
-            filters: [Bandpass::default(); MAX_BODY_MODES],
-            gains: [0.0; MAX_BODY_MODES],
+            b0: zero,
+            neg_b0: zero,
+            neg_a1: zero,
+            a2: zero,
+            s1: zero,
+            s2: zero,
+            gains: zero,
             count: 0,
             direct_gain,
         };
         for mode in modes.iter().take(MAX_BODY_MODES) {
             if mode.freq_hz < 0.45 * sample_rate_hz {
-                body.filters[body.count] = Bandpass::new(mode.freq_hz, mode.q, sample_rate_hz);
-                body.gains[body.count] = mode.gain;
+                let (b0, a1, a2) =
+                    Bandpass::new(mode.freq_hz, mode.q, sample_rate_hz).coefficients();
+                let k = body.count;
+                body.b0[k] = b0;
+                body.neg_b0[k] = -b0;
+                body.neg_a1[k] = -a1;
+                body.a2[k] = a2;
+                body.gains[k] = mode.gain;
                 body.count += 1;
             }
         }
@@ -74,30 +96,51 @@ impl BodyModes {
 
     #[inline]
     pub fn tick(&mut self, bridge_force_n: f64) -> f64 {
-        let mut y = self.direct_gain * bridge_force_n;
-        for (f, g) in self.filters[..self.count].iter_mut().zip(&self.gains) {
-            y += g * f.tick(bridge_force_n);
+        let x = bridge_force_n;
+        let mut out = [0.0; MAX_BODY_MODES];
+        for k in 0..MAX_BODY_MODES {
+            let y = self.b0[k] * x + self.s1[k];
+            self.s1[k] = self.neg_a1[k] * y + self.s2[k];
+            self.s2[k] = self.neg_b0[k] * x - self.a2[k] * y;
+            out[k] = y;
+        }
+        // Summed in mode order, as the modes were added one by one.
+        let mut y = self.direct_gain * x;
+        for k in 0..self.count.min(MAX_BODY_MODES) {
+            y += self.gains[k] * out[k];
         }
         y
     }
 
     pub fn reset(&mut self) {
-        self.filters.iter_mut().for_each(Bandpass::reset);
+        self.s1 = [0.0; MAX_BODY_MODES];
+        self.s2 = [0.0; MAX_BODY_MODES];
     }
 
-    /// Samples until every mode would ring out below `level` with no more input.
+    /// Samples until every mode would ring out below `level` with no more input: each
+    /// mode's poles have radius `sqrt(a2)`, so its state falls by that factor per sample
+    /// (0 if already below).
     pub fn samples_below(&self, level: f64) -> f64 {
-        self.filters[..self.count]
-            .iter()
-            .map(|f| f.samples_below(level))
+        (0..self.count)
+            .map(|k| {
+                let mag = self.state_magnitude(k);
+                let r = self.a2[k].max(0.0).sqrt();
+                if mag <= level || !(r > 0.0 && r < 1.0) {
+                    0.0
+                } else {
+                    (level / mag).ln() / r.ln()
+                }
+            })
             .fold(0.0, f64::max)
     }
 
     /// Whether every mode has rung out below `level` (state magnitude, N-scale).
     pub fn is_quiet(&self, level: f64) -> bool {
-        self.filters[..self.count]
-            .iter()
-            .all(|f| f.state_magnitude() < level)
+        (0..self.count).all(|k| self.state_magnitude(k) < level)
+    }
+
+    fn state_magnitude(&self, k: usize) -> f64 {
+        self.s1[k].abs().max(self.s2[k].abs())
     }
 }
 

@@ -86,6 +86,69 @@ impl Allpass1 {
     }
 }
 
+/// A chain of identical first-order allpass sections ([`Allpass1`]) sharing one
+/// coefficient: a stiff string's dispersion. The same arithmetic as ticking the sections
+/// one by one, with the coefficient loaded once.
+#[derive(Debug, Clone, Copy)]
+pub struct AllpassChain<const N: usize> {
+    a: f64,
+    stages: usize,
+    s: [f64; N],
+}
+
+impl<const N: usize> Default for AllpassChain<N> {
+    fn default() -> Self {
+        Self {
+            a: 0.0,
+            stages: 0,
+            s: [0.0; N],
+        }
+    }
+}
+
+impl<const N: usize> AllpassChain<N> {
+    /// `stages` sections (at most `N`) of coefficient `a`; the states are kept.
+    pub fn set(&mut self, stages: usize, a: f64) {
+        self.stages = stages.min(N);
+        self.a = a;
+    }
+
+    pub fn stages(&self) -> usize {
+        self.stages
+    }
+
+    pub fn coefficient(&self) -> f64 {
+        self.a
+    }
+
+    #[inline]
+    pub fn tick(&mut self, mut x: f64) -> f64 {
+        let a = self.a;
+        for s in &mut self.s[..self.stages] {
+            let y = a * x + *s;
+            *s = x - a * y;
+            x = y;
+        }
+        x
+    }
+
+    /// Phase delay in samples at `w` rad/sample: the sections' delays summed one by one.
+    pub fn phase_delay(&self, w: f64) -> f64 {
+        let one = Allpass1::phase_delay(self.a, w);
+        (0..self.stages).map(|_| one).sum()
+    }
+
+    /// What the sections hold (see [`Allpass1::stored_energy`]), summed one by one.
+    pub fn stored_energy(&self) -> f64 {
+        let scale = 1.0 - self.a * self.a;
+        self.s[..self.stages].iter().map(|s| s * s / scale).sum()
+    }
+
+    pub fn reset(&mut self) {
+        self.s = [0.0; N];
+    }
+}
+
 /// One-pole lowpass loss filter `H(z) = g (1 - p) / (1 - p z^-1)`, 0 <= p < 1.
 /// Its gain is largest at DC (`g`), which is kept below 1 so the loop is passive.
 #[derive(Debug, Clone, Copy, Default)]
@@ -219,6 +282,11 @@ impl Bandpass {
             s1: 0.0,
             s2: 0.0,
         }
+    }
+
+    /// `(b0, a1, a2)`: `H(z) = b0 (1 - z^-2) / (1 + a1 z^-1 + a2 z^-2)`.
+    pub fn coefficients(&self) -> (f64, f64, f64) {
+        (self.b0, self.a1, self.a2)
     }
 
     #[inline]

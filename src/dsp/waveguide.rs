@@ -63,7 +63,7 @@
 //! ```
 
 use super::delay::{split_loop, DelayLine};
-use super::filters::{Allpass1, OnePoleLoss};
+use super::filters::{Allpass1, AllpassChain, OnePoleLoss};
 use super::friction::{BowInput, FrictionContact, LoadLine};
 use std::f64::consts::PI;
 
@@ -121,8 +121,7 @@ pub struct WaveguideString {
     fundamental_hz: f64,
     playable: bool,
     loss: OnePoleLoss,
-    dispersion: [Allpass1; MAX_DISPERSION_STAGES],
-    dispersion_stages: usize,
+    dispersion: AllpassChain<MAX_DISPERSION_STAGES>,
     /// Most dispersion sections the fit may use.
     dispersion_cap: usize,
     fraction: Allpass1,
@@ -239,8 +238,7 @@ impl WaveguideString {
             fundamental_hz: 0.0,
             playable: false,
             loss: OnePoleLoss::default(),
-            dispersion: [Allpass1::default(); MAX_DISPERSION_STAGES],
-            dispersion_stages: 0,
+            dispersion: AllpassChain::default(),
             dispersion_cap: DEFAULT_DISPERSION_STAGES,
             fraction: Allpass1::default(),
             torsion: Torsion {
@@ -355,10 +353,7 @@ impl WaveguideString {
         let b = self.spec.inharmonicity_open * (f1_hz / self.spec.open_hz).powi(2);
         let budget = n - 2.0 * 2.0 - 0.5 - self.loss.phase_delay(w1);
         let (stages, a) = fit_dispersion(f1_hz, b, fs, &self.loss, budget, self.dispersion_cap);
-        self.dispersion_stages = stages;
-        for ap in &mut self.dispersion[..stages] {
-            ap.a = a;
-        }
+        self.dispersion.set(stages, a);
         self.playable = true;
         self.bend_to(f1_hz);
     }
@@ -376,7 +371,7 @@ impl WaveguideString {
 
     /// Dispersion allpass sections in use.
     pub fn dispersion_stages(&self) -> usize {
-        self.dispersion_stages
+        self.dispersion.stages()
     }
 
     /// The stopping finger has left: the string sounds `f1_hz` (its open pitch), longer,
@@ -456,10 +451,7 @@ impl WaveguideString {
         let fs = self.sample_rate_hz;
         let n = fs / f1_hz;
         let w1 = 2.0 * PI * f1_hz / fs;
-        let dispersion_delay: f64 = self.dispersion[..self.dispersion_stages]
-            .iter()
-            .map(|ap| Allpass1::phase_delay(ap.a, w1))
-            .sum();
+        let dispersion_delay = self.dispersion.phase_delay(w1);
         // 2 M + d = remainder, with the Thiran delay d in [0.5, 2.5)
         let remainder = n - self.loss.phase_delay(w1) - dispersion_delay;
         let m = split_loop(remainder).0.clamp(2, self.capacity - 2);
@@ -484,10 +476,7 @@ impl WaveguideString {
     pub fn loop_delay_at(&self, w: f64) -> f64 {
         2.0 * self.m as f64
             + Allpass1::phase_delay(self.fraction.a, w)
-            + self.dispersion[..self.dispersion_stages]
-                .iter()
-                .map(|ap| Allpass1::phase_delay(ap.a, w))
-                .sum::<f64>()
+            + self.dispersion.phase_delay(w)
             + self.loss.phase_delay(w)
     }
 
@@ -546,7 +535,7 @@ impl WaveguideString {
         self.pluck_tail = 0.0;
         self.pluck_tail_samples = 0;
         self.loss.reset();
-        self.dispersion.iter_mut().for_each(Allpass1::reset);
+        self.dispersion.reset();
         self.fraction.reset();
         self.torsion.filter.state = 0.0;
         self.hair.state = 0.0;
@@ -567,10 +556,7 @@ impl WaveguideString {
             })
             .sum();
         let filters = self.fraction.stored_energy()
-            + self.dispersion[..self.dispersion_stages]
-                .iter()
-                .map(Allpass1::stored_energy)
-                .sum::<f64>()
+            + self.dispersion.stored_energy()
             + self.loss.stored_energy();
         let pluck = self.pluck_tail * self.pluck_tail * self.pluck_tail_samples as f64;
         self.spec.z0_kg_per_s / self.sample_rate_hz * (waves + filters + pluck)
@@ -615,9 +601,7 @@ impl WaveguideString {
         let at_bridge = self.left[at(m - 1)];
         let at_nut = self.right[at(m - 1)];
         let mut reflected = self.fraction.tick(at_nut);
-        for ap in &mut self.dispersion[..self.dispersion_stages] {
-            reflected = ap.tick(reflected);
-        }
+        reflected = self.dispersion.tick(reflected);
         reflected = -self.loss.tick(reflected) * self.finger_reflection;
         if self.pluck_tail_samples != 0 {
             reflected += self.pluck_tail;
@@ -979,7 +963,7 @@ mod tests {
         let mut s = WaveguideString::new(cello_d(), fs, 60.0);
         s.set_dispersion_cap(cap);
         let stages = s.dispersion_stages();
-        let a = s.dispersion[0].a;
+        let a = s.dispersion.coefficient();
         let g = |f: f64| {
             let w = 2.0 * PI * f / fs;
             stages as f64 * Allpass1::phase_delay(a, w) + s.loss.phase_delay(w)
