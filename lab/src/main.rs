@@ -5,7 +5,9 @@ use colophony::dsp::friction::FrictionModel;
 use colophony::dsp::rubbed::RubbedPreset;
 use colophony::dsp::vocabulary::{BowControl, InstrumentKind};
 use colophony::quality::Quality;
-use colophony_lab::render::{check, parse_note, render_frames, write_wav, RenderSettings, WavOut};
+use colophony_lab::render::{
+    check, parse_note, render_blocks, render_frames, write_wav, RenderSettings, WavOut,
+};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -345,15 +347,16 @@ fn main() -> ExitCode {
                 check(&settings)
                     .and_then(|()| WavOut::create(&out, settings.sample_rate_hz, probe))
                     .and_then(|mut wav| {
-                        render_frames(
-                            &settings,
-                            |instrument| {
-                                if let Some(t) = tolerance {
-                                    instrument.set_newton_tolerance(t);
-                                }
-                            },
-                            |frame| wav.push(frame),
-                        )?;
+                        let configure = |instrument: &mut colophony::dsp::instrument::Instrument| {
+                            if let Some(t) = tolerance {
+                                instrument.set_newton_tolerance(t);
+                            }
+                        };
+                        if probe {
+                            render_frames(&settings, configure, |frame| wav.push(frame))?;
+                        } else {
+                            render_blocks(&settings, configure, |audio| wav.push_audio(audio))?;
+                        }
                         wav.finish()
                     })
             };

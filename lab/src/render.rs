@@ -204,14 +204,12 @@ pub fn render_with(
     Ok(out)
 }
 
-/// [`render_with`], handing each frame to `each` as it is made instead of keeping them
-/// (the command line's `render` streams them to the file). Returns the bowed string's
-/// Newton statistics.
-pub fn render_frames(
+/// The instrument `settings` bows, set up (`configure` last) with its note on; the
+/// frames to render and the frame where the bow lifts.
+fn prepare(
     settings: &RenderSettings,
     configure: impl FnOnce(&mut Instrument),
-    mut each: impl FnMut(&Frame) -> Result<(), RenderError>,
-) -> Result<SolverStats, RenderError> {
+) -> Result<(Instrument, usize, Option<usize>), RenderError> {
     check(settings)?;
     let fs = settings.sample_rate_hz;
     let frames = (settings.seconds * fs).round() as usize;
@@ -235,17 +233,60 @@ pub fn render_frames(
     instrument.set_reference_pitch(settings.reference_hz);
     configure(&mut instrument);
     instrument.note_on(settings.note);
+    Ok((instrument, frames, release))
+}
+
+/// `--release` lifts the bow only: the finger stays down and the stopped string rings
+/// on at its pitch (its free decay, which the tools measure).
+fn lift_bow(instrument: &mut Instrument, note: u8) {
+    instrument.set_fingers_held(true);
+    instrument.note_off(note);
+}
+
+/// Bows `settings` on the point-bow instrument frame by frame (audio and probe), handing
+/// each frame to `each`; returns the probed string's solver statistics.
+pub fn render_frames(
+    settings: &RenderSettings,
+    configure: impl FnOnce(&mut Instrument),
+    mut each: impl FnMut(&Frame) -> Result<(), RenderError>,
+) -> Result<SolverStats, RenderError> {
+    let (mut instrument, frames, release) = prepare(settings, configure)?;
     for i in 0..frames {
         if i % BLOCK == 0 {
             instrument.update_sleep();
         }
         if Some(i) == release {
-            // `--release` lifts the bow only: the finger stays down and the stopped string
-            // rings on at its pitch (its free decay, which the tools measure).
-            instrument.set_fingers_held(true);
-            instrument.note_off(settings.note);
+            lift_bow(&mut instrument, settings.note);
         }
         each(&instrument.tick(settings.bow))?;
+    }
+    Ok(instrument.probed_solver_stats())
+}
+
+/// [`render_frames`]' audio a block at a time (the same samples, without the probe):
+/// what `colophony render` writes to a 16-bit file.
+pub fn render_blocks(
+    settings: &RenderSettings,
+    configure: impl FnOnce(&mut Instrument),
+    mut each: impl FnMut(&[f64]) -> Result<(), RenderError>,
+) -> Result<SolverStats, RenderError> {
+    let (mut instrument, frames, release) = prepare(settings, configure)?;
+    let mut block = [0.0; BLOCK];
+    for start in (0..frames).step_by(BLOCK) {
+        let end = (start + BLOCK).min(frames);
+        instrument.update_sleep();
+        // The bow lifts within this block: the samples before it, then the rest.
+        let split = release
+            .filter(|r| (start..end).contains(r))
+            .unwrap_or(start);
+        if split > start {
+            instrument.process(settings.bow, &mut block[..split - start]);
+        }
+        if release == Some(split) {
+            lift_bow(&mut instrument, settings.note);
+        }
+        instrument.process(settings.bow, &mut block[split - start..end - start]);
+        each(&block[..end - start])?;
     }
     Ok(instrument.probed_solver_stats())
 }
@@ -505,6 +546,19 @@ impl WavOut {
             .and_then(|()| w.write_sample(frame.bow_point_velocity_m_per_s as f32))
             .and_then(|()| w.write_sample(frame.friction_force_n as f32))
             .map_err(|e| io_error(&self.path, &e))
+    }
+
+    /// Appends mono audio (a file made without the probe).
+    pub fn push_audio(&mut self, audio: &[f64]) -> Result<(), RenderError> {
+        debug_assert!(!self.probe, "push_audio writes the 16-bit mono file");
+        let Some(w) = self.writer.as_mut() else {
+            return Ok(());
+        };
+        let mut block = w.get_i16_writer(audio.len() as u32);
+        for &x in audio {
+            block.write_sample(to_i16(x));
+        }
+        block.flush().map_err(|e| io_error(&self.path, &e))
     }
 
     /// Completes the file and gives it its name.
