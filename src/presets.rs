@@ -507,7 +507,7 @@ mod tests {
         for (id, text) in FACTORY {
             Preset::parse(text).unwrap_or_else(|e| panic!("{id}: {e}"));
         }
-        // The issue asks for at least 12 musical and research presets.
+        // At least 12 musical and research presets.
         assert!(FACTORY.len() >= 12);
     }
 

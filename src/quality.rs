@@ -175,6 +175,7 @@ mod tests {
         assert_eq!(auto_nodes(c, open_c, 0.1, 0.01), GOOD_NODES);
         // About 138 samples per slip (c = 2 * 0.69 m * 65.4 Hz, 10 nodes per cm).
         let s = auto_target_samples_per_slip();
+        // From the figures above: 90.25 m/s x 1000 nodes/m x beta 0.1 / 65.41 Hz = 137.98.
         assert!((s - 138.0).abs() < 1.0, "{s}");
     }
 
@@ -202,6 +203,7 @@ mod tests {
                     let n = auto_nodes(kind, f0, beta, 0.01);
                     let s = samples_per_slip(kind, n, f0, beta, 0.01);
                     if n < MAX_NODES {
+                        // 1e-9: f64 rounding of the samples-per-slip arithmetic.
                         assert!(s >= auto_target_samples_per_slip() - 1e-9);
                     }
                     if n > AUTO_MIN_NODES {

@@ -212,6 +212,8 @@ fn dragging_the_pad_sets_velocity_and_force_within_one_gesture_each() {
     // Both parameters are where the mapping puts the release point.
     let (v, force) = PadMapping::default().pos_to_values(rect, end);
     let p = &f.params;
+    // The host keeps the value as a normalized f32 (the force on a skewed range): its
+    // rounding is far below 1e-3.
     assert!(
         (p.bow_velocity.value() - v).abs() < 1e-3,
         "velocity {} expected {v}",
@@ -222,7 +224,8 @@ fn dragging_the_pad_sets_velocity_and_force_within_one_gesture_each() {
         "force {} expected {force}",
         p.bow_force.value()
     );
-    // Up and to the right of the default (0.1 m/s, 1 N).
+    // Up and to the right of the default (0.1 m/s, 1 N). The release point maps to 1.05 m/s
+    // (0.85 of the width) and 2.5 N (0.01 N x 1000^0.8, 0.8 of the height).
     assert!(p.bow_velocity.value() > 0.9 && p.bow_force.value() > 1.5);
 }
 
@@ -238,6 +241,7 @@ fn dragging_to_the_bottom_edge_lifts_the_bow_and_left_reverses_it() {
     assert_one_gesture(&f.recorder.calls(), "Bow Velocity");
     assert_one_gesture(&f.recorder.calls(), "Bow Force");
     assert_eq!(f.params.bow_force.value(), 0.0);
+    // 0.1 of the width maps to -1.2 m/s.
     assert!(f.params.bow_velocity.value() < -1.0);
 }
 
@@ -262,6 +266,8 @@ fn a_click_on_the_pad_is_one_complete_gesture() {
     let calls = f.recorder.calls();
     assert_eq!(assert_one_gesture(&calls, "Bow Velocity"), 1, "{calls:?}");
     assert_eq!(assert_one_gesture(&calls, "Bow Force"), 1, "{calls:?}");
+    // A quarter of the width maps to -0.75 m/s; the normalized f32 round trip rounds far
+    // below 0.01.
     assert!((f.params.bow_velocity.value() + 0.75).abs() < 0.01);
 }
 

@@ -1,7 +1,7 @@
-//! Golden renders (issue 17, item 7): a few seconds of every source the plugin plays
-//! (the four point laws on the waveguide strings, paper B's thermal cello, each rubbed
-//! object), rendered through the CLAP build in the headless host with notes, a bend, a
-//! string choice and bow automation, must keep the same bits across refactoring.
+//! Golden renders: a few seconds of every source the plugin plays (the four point laws
+//! on the waveguide strings, paper B's thermal cello, each rubbed object), rendered
+//! through the CLAP build in the headless host with notes, a bend, a string choice and
+//! bow automation, must keep the same bits across refactoring.
 //!
 //! Each render is kept as a 64-bit FNV-1a hash of its samples' bits, with its RMS and
 //! peak for the failure message, in `tests/golden/renders.txt`. A change meant to be
@@ -13,8 +13,8 @@
 //! its `sin`, `exp`, `pow` variants by the CPU's features (FMA or not), which can change
 //! last bits that a bowed string's chaotic moments then amplify. The file records the
 //! features it was made on; on a machine that differs the test compares each render's
-//! RMS and peak within 2 % instead (the rounding changes of this repository's own history
-//! moved them by 0.2 % at most) and says so.
+//! RMS and peak within 2 % instead (last-bit rounding changes of this code move them by
+//! 0.2 % at most) and says so.
 
 mod host;
 
@@ -174,6 +174,7 @@ fn every_source_renders_the_same_bits_as_recorded() {
             g != *w
         } else {
             let ((gr, gp), (wr, wp)) = (levels(g), levels(w));
+            // Rounding changes move RMS and peak by 0.2 % at most (module doc).
             (gr / wr - 1.0).abs() > 0.02 || (gp / wp - 1.0).abs() > 0.02
         };
         if differs {

@@ -151,10 +151,13 @@ fn a_lifted_string_rings_down_to_exact_silence_without_subnormals() {
         "violin MIDI 100: last non-zero sample at {:.3} s",
         last_sound as f64 / fs
     );
+    // -60 dBFS, as in the test above: a sounding note is far louder.
     assert!(
         rms(&x[..secs(0.3, fs) as usize]) > 1e-3,
         "the note did not sound"
     );
+    // At about 60 ms a time constant, 3.2 s is over 50 of them: far past the strings'
+    // sleep threshold.
     assert!(
         last_sound < secs(3.5, fs) as usize,
         "still not silent 3.2 s after the bow lifted (last sample {last_sound})"
@@ -380,6 +383,7 @@ fn the_same_input_gives_bit_identical_output_for_any_instance_and_block_size() {
     let (score, frames) = busy_score(&mut first);
     let reference = first.render(frames, BLOCK, &score);
     write_wav("busy-score", FS, &reference);
+    // -60 dBFS: a default note peaks near -12 dBFS, so a score this quiet did not sound.
     assert!(
         rms(&channel_f64(&reference, 0)) > 1e-3,
         "the score is silent"
@@ -472,6 +476,7 @@ fn notes_outside_the_instruments_range_are_ignored_silently() {
             .at(0, Event::note_on(lowest))
             .at(secs(0.2, FS), Event::note_off(lowest));
         let out = plugin.render(secs(0.3, FS) as usize, BLOCK, &playable);
+        // -60 dBFS: a sounding note is far louder.
         assert!(
             rms(&channel_f64(&out, 0)) > 1e-3,
             "{}: no sound from MIDI {lowest} after the ignored notes",
@@ -580,8 +585,10 @@ fn friction_model_and_resonator_switch_during_notes_without_allocation_nan_or_cl
     let peak = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     assert_no_click_at(&x, &switch_at);
     println!("peak {peak:.3}");
+    // Full scale: the safety limiter keeps the output below 1.
     assert!(peak < 1.0, "peak {peak}");
     for (from, to) in [(12_000, 24_000), (48_100, 60_000), (72_100, 84_000)] {
+        // -60 dBFS: a sounding note is far louder.
         assert!(rms(&x[from..to]) > 1e-3, "silent between {from} and {to}");
     }
 }
@@ -617,6 +624,7 @@ fn saved_state_restores_parameters_and_reproduces_output_exactly() {
         .at(secs(0.3, FS), Event::note_off(69));
     let a = first.render(secs(0.5, FS) as usize, BLOCK, &score);
     let b = second.render(secs(0.5, FS) as usize, BLOCK, &score);
+    // -60 dBFS: a default note peaks near -12 dBFS.
     assert!(
         rms(&channel_f64(&a, 0)) > 1e-3,
         "the restored patch is silent"
@@ -644,6 +652,7 @@ fn saved_state_restores_parameters_and_reproduces_output_exactly() {
         let note = Score::new().at(0, Event::note_on(69));
         let out = second.render(secs(0.2, FS) as usize, BLOCK, &note);
         assert!(out.iter().flatten().all(|x| x.is_finite()));
+        // -60 dBFS: a sounding note is far louder.
         assert!(
             rms(&channel_f64(&out, 0)) > 1e-3,
             "silent after a bad state"
@@ -674,6 +683,7 @@ fn extreme_sample_rates_and_block_sizes_stay_finite_and_free_of_subnormals() {
             assert_eq!(bad, None, "{sample_rate} Hz, block {block}");
             let peak = out.iter().flatten().fold(0.0f32, |m, x| m.max(x.abs()));
             println!("{sample_rate} Hz, block {block}: peak {peak:.3}");
+            // Full scale: the safety limiter keeps the output below 1.
             assert!(peak < 1.0);
         }
     }
@@ -695,6 +705,8 @@ fn extreme_bowing_never_exceeds_full_scale() {
     let peak = out.iter().flatten().fold(0.0f32, |m, x| m.max(x.abs()));
     println!("extreme bowing: peak {peak:.4}");
     assert!(out.iter().flatten().all(|x| x.is_finite()));
+    // The limiter is the identity up to 0.9 of full scale and never reaches 1: driven
+    // several times past full scale, the output peaks well above 0.5.
     assert!(peak < 1.0 && peak > 0.5, "peak {peak}");
 }
 
@@ -727,12 +739,14 @@ fn thermal_model_plays_in_tune_and_survives_bow_changes_and_switches_during_note
         .all(|v| v.is_finite() && (*v == 0.0 || v.is_normal())));
     let peak = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     println!("peak {peak:.3}");
+    // Full scale: the safety limiter keeps the output below 1.
     assert!(peak < 1.0, "peak {peak}");
     // Sounds in every section: the rebuilds fade out and land the bow again.
     for at in [0u64, 24_001, 48_007, 72_011, 96_013, 120_017] {
         let from = at as usize + 9_600;
         let level = rms(&x[from..from + 9_600]);
         println!("from sample {from}: RMS {level:.4}");
+        // -60 dBFS: a sounding note is far louder.
         assert!(level > 1e-3, "silent after {from}");
     }
     // After the note off, A3 (moved to the violin's G string by the instrument switch)
@@ -784,11 +798,13 @@ fn quality_and_string_switches_during_notes_keep_sounding_in_tune_without_clicks
             .iter()
             .all(|v| v.is_finite() && (*v == 0.0 || v.is_normal())));
         let peak = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        // Full scale: the safety limiter keeps the output below 1.
         assert!(peak < 1.0, "{model}: peak {peak}");
         for at in [0u64, 24_001, 48_007, 72_011, 96_013, 120_000] {
             let from = at as usize + 9_600;
             let level = rms(&x[from..from + 9_600]);
             println!("{model}: from sample {from}: RMS {level:.4}");
+            // -60 dBFS: a sounding note is far louder.
             assert!(level > 1e-3, "{model}: silent after {from}");
         }
         let row = if model.starts_with("Thermal") {
@@ -802,6 +818,8 @@ fn quality_and_string_switches_during_notes_keep_sounding_in_tune_without_clicks
             nominal,
         );
         println!("{model}: C3 on the C string, free decay {error:+.2} cents from its intonation");
+        // 5 cents, as in the thermal test above: about the smallest difference players
+        // notice.
         assert!(error.abs() < 5.0, "{model}: {error:+.2} cents");
         assert_no_click_at(&x, &switch_at);
     }
@@ -832,6 +850,8 @@ fn the_reported_tail_covers_the_ring_out_and_ends_when_the_strings_or_objects_sl
             let out = plugin.render(BLOCK, BLOCK, &Score::new());
             assert!(out[0].iter().all(|v| v.is_finite()));
             rang += BLOCK;
+            // A guard against a tail that never ends: cello D3's energy rings out over
+            // 6-10 s (docs/playing-space.md).
             assert!(
                 rang < 120 * FS as usize,
                 "{model}: still ringing after 2 minutes"
@@ -843,8 +863,10 @@ fn the_reported_tail_covers_the_ring_out_and_ends_when_the_strings_or_objects_sl
             rang as f64 / FS
         );
         // The estimate lets every partial decay at the fundamental's (slowest) rate (a
-        // rubbed object: each mode at its own, with its envelope's worst ripple), so it
-        // is an upper bound; it must not be far off either (within a factor of two).
+        // rubbed object: each mode at its own, with its envelope's worst ripple), so it is
+        // an upper bound; it must not be far off either (within a factor of two). The
+        // plugin notices silence at its next estimate, every 2048 samples (`TAIL_EVERY`),
+        // and the host hears it at the end of a block.
         assert!(
             rang as f64 <= told as f64 + 2048.0 + BLOCK as f64,
             "{model}"
@@ -934,6 +956,7 @@ fn states_saved_by_every_version_load_with_their_values() {
             BLOCK,
             &Score::new().at(0, Event::note_on(62)),
         );
+        // -60 dBFS: a sounding note is far louder.
         assert!(rms(&channel_f64(&out, 0)) > 1e-3, "{fixture}: silent");
         // Saved again, it carries this build's version (the JSON after the 8-byte length).
         let resaved = String::from_utf8(plugin.save_state()[8..].to_vec()).unwrap();
@@ -1063,6 +1086,7 @@ fn a_bridge_saved_with_the_project_plays_and_a_damaged_one_plays_the_shipped_bri
     }));
     for out in [&shipped, &chosen, &damaged] {
         assert!(out.iter().all(|x| x.is_finite()));
+        // -60 dBFS: a sounding note is far louder.
         assert!(
             rms(&out.iter().map(|&x| x as f64).collect::<Vec<_>>()) > 1e-3,
             "silent"
@@ -1074,6 +1098,7 @@ fn a_bridge_saved_with_the_project_plays_and_a_damaged_one_plays_the_shipped_bri
         .zip(&chosen)
         .map(|(a, b)| (a - b) as f64)
         .collect();
+    // -60 dBFS, the level these tests take for silence: the two bridges sound apart.
     assert!(rms(&diff) > 1e-3, "the saved bridge did not play");
     assert_eq!(
         damaged, shipped,
@@ -1081,8 +1106,8 @@ fn a_bridge_saved_with_the_project_plays_and_a_damaged_one_plays_the_shipped_bri
     );
 }
 
-/// The plugin reports its resampler's delay as latency (issue 16, item 3: the point
-/// strings run at 48 kHz inside): none at 48 kHz, where nothing is resampled; at other
+/// The plugin reports its resampler's delay as latency (the point strings run at 48 kHz
+/// inside): none at 48 kHz, where nothing is resampled; at other
 /// rates the delay `Instrument::latency_samples` measures (the resampler's tests check
 /// that the output is shifted by exactly that), rounded, and a fraction of a millisecond.
 #[test]
@@ -1137,6 +1162,7 @@ fn the_midi_map_travels_with_the_state_and_routes_the_controllers() {
     mapped.activate(FS, BLOCK);
     let soft = play(&mut mapped);
     println!("default map {loud:.4}, CC74 to soft dynamics {soft:.4}");
+    // -60 dBFS: a default note peaks near -12 dBFS.
     assert!(loud > 1e-3, "the default plays");
     // Dynamics at 5 %: the bow's speed and force a twentieth (-26 dB): well under half.
     assert!(

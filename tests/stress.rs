@@ -1,5 +1,5 @@
-//! Numerical-stability stress suite (issue 6, item 5): fixed-seed property tests of random
-//! sample-accurate automation over the full parameter ranges, at every supported rate.
+//! Numerical-stability stress suite: fixed-seed property tests of random sample-accurate
+//! automation over the full parameter ranges, at every supported rate.
 //!
 //! **What is generated** (proptest strategies, so a failure shrinks to a small script):
 //! a sample rate (8 k to 384 k), a solver preset (draft, good or reference: the bristle
@@ -387,8 +387,8 @@ enum Engine {
 struct DspCase {
     rate_hz: f64,
     engine: Engine,
-    /// The solver preset (Newton tolerance): the plugin's default is `Good`, whose looser
-    /// stop once let the bristle laws drift where `Reference`'s did not.
+    /// The solver preset (Newton tolerance): the plugin's default is `Good`, whose stop is
+    /// looser than `Reference`'s.
     quality: Quality,
     blocks: Vec<usize>,
     seconds: f64,
@@ -551,8 +551,8 @@ impl Rig {
     /// a velocity bound of no use), so the bound is a scale, not a proof: the output is
     /// `gain v_res`, stick-slip swings the contact over about twice the exciter's velocity,
     /// which is at most 15 times the preset's (1.5 m/s over the 0.1 m/s reference); the
-    /// loudest preset by this measure gives 30. The runs peak at 13; the runaway exciter
-    /// of `paper_modal_exciter_does_not_run_away_while_the_bow_force_is_down` went past.
+    /// loudest preset by this measure gives 30. The runs peak at 13; a runaway exciter goes
+    /// past (`paper_modal_exciter_does_not_run_away_while_the_bow_force_is_down`).
     fn peak_bound(&self) -> f64 {
         match self.engine {
             Engine::Strings(..) | Engine::Thermal(..) => 20.0,
@@ -1128,12 +1128,12 @@ fn the_plugin_stays_finite_below_full_scale_and_deterministic_across_hosts_block
 // ---------------------------------------------------------------------------------------
 // Regression cases found by the suite
 
-/// Found by the strings suite (seed `0x5eed_0001`, shrunk): a cello's C string at 8 kHz,
-/// bowed 29 ms at C#2 and lifted, seemed to gain 0.4 % of its energy over one period.
-/// Not an instability (the nut's loss filter has `|H| <= g < 1`): the energy counted only
-/// the travelling waves, and at low rates the nut's dispersion allpasses hold a large part
-/// of the loop and hand it back. `WaveguideString::energy_j` now counts what they hold, so
-/// the energy may not grow on any sample.
+/// A case from the strings suite (seed `0x5eed_0001`, shrunk): a cello's C string at
+/// 8 kHz, bowed 29 ms at C#2 and lifted. At low rates the nut's dispersion allpasses hold a
+/// large part of the loop and hand it back, so the travelling waves alone gain 0.4 % of
+/// their energy over a period; the nut's loss filter has `|H| <= g < 1`, and
+/// `WaveguideString::energy_j` counts what the allpasses hold, so the energy may not grow
+/// on any sample.
 #[test]
 fn lifted_cello_c_string_at_8_khz_never_gains_energy_counting_the_nut_filters() {
     let fs = 8_000.0;
@@ -1159,18 +1159,20 @@ fn lifted_cello_c_string_at_8_khz_never_gains_energy_counting_the_nut_filters() 
         );
         last = e;
     }
+    // At Q1 500 the C string's fundamental keeps exp(-2 pi 65.4 / 500) = 0.44 of its
+    // energy over 1 s, its higher partials less.
     assert!(
         last < 0.5 * first,
         "the string did not decay: {first:e} -> {last:e} J"
     );
 }
 
-/// Found by the rubbed suite (seed `0x5eed_0003`, long run, shrunk): paper A's modal scene
-/// at 8 kHz, held with the bow force down, then up again, went past the peak bound. The
-/// exciter (a free 50 g mass) was pushed with a fixed force, the steady friction at the
-/// preset's 1 N; under a lighter normal force nothing held it back and it accelerated
-/// without bound (8 m/s^2 with none), then struck the 1 g modes at tens of m/s.
-/// `RubbedScene::tick_with` now pushes in proportion to the normal force.
+/// A case from the rubbed suite (seed `0x5eed_0003`, long run, shrunk): paper A's modal
+/// scene at 8 kHz, held with the bow force down, then up again. The exciter is a free 50 g
+/// mass; pushed with a fixed force (the steady friction at the preset's 1 N), nothing
+/// holds it back under a lighter normal force and it accelerates without bound (8 m/s^2
+/// with none), then strikes the 1 g modes at tens of m/s. `RubbedScene::tick_with` pushes
+/// in proportion to the normal force.
 #[test]
 fn paper_modal_exciter_does_not_run_away_while_the_bow_force_is_down() {
     let fs = 8_000.0;
@@ -1190,7 +1192,7 @@ fn paper_modal_exciter_does_not_run_away_while_the_bow_force_is_down() {
     }
     // No normal force: nothing pushes or holds the mass, so it coasts. Twice its fastest
     // speed in contact leaves room for the trapezoidal rule's last half-step of contact
-    // force; the fixed push reached 0.5 + 8 x 3 = 24 m/s.
+    // force; a fixed push reaches 0.5 + 8 x 3 = 24 m/s.
     for n in 0..(3.0 * fs) as usize {
         let v = scene
             .tick_with(pressed(0.0))
@@ -1199,7 +1201,7 @@ fn paper_modal_exciter_does_not_run_away_while_the_bow_force_is_down() {
         assert!(v.abs() < 2.0 * fastest, "sample {n}: exciter at {v} m/s");
     }
     // Pressed again, five times harder: the scene's own level. Measured: 2.4 (3.9 at ten
-    // times the force); the runaway exciter struck the modes to 21.
+    // times the force); an exciter running away strikes the modes to 21.
     let mut peak = 0.0f64;
     for _ in 0..fs as usize {
         peak = peak.max(scene.tick_with(pressed(5.0)).audio.abs());
@@ -1207,12 +1209,11 @@ fn paper_modal_exciter_does_not_run_away_while_the_bow_force_is_down() {
     assert!(peak < 8.0, "peak {peak}");
 }
 
-/// Found by the rubbed suite after the fix above (seed `0x5eed_0003`, long run): paper A's
-/// modal scene under the static hyperbolic law (the plugin's default law) reached the peak
-/// bound. The push, the bristle law's steady friction at 0.5 m/s (0.2 N of it viscous,
-/// `sigma2 v`), exceeds the 0.2 N the static curves fall to at high speed, so the free
-/// mass accelerated for as long as the note lasted. The push is now capped at the law's
-/// high-speed friction.
+/// A case from the rubbed suite (seed `0x5eed_0003`, long run): paper A's modal scene
+/// under the static hyperbolic law (the plugin's default law). The bristle law's steady
+/// friction at 0.5 m/s (0.2 N of it viscous, `sigma2 v`) exceeds the 0.2 N the static
+/// curves fall to at high speed, so a push of that size accelerates the free mass for as
+/// long as the note lasts. The push is capped at the law's high-speed friction.
 #[test]
 fn paper_modal_exciter_under_a_static_law_does_not_run_away() {
     let fs = 8_000.0;
@@ -1222,8 +1223,8 @@ fn paper_modal_exciter_under_a_static_law_does_not_run_away() {
         let mut scene = RubbedScene::from_spec(spec, law, fs).unwrap();
         for n in 0..(5.0 * fs) as usize {
             let v = scene.tick().contact.exciter_velocity_m_per_s;
-            // The mass may overshoot its target in stick-slip but not run away: the
-            // uncapped push reached 0.2 N / 50 g x 5 s = 20 m/s.
+            // The mass may overshoot its target in stick-slip but not run away: an
+            // uncapped push reaches 0.2 N / 50 g x 5 s = 20 m/s.
             assert!(
                 v.abs() < 2.0 * target,
                 "{law:?}, sample {n}: exciter at {v} m/s"
@@ -1232,11 +1233,11 @@ fn paper_modal_exciter_under_a_static_law_does_not_run_away() {
     }
 }
 
-/// A random script in which a lifted string once gained energy: cello, hyperbolic law,
-/// 96 kHz, draft, one-sample blocks. All notes off lifted the bow but left the fingers
-/// down, and the mod wheel's vibrato (CC1 on channel 5) kept moving the finger on the
-/// ringing A string, pumping it 0.5 % a period. A released string now rings free: its
-/// finger lifts as at a note-off and the bend and vibrato no longer reach it.
+/// A random script in which a lifted string could gain energy: cello, hyperbolic law,
+/// 96 kHz, draft, one-sample blocks. All notes off lifts the bow; a finger left down on the
+/// ringing A string would move with the mod wheel's vibrato (CC1 on channel 5) and pump
+/// it 0.5 % a period. A released string rings free: its finger lifts as at a note-off and
+/// the bend and vibrato do not reach it.
 /// `DROP=i,j,..` leaves steps out when replaying it.
 #[test]
 fn a_lifted_string_never_gains_energy_in_a_replayed_random_script() {

@@ -120,6 +120,8 @@ fn the_vst3_wrapper_plays_the_same_samples_as_the_clap_wrapper() {
         );
         assert_eq!(a[1], b[1], "{sample_rate} Hz: right channel");
         let left = channel_f64(&b, 0);
+        // -80 dBFS: a sounding note is far louder (the golden renders' RMS is 0.13-0.24 on
+        // the strings).
         assert!(rms(&left) > 1e-4, "{sample_rate} Hz: the note is silent");
         if block > 1 {
             // The note plays at its pitch (a quarter tone: the test is of the format,
@@ -168,7 +170,7 @@ fn a_daws_flush_of_every_midi_controller_through_vst3_neither_overflows_nor_allo
     // (a zero-sample process call), and in a playing block with a note and our own
     // automation. The wrapper turns each point into an event in buffers reserved at load
     // (`Plugin::INPUT_EVENT_CAPACITY`); overflowing them allocates on the audio thread
-    // (Ardour logged it four times in 6 s before the capacity was raised).
+    // (with the wrapper's default capacity, Ardour logs it four times in 6 s).
     const BLOCK: usize = 512;
     let mut vst3 = load();
     let mut clap = HostedPlugin::load(test_plugin_path());
@@ -208,6 +210,8 @@ fn a_daws_flush_of_every_midi_controller_through_vst3_neither_overflows_nor_allo
         }
         let out = vst3.render(8 * BLOCK, BLOCK, &score);
         assert!(out.iter().flatten().all(|x| x.is_finite()));
+        // -80 dBFS: a sounding note is far louder (the golden renders' RMS is 0.13-0.24 on
+        // the strings).
         assert!(
             rms(&channel_f64(&out, 0)[4 * BLOCK..]) > 1e-4,
             "{sample_rate} Hz: the note sounded through the flushes"
@@ -268,6 +272,7 @@ fn a_vst3_project_keeps_its_state_and_reopens_the_clap_fixtures() {
         .at(14_400, Event::note_off(69));
     let a = first.render(24_000, 256, &notes);
     let b = second.render(24_000, 256, &notes);
+    // -60 dBFS: a default note peaks near -12 dBFS.
     assert!(
         rms(&channel_f64(&a, 0)) > 1e-3,
         "the restored patch is silent"

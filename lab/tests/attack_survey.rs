@@ -5,18 +5,14 @@
 //! regime classifier on the contact probe over 1.5-2.5 s. A survey, printed, not
 //! asserted: which limit cycle an attack falls into is chaotic, so it is read as counts.
 //!
-//! 2026-11-26, before and after the violin's and viola's strings went to 96 kHz inside
-//! (attacks in Helmholtz motion, of 52; hyperbolic / static / LuGre / elasto-plastic):
-//! violin 51 / 52 / 49 / 51 -> 49 / 51 / 51 / 52, viola 47 / 52 / 51 / 51 -> 48 / 52 / 51 /
-//! 52. The cello, before and after its A string went to 96 kHz inside (2026-11-26): 50 /
-//! 50 / 49 / 52 of 52 both times, the same attacks failing (D#3 and F#4 at velocity 1.0
-//! hyperbolic, F#2 static, C2, A2 and A3 LuGre: double slips or raucous); the violin and
-//! viola read as above. With the plugin's bristle three times stiffer (`sigma0` 3e5 N/m,
-//! 2026-11-26, later), LuGre / elasto-plastic: violin 51 / 52, viola 51 / 52, cello 49 / 52
-//! -> 52 / 50 (the cello's F#2 at velocities 0.3 and 1.0 raucous with elasto-plastic; the
-//! violin's E6 at 0.8 and the viola's D#5 at 1.0 double-slip with LuGre); the hyperbolic
-//! and static counts as above. `cargo test --release --test attack_survey -- --ignored
-//! --nocapture`.
+//! As last run, attacks in Helmholtz motion, of 52 (hyperbolic / static / LuGre /
+//! elasto-plastic; the violin's and viola's strings and the cello's A string at 96 kHz
+//! inside, the plugin's bristle at `sigma0` 3e5 N/m): violin 49 / 51 / 51 / 52, viola
+//! 48 / 52 / 51 / 52, cello 50 / 50 / 52 / 50. Among the misses (double slips or
+//! raucous): the cello's D#3 and F#4 at velocity 1.0 with the hyperbolic law, its F#2 with
+//! the static law and at velocities 0.3 and 1.0 with elasto-plastic; the violin's E6 at
+//! 0.8 and the viola's D#5 at 1.0 with LuGre. `cargo test --release --test attack_survey
+//! -- --ignored --nocapture`.
 use colophony::dsp::friction::FrictionModel;
 use colophony::dsp::vocabulary::{midi_to_hz, BowControl, InstrumentKind};
 use colophony::measure::contact::ContactSample;

@@ -74,7 +74,7 @@ fn hz(note: u8) -> f64 {
 
 /// Notes known to miss their pitch here, with the law: the double bass's open E1 with the
 /// hyperbolic and static laws sits 6-18 cents off at 0.97-1.27 s and has not settled by
-/// 2 s (the static law +17 cents at 1.7-2.0 s, measured 2026-11-27): its attack through
+/// 2 s (the static law +17 cents at 1.7-2.0 s, measured): its attack through
 /// the performer ends in another limit cycle than the landing the intonation table was
 /// measured with. The test fails if one of them comes back in tune, so the list is kept
 /// true.
@@ -117,8 +117,8 @@ fn a_harder_note_velocity_starts_louder_and_both_speak_at_the_notes_pitch() {
                     "{:>11} {note:>3} {name:>14}: first 80 ms {louder:+5.2} dB, centroid x{brighter:4.2}; pitch at {from:.2}-{to:.2} s {c_soft:+6.1} / {c_hard:+6.1} cents",
                     kind.name()
                 ));
-                // The audible difference between velocities 30 and 120: 3 dB in the
-                // first 80 ms' peak, or 20 % in their spectral centroid.
+                // An audible difference between velocities 30 and 120: 3 dB in the first
+                // 80 ms' peak, or 20 % in their spectral centroid.
                 if louder < 3.0 && brighter < 1.2 {
                     failures.push(format!(
                         "{} {note} {name}: {louder:+.2} dB, x{brighter:.2}",

@@ -1,5 +1,5 @@
-//! The bridge admittance fit (issue 5) on synthetic data with known modes, its refusal of
-//! bad input, the `colophony fit-bridge` command as a user runs it, and the shipped
+//! The bridge admittance fit on synthetic data with known modes, its refusal of bad
+//! input, the `colophony fit-bridge` command as a user runs it, and the shipped
 //! generic bridges.
 
 use colophony_lab::admittance_fit::synthetic::{
@@ -87,9 +87,9 @@ fn assert_passive(bridge: &BridgeModes) {
     }
 }
 
-// Tolerances of the recovery tests are the issue's: frequency 1 %, bandwidth 20 %, gain
-// 15 % (Frobenius, relative). With 1 % noise the fit does far better (about 0.01 %,
-// 0.5 % and 0.2 %); the margins leave room for harder draws, not for a broken fit.
+// Tolerances of the recovery tests: frequency 1 %, bandwidth 20 %, gain 15 % (Frobenius,
+// relative). With 1 % noise the fit does far better (about 0.01 %, 0.5 % and 0.2 %); the
+// margins leave room for harder draws, not for a broken fit.
 const FREQ_TOL: f64 = 0.01;
 const BANDWIDTH_TOL: f64 = 0.2;
 const GAIN_TOL: f64 = 0.15;

@@ -40,8 +40,9 @@ fn helmholtz_slip_fraction_equals_beta_with_one_slip_per_period() {
     let stats = cello_d3_slips(s.bow);
     let beta = s.bow.position_beta;
     println!("cello D3 at defaults: {stats:?}, beta {beta}");
-    // Raman: the corners pass the bow beta of a period apart. 10 % is the issue's bound;
-    // the bow position itself is rounded to the grid by under 1 %.
+    // Raman: the corners pass the bow beta of a period apart. The rounded corners' centres
+    // measure 0.104 at beta 0.1 (docs/papers-reproduced.md) and the bow position is
+    // rounded to the grid by under 1 %: 10 % holds both.
     assert!(
         (stats.slip_fraction - beta).abs() < 0.1 * beta,
         "corner-to-corner slip fraction {}",
@@ -55,6 +56,8 @@ fn helmholtz_slip_fraction_equals_beta_with_one_slip_per_period() {
     );
     // Sticking velocity is the bow velocity (within 10 %).
     let vb = s.bow.velocity_m_per_s;
+    // 10 %: the playing-space map's Helmholtz criterion (docs/playing-space.md); sticking
+    // is exact in the model, and measures 0.100 m/s (docs/papers-reproduced.md).
     assert!((stats.stick_velocity_m_per_s - vb).abs() < 0.1 * vb);
     // Raman's slip velocity -v_b (1 - beta) / beta is not asserted: the rounded corners
     // take part of the slip plateau between the half-jump points (see the next test).
@@ -72,7 +75,7 @@ fn corner_rounding_shrinks_as_bow_force_rises() {
     // Cremer: the losses round the Helmholtz corner, the friction force sharpens it at each
     // slip; more force, sharper corners, so the strict slip time falls toward beta.
     // From 1 N (F_max / 5 on cello D3): at 0.5 N (F_max / 10) the string with the bow
-    // hair and the intonation table of 2026-11-25 still slips 1.23 times a period after
+    // hair and the intonation table still slips 1.2 times a period after
     // 1.5 s (docs/playing-space.md: below about F_max / 6 the point bow settles late or
     // not at all), so the corners there are not Helmholtz corners.
     let base = settings(InstrumentKind::Cello, 50).bow;
@@ -80,6 +83,8 @@ fn corner_rounding_shrinks_as_bow_force_rises() {
         .into_iter()
         .map(|force_n| {
             let stats = cello_d3_slips(BowControl { force_n, ..base });
+            // One slip per period over ~147 periods, as above: only the window edges add a
+            // fraction.
             assert!(
                 (stats.slips_per_period - 1.0).abs() < 0.02,
                 "{force_n} N: {stats:?}"
@@ -95,6 +100,8 @@ fn corner_rounding_shrinks_as_bow_force_rises() {
         assert!(pair[1].1 < pair[0].1, "rounding grew with force: {pair:?}");
     }
     // Always at least beta: the flanks only add time to the ideal slip.
+    // 5 %: the slip (about 33 of 327 samples) is counted in whole samples, 3 % each,
+    // and the bow position is rounded to the grid by under 1 %.
     assert!(strict.iter().all(|(_, f)| *f >= 0.95 * base.position_beta));
 }
 
@@ -112,6 +119,7 @@ fn helmholtz_amplitude_scales_as_bow_velocity_over_beta() {
             position_beta,
         };
         let stats = cello_d3_slips(bow);
+        // One slip per period over ~147 periods: only the window edges add a fraction.
         assert!(
             (stats.slips_per_period - 1.0).abs() < 0.02,
             "{bow:?}: {stats:?}"
@@ -171,7 +179,8 @@ fn free_decay_sits_where_the_intonation_table_tunes_it_across_every_range() {
         for note in notes {
             let err = free_decay_pitch_error_cents(kind, note);
             println!("{} note {note}: free decay {err:+.3} cents", kind.name());
-            // 2 cents: the issue's tuning target; the estimator itself is good to 0.01 cent
+            // 2 cents: below what players hear (tests/plugin_host.rs); the estimator itself
+            // is good to 0.01 cent.
             assert!(
                 err.abs() < 2.0,
                 "{} note {note}: {err:+.3} cents",
@@ -189,6 +198,8 @@ fn bowed_pitch_at_defaults_within_ten_cents() {
     let f = peak_frequency_hz(steady, FS, midi_to_hz(50.0), 50.0);
     let err = cents(f, midi_to_hz(50.0));
     println!("cello D3 bowed at defaults: {err:+.3} cents (bow-force flattening)");
+    // 10 cents is where a note starts to sound out of tune (tests/plugin_host.rs);
+    // measured +0.2 cents (docs/papers-reproduced.md).
     assert!(err.abs() < 10.0);
 }
 
@@ -208,6 +219,8 @@ fn energy_never_grows_with_bow_lifted() {
         // can only move the RMS by rounding-level amounts when nothing gains energy
         assert!(pair[1] <= pair[0] * (1.0 + 1e-6), "level grew: {pair:?}");
     }
+    // At Q1 500, A4's amplitude falls by e in Q / (pi f) = 0.36 s: over 1.9 s, far
+    // under 0.9.
     assert!(levels.last().unwrap() < &(levels[0] * 0.9));
 }
 
@@ -251,6 +264,9 @@ fn output_is_finite_and_free_of_subnormals_at_extreme_rates_and_settings() {
                             "{fs} Hz {} note {note}: sample {x}",
                             kind.name()
                         );
+                        // The bow's largest velocity jump, v_b / beta = 1.5 / 0.02 =
+                        // 75 m/s, reaches the output as at most 15 (tests/stress.rs,
+                        // `peak_bound`).
                         assert!(
                             x.abs() < 16.0,
                             "{fs} Hz {} note {note}: sample {x}",
@@ -301,7 +317,7 @@ fn waking_from_sleep_matches_never_sleeping_and_keeps_the_pitch() {
     // must be one whose bowed motion is periodic at the defaults: in an irregular regime
     // (several high violin notes are) the attack is chaotic, and the 1e-16 J left in the
     // never-sleeping string grows into a different waveform within a period, sleep or
-    // not. MIDI 99 is periodic (and was with free-decay tuning too).
+    // not. MIDI 99 is periodic.
     let s = |t: f64| (t * FS) as usize;
     let score = [
         (0, true, 99u8),
@@ -319,6 +335,8 @@ fn waking_from_sleep_matches_never_sleeping_and_keeps_the_pitch() {
         .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
     let db = 20.0 * (diff / peak).log10();
     println!("slept {blocks} blocks (none without skipping: {none}); largest difference {db:.0} dB below the peak");
+    // The note rings out within a second of its release at 0.3 s and sleeps until 3.0 s:
+    // about 1.7 s, some 300 blocks of 256.
     assert!(blocks > 100 && none == 0, "the string never slept");
     // The sleep threshold (1e-16 J against a few mJ bowed) is -130 dB in energy; the
     // difference can only be what was cleared at that level.
@@ -327,13 +345,15 @@ fn waking_from_sleep_matches_never_sleeping_and_keeps_the_pitch() {
     let after = |x: &[f64]| peak_frequency_hz(&x[s(3.1)..s(3.5)], FS, f, 50.0);
     let shift = cents(after(&slept), after(&full));
     println!("pitch after waking: {shift:+.4} cents from never sleeping");
+    // The renders differ by under -100 dB, so the peak search finds the same pitch in both
+    // to far better than 0.01 cents.
     assert!(shift.abs() < 0.01);
 }
 
-/// The plugin's point strings run at one internal rate whatever the host's (issue 16,
-/// item 3): the same note, bowing and friction law give the same motion and pitch at
-/// every host rate. Checked for every point law on cello D3 (paper A's scene, 1.1 N,
-/// beta 0.1) and violin A5 (defaults), host rates 22.05 to 384 kHz.
+/// The plugin's point strings run at one internal rate whatever the host's: the same note,
+/// bowing and friction law give the same motion and pitch at every host rate. Checked for
+/// every point law on cello D3 (paper A's scene, 1.1 N, beta 0.1) and violin A5 (defaults),
+/// host rates 22.05 to 384 kHz.
 #[test]
 fn the_bowed_string_plays_the_same_motion_and_pitch_at_every_host_rate() {
     use colophony::dsp::friction::FrictionModel;
@@ -385,7 +405,7 @@ fn the_bowed_string_plays_the_same_motion_and_pitch_at_every_host_rate() {
                         reference.strict_slip_fraction
                     );
                 }
-                // 0.1 cent: far below the 2 cents item 3 allows; the peak search's own
+                // 0.1 cent: the same internal motion, only resampled; the peak search's own
                 // resolution over 1 s is finer still.
                 let moved = cents(pitch, reference_pitch).abs();
                 assert!(
@@ -436,8 +456,8 @@ fn bowed_pitch(
 /// lock"); the violin's strings run at 96 kHz inside for that
 /// (`InstrumentKind::point_oversampling`). Every friction law, A5 to A6 every second
 /// semitone, bowed at 1 N, beta 0.1, 0.1 m/s through the plugin's model at a 48 kHz host,
-/// the 192 kHz strings, and the strings at 48 kHz themselves (what the plugin played
-/// before); the bowed pitch over 0.5-1.5 s.
+/// the 192 kHz strings, and the strings at 48 kHz themselves; the bowed pitch over
+/// 0.5-1.5 s.
 #[test]
 fn the_violins_top_octave_plays_the_refined_models_pitch() {
     use colophony::dsp::friction::FrictionModel;
@@ -465,7 +485,8 @@ fn the_violins_top_octave_plays_the_refined_models_pitch() {
     };
     let (p, c) = (median(&mut plugin), median(&mut coarse));
     println!("median |difference| from 192 kHz: plugin {p:.2} cents, 48 kHz strings {c:.2}");
-    // Item 1's ±3 cents: the plugin's discretisation may not move the median note by more.
+    // ±3 cents, the playing-space map's bound for a note in tune (docs/playing-space.md):
+    // the plugin's discretisation may not move the median note by more.
     assert!(
         p < 3.0,
         "plugin median {p:.2} cents from the 192 kHz strings"

@@ -44,7 +44,9 @@ fn elasto_plastic_bowing_of_the_cello_d_string_is_helmholtz_motion_at_the_right_
     let f = peak_frequency_hz(&out.audio[FS as usize..], FS, midi_to_hz(50.0), 50.0);
     let bowed_cents = cents(f, midi_to_hz(50.0));
     println!("elasto-plastic, cello D at 1.1 N: {stats:?}; bowed pitch {bowed_cents:+.2} cents from the free string");
-    // The bounds: slip fraction within 10 % of beta, one slip per period.
+    // Slip fraction within 10 % of beta: the rounded corners and the bow position rounded
+    // to the grid (under 1 %) move it, measured 0.108 (docs/papers-reproduced.md). One slip
+    // per period over ~147 periods: only the window edges add a fraction.
     assert!(
         (stats.slip_fraction - 0.1).abs() < 0.01,
         "slip fraction {}",
@@ -55,6 +57,8 @@ fn elasto_plastic_bowing_of_the_cello_d_string_is_helmholtz_motion_at_the_right_
         "{} slips per period",
         stats.slips_per_period
     );
+    // 10 % of v_b, the playing-space map's Helmholtz criterion; presliding creep keeps
+    // sticking off v_b by about 1e-3 m/s.
     assert!((stats.stick_velocity_m_per_s - 0.1).abs() < 0.01);
     // Bowed pitch within 10 cents of the free string (tuned to 0.002 cents: see
     // model_physics.rs), so this is the bowing's own shift.
@@ -85,6 +89,8 @@ fn newton_needs_at_most_7_iterations_for_99_percent_of_samples_in_the_cello_d_sc
             100.0 * stats.fraction_within(7)
         );
         assert_eq!(stats.samples(), (2.0 * FS) as u64);
+        // Paper A reports fewer than 7 iterations a sample (docs/papers-reproduced.md);
+        // measured 99.96 % within 7.
         assert!(stats.fraction_within(7) >= 0.99, "{stats:?}");
         assert_eq!(
             stats.fallbacks, 0,
@@ -184,6 +190,7 @@ fn presliding_below_breakaway_is_purely_elastic() {
         let z = ep.bristle_displacement_m();
         worst = worst.max((z - x).abs() / z_ba);
         let elastic = p.sigma0_n_per_m * z + (p.sigma1_kg_per_s + p.sigma2_kg_per_s) * v;
+        // Rounding only, as for z below: the forces stay under 0.2 N.
         assert!((f - elastic).abs() < 1e-9, "sample {n}: {f} vs {elastic}");
         lugre_gap = lugre_gap.max((lugre.bristle_displacement_m() - x).abs() / z_ba);
     }
@@ -214,6 +221,7 @@ fn per_sample_and_block_processing_give_identical_output() {
     for chunk in block.chunks_mut(97) {
         b.process(bow, chunk);
     }
+    // -60 dBFS: a bowed note at 1.1 N is far louder.
     assert!(rms(&ticks) > 1e-3);
     assert!(ticks
         .iter()
@@ -252,8 +260,11 @@ fn block_processing_through_sleep_gives_the_same_bits_as_ticking() {
         b.process(bow, &mut out);
         blocks.extend(out);
     }
+    // -80 dBFS: a bowed note is far louder.
     assert!(rms(&ticks) > 1e-4, "the note did not sound");
     assert!(!a.is_ringing(), "the string never fell asleep again");
+    // 20 blocks before the note, and the rest of the 8 s once the string rings out
+    // (within 3.2 s of its release: tests/plugin_host.rs).
     assert!(slept > 40, "asleep for only {slept} blocks");
     assert!(ticks
         .iter()
@@ -322,6 +333,8 @@ fn the_authors_modal_scenario_sticks_and_slips_while_the_bow_accelerates() {
     let bow_end = frames.last().unwrap().contact.exciter_velocity_m_per_s;
     let stick = frames
         .iter()
+        // 1e-3 m/s, as for the cello above: bristle creep keeps the contact off exact
+        // sticking.
         .filter(|f| f.relative_velocity_m_per_s.abs() < 1e-3)
         .count();
     let peak = frames.iter().fold(0.0f64, |m, f| {

@@ -39,6 +39,7 @@ fn the_internal_rate_is_wave_speed_over_node_spacing_as_in_table_1() {
         // 0.16 mm is 91 m/s), so it is printed beside ours, not asserted.
         let spec = ThermalStringSpec::cello_c();
         let c = 2.0 * spec.length_m * spec.f0_hz;
+        // f64 rounding of a rate under 550 kHz is about 1e-10 Hz.
         assert!((s.internal_rate_hz() - c * nodes as f64 / 0.01).abs() < 1e-6);
     }
 }
@@ -65,7 +66,8 @@ fn the_free_string_is_in_tune_at_the_internal_rate() {
         let f0 = peak_frequency_hz(&out[(0.3 * fs) as usize..], fs, 65.41, 50.0);
         let error = cents(f0, 65.41);
         println!("N_B {nodes}: free decay {error:+.3} cents");
-        // 2 cents, the foundation's tuning target.
+        // 2 cents, the free strings' tuning bound: below what players hear
+        // (tests/plugin_host.rs).
         assert!(error.abs() < 2.0);
     }
 }
@@ -92,6 +94,7 @@ fn the_ftcs_bound_is_enforced_by_substeps_or_a_clear_error() {
             s.thermal_substeps(),
             s.ftcs_ratio()
         );
+        // 1e-12: rounding of the ratio alpha dt / dx^2 in f64.
         assert!(s.ftcs_ratio() <= FTCS_TARGET + 1e-12);
     }
     let th = ThermalParams {
@@ -181,8 +184,8 @@ fn temperature_rises_while_slipping_and_diffuses_while_sticking() {
     println!("whole-width slips well below the sliding equilibrium that warmed: {heated}/{below}; well above it that cooled: {cooled}/{above}; all-stick samples obeying diffusion: {diffusive}/{sticks}");
     // The default contact cools in 33 us, so a slip spends only its first samples far
     // from equilibrium, and whole-width slips that far off come with the attack's first
-    // slips, not every period: 9 in these 0.3 s (and no more in 0.5 s, measured on
-    // 2026-11-27). Every one must move toward equilibrium; at least five, so the
+    // slips, not every period: 9 in these 0.3 s (and no more in 0.5 s, measured). Every
+    // one must move toward equilibrium; at least five, so the
     // direction is seen on several.
     assert!(below + above >= 5 && heated == below && cooled == above);
     assert!(sticks > 100 && diffusive == sticks);
@@ -220,6 +223,8 @@ fn energy_never_grows_with_the_bow_lifted() {
         // 1e-9 relative: rounding only.
         assert!(w[1] <= w[0] * (1.0 + 1e-9), "energy grew: {w:?}");
     }
+    // Over 29 periods at Q1 500 the fundamental's energy falls by
+    // exp(-2 pi 29 / 500) = 0.69.
     assert!(levels[29] < 0.9 * levels[0]);
 }
 
@@ -258,8 +263,10 @@ fn figure_6_settles_into_helmholtz_motion_with_partial_slips_and_a_slip_fraction
         100.0 * (stats.slip_fraction / beta - 1.0)
     );
     // Partial slips across the width, as the paper shows, and whole-width slips.
+    // Measured 65 % and 9 % of the time (docs/papers-reproduced.md).
     assert!(partial as f64 / len > 0.01 && full as f64 / len > 0.01);
-    // The contact heats while slipping and cools while sticking within each period.
+    // The contact heats while slipping and cools while sticking within each period. The
+    // temperature cycles over 0-21.6 K in the steady motion (docs/papers-reproduced.md).
     assert!(tmax - tmin > 5.0);
     // Helmholtz motion: one slip per period (over ~7.6 periods the window edges can add
     // a fraction), lasting about beta of the period. Not shorter than beta; longer by
@@ -335,8 +342,9 @@ fn the_thermal_bow_renders_at_the_host_rate_in_tune_and_bounded() {
         let peak = out.audio.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         println!("{} MIDI {note}: bowed {bowed_cents:+.2} cents, free {free_cents:+.2} cents, RMS {:.3}, peak {peak:.3}", kind.name(), rms(bowed));
         assert!(out.audio.iter().all(|x| x.is_finite()));
+        // -60 dBFS: a bowed note is far louder; 1.0 is a float output's full scale.
         assert!(rms(bowed) > 1e-3 && peak < 1.0);
-        // The free string through the resampler: 2 cents, the foundation's target.
+        // The free string through the resampler: 2 cents, the free strings' tuning bound.
         assert!(free_cents.abs() < 2.0);
     }
 }
@@ -433,6 +441,7 @@ fn the_thermal_instrument_rings_in_tune_and_flattens_with_bow_force() {
             rms(&out[9_600..]),
             cello.nodes_per_string()
         );
+        // -60 dBFS: a bowed note is far louder.
         assert!(rms(&out[9_600..]) > 1e-3, "MIDI {note} is silent");
         // The free string is tuned with the bridge's horizontal phase delay; its coupling of
         // the polarisations is not in the tuning. 5 cents: about the smallest pitch
@@ -560,9 +569,7 @@ fn quiet_polarisations_sleep_while_others_ring_and_waking_matches_never_sleeping
     // attack (the samples differ, measured -21 to -25 dB), but the note is the same:
     // pitch, and level once the attack is over (0.5 s: the thermal bow settles into
     // Helmholtz motion within 0.6 s at beta 0.1). The attack moves more (printed; level
-    // -0.013 dB with the loss fitted at 20 f1, -0.067 dB since the loss is fitted at
-    // 10 f1 as the waveguide's, -0.081 dB and +0.05 cents with the table fitted at the
-    // defaults; the difference dies away within a second).
+    // -0.081 dB and +0.05 cents; the difference dies away within a second).
     let f = 65.41;
     let pitch_of = |x: &[f64]| peak_frequency_hz(&x[s(30.5)..s(31.0)], fs, f, 5.0);
     let attack_pitch_of = |x: &[f64]| peak_frequency_hz(&x[s(30.1)..s(30.5)], fs, f, 5.0);
@@ -584,8 +591,8 @@ fn quiet_polarisations_sleep_while_others_ring_and_waking_matches_never_sleeping
 #[test]
 fn the_lone_strings_fundamental_decays_at_its_q1_terminations_included() {
     // The string's own resistive terminations lose energy too; the loop's loss filter
-    // makes up only the rest, so the whole string decays at Q1 (it decayed at Q 64 while
-    // the filter ignored them). After a second of free decay the low partials carry the
+    // makes up only the rest, so the whole string decays at Q1 (at Q 64 if the filter
+    // ignored them). After a second of free decay the low partials carry the
     // energy, and the filter puts partials 2-5 at 0.9-1.0 Q1: the energy's decay rate
     // reads a Q between 0.85 Q1 and Q1 (plus rounding of the measurement).
     let mut s = cello_c(10);
@@ -616,11 +623,11 @@ fn the_lone_strings_fundamental_decays_at_its_q1_terminations_included() {
     assert!(q > 0.85 * q1 && q < 1.02 * q1, "Q {q:.0}");
 }
 
-/// Issue 16, items 4 and 5: every bow setting at the bounds of the plugin's ranges builds
-/// at every host rate from 8 to 384 kHz, and every playable note of every instrument
-/// speaks with it: the highest note (31 semitones above the top string) on a 1-node,
-/// 2 cm bow, the coarsest and widest, which once refused to build ("the bow is wider
-/// than the string"), and on a 60-node, 5 mm bow, the finest. A stopped string too short
+/// Every bow setting at the bounds of the plugin's ranges builds at every host rate from
+/// 8 to 384 kHz, and every playable note of every instrument speaks with it: the highest
+/// note (31 semitones above the top string) on a 1-node, 2 cm bow, the coarsest and
+/// widest, where the bow is wider than the stopped string, and on a 60-node, 5 mm bow,
+/// the finest. A stopped string too short
 /// for the whole bow plays with the nodes that fit, at the same total force.
 #[test]
 fn every_note_speaks_with_every_bow_setting_at_every_host_rate() {
@@ -673,7 +680,7 @@ fn every_note_speaks_with_every_bow_setting_at_every_host_rate() {
     }
 }
 
-/// Issue 16, item 3: the explicit convective loss of eq. (1), `-h C_C |v| T` per
+/// The explicit convective loss of eq. (1), `-h C_C |v| T` per
 /// sub-step, overshoots when `h C_C |v|` nears 1 (the node would lose more heat than it
 /// holds) and grows when it exceeds 2. The fastest slips the plugin allows (1.5 m/s at
 /// beta 0.02 slips at up to about v_b / beta = 75 m/s) on the coarsest bow (one node,
@@ -780,8 +787,8 @@ fn the_thermal_instrument_plays_the_same_motion_and_pitch_at_every_host_rate() {
                     reference.slips_per_period
                 );
             }
-            // 0.1 cent: far below the 2 cents issue 16 allows between rates; the peak
-            // search over 0.8 s resolves finer.
+            // 0.1 cent: the same internal motion, only resampled; the peak search over
+            // 0.8 s resolves finer.
             let moved = cents(pitch, reference_pitch).abs();
             assert!(
                 moved < 0.1,

@@ -1,5 +1,5 @@
-//! The playing-space map's coarse subset (issue 16, item 6): every model, every instrument,
-//! every fifth semitone from the lowest open string to two octaves above the highest, at
+//! The playing-space map's coarse subset: every model, every instrument, every fifth
+//! semitone from the lowest open string to two octaves above the highest, at
 //! 44.1 and 96 kHz, through the engines the plugin plays (`colophony_lab::playing_space`).
 
 use colophony::dsp::vocabulary::InstrumentKind;
@@ -85,9 +85,9 @@ fn nominal_results() -> &'static [(Cell, Measured)] {
 
 /// Every note of every model speaks at the plugin's defaults and at the middle of its
 /// window, at both rates, with finite output below full scale: no note is refused or
-/// silent (the thermal model used to drop high notes whose string was shorter than the
-/// bow), and none runs away (the bristle laws' Newton stop once let the bristle drift and
-/// grew the violin's and viola's high notes at the window's middle to peaks of 50-375).
+/// silent (a high note's string shorter than the thermal bow plays with the nodes that
+/// fit), and none runs away (a bristle left to drift by a loose Newton stop grows the
+/// violin's and viola's high notes at the window's middle to peaks of 50-375).
 #[test]
 fn every_note_of_every_model_speaks_at_nominal_bowing() {
     let results = nominal_results();
@@ -121,13 +121,13 @@ fn every_note_of_every_model_speaks_at_nominal_bowing() {
     );
 }
 
-/// Tuned by the bowed sound (issue 16, item 1): bowed at the plugin's defaults, where the
-/// table is fitted, the point laws' notes centre on equal temperament and most lie within
-/// 10 cents of it, at host rates the table was not measured at. Before any table every
-/// point law sat 6 to 9 cents sharp (median) with 50-74 % of the nominal cells within 10
-/// cents. The other nominal bowing, the window's geometric middle (`F_max / 11`), is
-/// printed against the defaults note by note, and over both bowings as the earlier test
-/// counted them: it is rarely Helmholtz motion, and its pitch is its regime's, not the
+/// Tuned by the bowed sound: bowed at the plugin's defaults, where the table is fitted,
+/// the point laws' notes centre on equal temperament and most lie within 10 cents of it,
+/// at host rates the table is not measured at. Without the table every point law sits 6 to
+/// 9 cents sharp (median) with 50-74 % of the nominal cells within 10 cents. The other
+/// nominal bowing, the window's geometric middle (`F_max / 11`), is printed against the
+/// defaults note by note, and over both bowings together: it is rarely Helmholtz motion,
+/// and its pitch is its regime's, not the
 /// flattening's (docs/playing-space.md, "Tuned at the defaults").
 #[test]
 fn bowed_at_the_defaults_the_point_laws_centre_on_equal_temperament() {
@@ -185,7 +185,7 @@ fn bowed_at_the_defaults_the_point_laws_centre_on_equal_temperament() {
             // 2 cents: a systematic offset below what players hear on sustained notes
             // (the table's residual scatter at 48 kHz is about 3 cents either way: the
             // sample-grid lock). Two thirds within 10 cents: the rest are the irregular
-            // regimes (their pitch wanders), which item 2 of issue 16 still has.
+            // regimes, whose pitch wanders.
             if median.abs() > 2.0 || within < 2.0 / 3.0 {
                 failures.push(line);
             }
@@ -196,10 +196,10 @@ fn bowed_at_the_defaults_the_point_laws_centre_on_equal_temperament() {
 
 /// The thermal model bowed at nominal (the plugin's defaults, 1 N, and the middle of each
 /// note's window) in Helmholtz motion sounds in tune: with paper B's eq. (1) as written
-/// its notes were 17 cents flat at the defaults (median) and the middle slid. Both nominal
-/// bowings stick with the default constants since 2026-11-25. The intonation table is
-/// fitted at the defaults (with the mean of the two, the defaults sat 3.4 cents flat);
-/// the middle sounds a little sharper, the pitch falling with force (both printed).
+/// its notes sit 17 cents flat at the defaults (median) and the middle's pitch slides; the
+/// default constants keep both nominal bowings sticking. The intonation table is fitted at
+/// the defaults (fitted to the mean of the two, the defaults sit 3.4 cents flat); the
+/// middle sounds a little sharper, the pitch falling with force (both printed).
 #[test]
 fn the_thermal_model_bowed_at_nominal_is_in_tune_where_it_is_helmholtz() {
     let results = nominal_results();
@@ -230,7 +230,7 @@ fn the_thermal_model_bowed_at_nominal_is_in_tune_where_it_is_helmholtz() {
         "no thermal note at nominal bowing is in Helmholtz motion"
     );
     let median = cents[cents.len() / 2];
-    // 3 cents: issue 16's nominal target.
+    // 3 cents: the map's bound for a nominal cell in tune (docs/playing-space.md).
     assert!(
         median.abs() <= 3.0,
         "median {median:+.1} cents over {cents:?}"
@@ -268,8 +268,8 @@ fn far_above_the_window_the_static_laws_are_never_in_helmholtz_motion() {
     assert_never_helmholtz(&cells);
 }
 
-/// Issue 16, item 2, on the coarse subset: inside the window every model is in Helmholtz
-/// motion within 0.3 s. **Not met yet** (docs/playing-space.md: the point laws reach it in
+/// On the coarse subset: inside the window every model is in Helmholtz motion within
+/// 0.3 s. **Not met** (docs/playing-space.md: the point laws reach it in
 /// about a fifth of the window's cells, mostly in its upper half; the thermal model almost
 /// nowhere), so it is ignored in CI; run it with `cargo test --test playing_space --
 /// --ignored` to see the cells that miss.
@@ -310,6 +310,7 @@ fn weighted_strings_settle_the_cellos_middle_strings_at_the_defaults() {
     let mut bare = Vec::new();
     for note in 43..=56u8 {
         let cell = Cell::new(model, kind, note, 48_000.0, Bowing::Defaults, 0.6);
+        // 1 N times Z0 over 0.2 kg/s: 4.2 N on the G string, 2.5 N on the D.
         assert!(cell.bow.force_n > 2.0, "the defaults cell is weighted");
         weighted.push(cell);
         bare.push(Cell {
@@ -332,11 +333,11 @@ fn weighted_strings_settle_the_cellos_middle_strings_at_the_defaults() {
 }
 
 /// Paper B's instrument plays the same model at every host rate (its bow moves at its own
-/// internal rate; the host rate only resamples): the quick map's cells whose regime or
-/// pitch differed between 44.1 and 96 kHz before that (2026-11-26: viola 78 at
-/// `F_max / 2`, beta 0.12, Helmholtz at both but -15.1 against +26.8 cents; violin 85 at
-/// the defaults and cello 51 at the window's middle, Helmholtz at one rate and raucous at
-/// the other) now give the same regime and pitch.
+/// internal rate; the host rate only resamples): three cells of the quick map that a bow
+/// moving at the host rate plays differently at 44.1 and 96 kHz (viola 78 at `F_max / 2`,
+/// beta 0.12, Helmholtz at both but -15.1 against +26.8 cents; violin 85 at the defaults
+/// and cello 51 at the window's middle, Helmholtz at one rate and raucous at the other)
+/// give the same regime and pitch.
 #[test]
 fn the_thermal_model_plays_the_same_cell_at_44_1_and_96_khz() {
     for (kind, note, bowing) in [

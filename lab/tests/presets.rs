@@ -38,13 +38,14 @@ fn every_factory_preset_sounds_on_its_note() {
         assert!(level > 1e-3, "{id}: rms {level:.2e}");
         if setup.rubbed.is_none() {
             let tail_rms = rms(tail);
+            // -60 dBFS, as above: a bowed note that speaks is far louder.
             assert!(
                 tail_rms > 1e-3,
                 "{id}: the bowed note dies ({tail_rms:.2e} after 0.75 s)"
             );
-            // The bowed strings sound their note: within a quarter tone (the window's
-            // intonation is the playing-space issue's; this checks the preset plays the
-            // note, not an octave or a fifth off).
+            // The bowed strings sound their note: within a quarter tone (the intonation
+            // has its own tests, lab/tests/playing_space.rs; this checks the preset plays
+            // the note, not an octave or a fifth off).
             let hz = autocorrelation_pitch_hz(tail, FS, midi_to_hz(note as f64));
             let off = cents(hz, midi_to_hz(note as f64));
             assert!(

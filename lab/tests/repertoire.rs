@@ -32,7 +32,7 @@ use rayon::prelude::*;
 /// next begins (legato, one bow) unless a rest (note 0) comes between.
 struct Part {
     name: &'static str,
-    /// Two notes a second or slower, legato: the parts every model plays in tune today
+    /// Two notes a second or slower, legato: the parts every model plays in tune
     /// (asserted at every rate); the others are surveyed.
     cantabile: bool,
     kind: InstrumentKind,

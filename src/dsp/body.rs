@@ -196,6 +196,7 @@ mod tests {
             for mode in kind.body_modes() {
                 let m = muted(mode, scale);
                 if mode.freq_hz >= BRIDGE_MODES_FROM_HZ * scale {
+                    // Exact ratios but for f64 rounding.
                     assert!((m.freq_hz / mode.freq_hz - 0.5).abs() < 1e-12);
                     assert!((m.gain / mode.gain - 0.25).abs() < 1e-12);
                 } else {
@@ -241,6 +242,7 @@ mod tests {
         assert_eq!(modes[1].q, 300.0);
         assert_eq!(modes[5].q, 100.0);
         // Kept: 15.5 of 15.6.
+        // A ratio of sums of the peaks above: f64 rounding only.
         assert!((kept - 15.5 / 15.6).abs() < 1e-12, "{kept}");
     }
 

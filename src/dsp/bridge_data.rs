@@ -265,6 +265,8 @@ mod tests {
         assert_eq!(nearest_psd(2.0, 0.5, 1.0), [[2.0, 0.5], [0.5, 1.0]]);
         let g = nearest_psd(1.0, 2.0, 1.0);
         let [lo, hi] = symmetric_eigenvalues(g[0][0], g[0][1], g[1][1]);
+        // The eigenvalues of [[1, 2], [2, 1]] are 3 and -1, clipped to 0: f64 rounding at
+        // size 3.
         assert!(lo.abs() < 1e-12 && (hi - 3.0).abs() < 1e-12, "{lo} {hi}");
         assert_eq!(nearest_psd(-1.0, 0.0, -2.0), [[0.0; 2]; 2]);
     }

@@ -404,6 +404,8 @@ mod tests {
         // C1 at the knee: slope 1 on both sides.
         let h = 1e-7;
         let slope = (safety_limit(SAFETY_KNEE + h) - SAFETY_KNEE) / h;
+        // A one-sided difference over h = 1e-7: the curve's bend past the knee
+        // (f'' = -2 / 0.1) gives 1e-6, rounding 2e-9.
         assert!((slope - 1.0).abs() < 1e-5);
     }
 
@@ -432,6 +434,7 @@ mod tests {
     fn loss_filter_hits_both_gains_and_stays_passive() {
         let (w1, w2) = (0.02, 0.2);
         let f = OnePoleLoss::fit(w1, 0.99, w2, 0.9);
+        // The gain at w1 is set in closed form: rounding only.
         assert!((f.gain(w1) - 0.99).abs() < 1e-9);
         assert!((f.gain(w2) - 0.9).abs() < 1e-6);
         assert!(f.gain(0.0) < 1.0);

@@ -630,6 +630,7 @@ mod tests {
             );
             let tuned = want * 2f64.powf(-c / 1200.0);
             let f = cello.string(index).fundamental_hz();
+            // The string is tuned to this frequency: the two differ by f64 rounding only.
             assert!(
                 (f - tuned).abs() < 1e-9 * tuned,
                 "{f} Hz, table says {tuned} Hz"
@@ -646,6 +647,7 @@ mod tests {
                 cello.tick(bow);
             }
             let x: Vec<f64> = (0..fs as usize).map(|_| cello.tick(bow).audio).collect();
+            // Without the table the string is tuned to `want` itself: rounding only.
             assert!((cello.string(index).fundamental_hz() - want).abs() < 1e-9 * want);
             let got = peak_frequency_hz(&x, fs, want, 30.0);
             assert!(

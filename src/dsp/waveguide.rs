@@ -757,6 +757,8 @@ mod tests {
         };
         for k in 1..400 {
             let f = k as f64 / 400.0 * 0.5 * fs;
+            // f64 rounding of admittances of at most 0.3 s/kg (torsion 1 / (2 x 3.3 Z0),
+            // hair 1 / 5.77).
             assert!(y(f).0 >= -1e-15, "fs {fs}: Re Y({f}) = {}", y(f).0);
         }
         let high = (0.2 * fs).max(4.0 * f_c).min(0.45 * fs);
@@ -939,6 +941,8 @@ mod tests {
             assert!(e <= last * (1.0 + 1e-12), "energy grew: {last} -> {e}");
             last = e;
         }
+        // Over 200 periods at Q1 500 the fundamental keeps exp(-2 pi 200 / 500) = 0.08 of
+        // its energy, the loop's DC pair (Q about 640) 0.14.
         assert!(
             last < 0.5 * first,
             "the lifted string did not decay: {first} -> {last}"
@@ -981,14 +985,16 @@ mod tests {
 
     #[test]
     fn the_dispersion_fit_makes_the_same_stiff_string_at_every_rate_and_improves_with_order() {
-        // Found by the work-precision bench: with the allpass coefficient clamped at
-        // -0.95 the 768 kHz string came out nearly harmonic (partial 10 at -9.8 cents
-        // instead of +3.7), so the reference rate was a different string.
+        // The allpass coefficient is not clamped: clamped at -0.95, the 768 kHz string
+        // comes out nearly harmonic (partial 10 at -9.8 cents instead of +3.7), a different
+        // string from the 48 kHz one.
         let at_48k = fitted_partial_errors(48_000.0, DEFAULT_DISPERSION_STAGES);
         for fs in [22_050.0, 96_000.0, 192_000.0, 384_000.0, 768_000.0] {
             let here = fitted_partial_errors(fs, DEFAULT_DISPERSION_STAGES);
             println!("{fs} Hz: partials 2, 5, 10, 20 off by {here:.2?} cents");
             for (a, b) in here.iter().zip(&at_48k) {
+                // 0.1 cents: far inside the 13.5 cents a clamped coefficient moves
+                // partial 10 at 768 kHz.
                 assert!((a - b).abs() < 0.1, "{fs} Hz: {here:?} against {at_48k:?}");
             }
         }

@@ -327,6 +327,7 @@ mod tests {
         };
         let s = ContactSample::new(&frame, &bow);
         assert_eq!(s.string_velocity, -0.8);
+        // The sample holds f32: an ulp near 1 is 1.2e-7.
         assert!((s.relative_velocity + 0.9).abs() < 1e-6);
         assert!((s.mu - 0.2).abs() < 1e-6);
         let lifted = BowControl {

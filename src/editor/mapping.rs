@@ -127,11 +127,14 @@ mod tests {
         for i in 0..=400 {
             let x = r.left() + i as f32;
             let back = m.velocity_to_x(r, m.x_to_velocity(r, x));
+            // f32 on coordinates up to 420 px: an ulp there is 3e-5 px.
             assert!((back - x).abs() < 1e-3, "x {x} came back as {back}");
         }
         for j in 0..=300 {
             let y = r.top() + j as f32;
             let back = m.force_to_y(r, m.y_to_force(r, y));
+            // f32 through powf and ln: a relative ulp of the force moves the row by
+            // 300 / ln(1000) x 1.2e-7 = 5e-6 px, the coordinates' own ulp is 3e-5 px.
             assert!((back - y).abs() < 1e-2, "y {y} came back as {back}");
         }
     }
@@ -141,10 +144,14 @@ mod tests {
         let (m, r) = pad();
         for v in [-1.5f32, -0.7, -0.01, 0.0, 0.1, 1.2, 1.5] {
             let back = m.x_to_velocity(r, m.velocity_to_x(r, v));
+            // f32: an ulp of 1.5 m/s is 1.2e-7, of the 420 px it passes through 3e-5 px
+            // (2e-7 m/s).
             assert!((back - v).abs() < 1e-5, "v {v} came back as {back}");
         }
         for f in [0.011f32, 0.1, 0.5, 1.0, 3.3, 10.0] {
             let back = m.y_to_force(r, m.force_to_y(r, f));
+            // f32 through powf and ln: a relative ulp (1.2e-7) times ln(1000) = 6.9, and
+            // the pixel's own.
             assert!((back / f - 1.0).abs() < 1e-4, "f {f} came back as {back}");
         }
     }
@@ -154,6 +161,7 @@ mod tests {
         let (m, r) = pad();
         assert_eq!(m.x_to_velocity(r, r.left()), -1.5);
         assert_eq!(m.x_to_velocity(r, r.right()), 1.5);
+        // f32 rounding of values up to 1.5.
         assert!(m.x_to_velocity(r, r.center().x).abs() < 1e-6);
         let quarter = m.x_to_velocity(r, r.left() + 0.75 * r.width());
         assert!((quarter - 0.75).abs() < 1e-6);
@@ -164,11 +172,14 @@ mod tests {
         let (m, r) = pad();
         assert_eq!(m.y_to_force(r, r.bottom()), 0.0);
         assert_eq!(m.y_to_force(r, r.bottom() + 5.0), 0.0);
+        // f32 powf: an ulp of 10 N is 1e-6.
         assert!((m.y_to_force(r, r.top()) - 10.0).abs() < 1e-4);
         // Three decades over the height: the middle is 0.01 * 1000^0.5 = 0.316 N.
         let mid = m.y_to_force(r, r.center().y);
+        // f32 rounding, and the constant written to seven digits.
         assert!((mid - 0.316_227_8).abs() < 1e-4, "mid {mid}");
-        // One pixel above the bottom edge is just above the log floor.
+        // One pixel above the bottom edge is just above the log floor: one row of 300 is
+        // 0.01 x 1000^(1/300) = 0.01023 N.
         let above = m.y_to_force(r, r.bottom() - 1.0);
         assert!(above > 0.01 && above < 0.0105, "above {above}");
         // Forces the log scale cannot show sit on the bottom edge.
@@ -208,6 +219,7 @@ mod tests {
         let (m, r) = pad();
         let p = m.values_to_pos(r, 0.1, 1.0);
         let (v, f) = m.pos_to_values(r, p);
+        // f32 rounding through the pixel and back, as in the round trips above.
         assert!((v - 0.1).abs() < 1e-5 && (f - 1.0).abs() < 1e-4);
     }
 }

@@ -387,6 +387,8 @@ mod tests {
             assert!((lifts - first).abs_diff(m_lifts - m_first) <= 1);
             peaks.push(force[first..lifts].iter().copied().fold(0.0, f64::max));
             let rest = force[95_000];
+            // The hair damps a bounce at 12 /s (src/dsp/bounce.rs): what is left after 2 s
+            // is far under 1 % of the pull.
             assert!(
                 (rest / stroke::SPICCATO_PULL_N - 1.0).abs() < 0.01,
                 "rests at {rest} N"
@@ -525,10 +527,12 @@ mod tests {
         let mut p = cello_with(&setup);
         p.note_on(58, 1.0);
         let ringing = rms(&play(&mut p, 0.2));
+        // -60 dBFS: a plucked note is far louder.
         assert!(ringing > 1e-3, "{ringing}");
         p.note_off(58);
         play(&mut p, 0.1);
         let after = rms(&play(&mut p, 0.1));
+        // 0.25: 12 dB down, the bowed note's release criterion (lab/tests/note_release.rs).
         assert!(after < 0.25 * ringing, "{ringing} then {after}");
     }
 
@@ -557,6 +561,7 @@ mod tests {
     fn the_velocity_sets_the_plucks_displacement_over_its_range() {
         let soft = pluck_for(InstrumentKind::Cello, 0.0).displacement_m;
         let hard = pluck_for(InstrumentKind::Cello, 1.0).displacement_m;
+        // f64 rounding only.
         assert!((20.0 * (hard / soft).log10() - PLUCK_RANGE_DB).abs() < 1e-9);
         let mut last = 0.0;
         for v in 0..=127 {

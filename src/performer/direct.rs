@@ -174,7 +174,9 @@ mod tests {
         assert_eq!((speed_at(0.0), speed_at(1.0)), (0.0, 1.5));
         assert_eq!((force_at(0.0), force_at(1.0)), (0.0, 10.0));
         assert_eq!((position_at(0.0), position_at(1.0)), (0.02, 0.5));
-        // The defaults are reachable near the documented controller values.
+        // The defaults are reachable near the documented controller values, within one
+        // 7-bit step of each curve there (3 x / 127 = 0.006 m/s, 40 x^3 / 127 = 0.055 N):
+        // 1.5 (33/127)^2 = 0.101 m/s, 10 (71/127)^4 = 0.98 N.
         assert!((speed_at(33.0 / 127.0) - 0.1).abs() < 0.005);
         assert!((force_at(71.0 / 127.0) - 1.0).abs() < 0.05);
     }
@@ -197,6 +199,7 @@ mod tests {
             last = d.apply(bow);
         }
         let share = (last.velocity_m_per_s + 0.1) / (-1.5 + 0.1);
+        // 1 - e^-1 = 0.632 after 480 samples; a sample more or less moves it by 0.0008.
         assert!((share - 0.632).abs() < 0.01, "{share}");
         for _ in 0..(0.2 * fs) as usize {
             last = d.apply(bow);

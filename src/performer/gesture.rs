@@ -445,6 +445,7 @@ mod tests {
         let cents = vibrato_cents(&Setup::default(), &[]);
         // Silent through the onset delay.
         let delay = (VIBRATO_DELAY_S * FS) as usize;
+        // 1e-6 cents: rounding; the finger has not moved.
         assert!(cents[..delay - 64].iter().all(|c| c.abs() < 1e-6));
         // After the fade-in: depth and rate within 5 % of the setting (the drift wanders
         // by at most 4 % and 3 %).
@@ -464,9 +465,11 @@ mod tests {
             ..Setup::default()
         };
         let (_, rate) = depth_and_rate(&vibrato_cents(&setup, &[]));
+        // 5 %, as above: the drift moves the rate by at most 3 %.
         assert!((rate / 7.0 - 1.0).abs() < 0.05, "parameter: {rate}");
         // CC19 at 0: the slowest rate.
         let (_, rate) = depth_and_rate(&vibrato_cents(&setup, &[(19, 0.0)]));
+        // 5 %, as above.
         assert!(
             (rate / VIBRATO_RATE_MIN_HZ - 1.0).abs() < 0.05,
             "CC19: {rate}"
@@ -499,6 +502,8 @@ mod tests {
         // The attack: from rest to the asked speed, the force landing as asked (no accent
         // at half velocity).
         p.tick(bow);
+        // One sample into the stroke's linear ramp from rest (35 ms at velocity 0.5):
+        // 0.37 m/s / 1660, about 2e-4 m/s.
         assert!(p.bow().velocity_m_per_s.abs() < 0.01 && p.bow().force_n == bow.force_n);
         let attack = (stroke::ATTACK_SLOWEST_S * FS) as usize;
         for _ in 0..attack {

@@ -182,6 +182,8 @@ mod tests {
             p.tick(bow);
         }
         let want = direct::force_at((100.0f32 / 127.0) as f64);
+        // Within a millionth the smoothing snaps to its target (about 14 time constants,
+        // 0.14 s): after 0.2 s the force is the curve's value to rounding.
         assert!((p.bow().force_n - want).abs() < 1e-9, "{:?}", p.bow());
         // The parameter moves (automation): the force is the parameter's again.
         let automated = BowControl {
@@ -220,6 +222,7 @@ mod tests {
         p.set_controller(74, 1.0);
         run(&mut p);
         // The force controller's curve at half its travel (the mapping's top).
+        // Snapped to the target after 0.2 s, as above: rounding only.
         assert!(
             (p.bow().force_n - direct::force_at(0.5)).abs() < 1e-9,
             "{:?}",
@@ -230,6 +233,7 @@ mod tests {
         p.set_midi_map(&MidiMap::default());
         p.set_controller(direct::CC_BOW_FORCE, 1.0);
         run(&mut p);
+        // Snapped to the target after 0.2 s, as above.
         assert!((p.bow().force_n - direct::force_at(1.0)).abs() < 1e-9);
     }
 
@@ -249,6 +253,8 @@ mod tests {
         let mut p = cello();
         p.note_on(50, 0.8);
         let hz = |p: &Performer| p.strings().string(string).fundamental_hz();
+        // The bent string stops where the stopped note does: the same place and table
+        // correction, so rounding only.
         let same = |a: f64, b: f64| (1200.0 * (a / b).log2()).abs() < 0.01;
         p.set_pitch_wheel(1.0);
         assert!(same(hz(&p), stopped_hz(52)), "default range: two semitones");

@@ -295,7 +295,7 @@ mod tests {
     #[test]
     fn the_default_map_passes_each_controller_through_unchanged() {
         // The defaults move their targets with the controller's own value, bit for bit
-        // (the performer's behaviour before the map existed).
+        // (each controller drives its target directly, as with no map at all).
         let map = MidiMap::default();
         for x in [0.0, 1.0 / 127.0, 0.5, 100.0 / 127.0, 1.0] {
             for (cc, target) in [
@@ -322,6 +322,7 @@ mod tests {
         m.max = 0.75;
         assert_eq!(m.shape(0.0), 0.25);
         assert_eq!(m.shape(1.0), 0.75);
+        // f64 rounding only.
         assert!((m.shape(0.5) - 0.5).abs() < 1e-12);
         // Inverted.
         m.min = 1.0;
@@ -331,6 +332,7 @@ mod tests {
         // Curves: +1 is x^(1/3) (fast from the bottom), -1 is x^3; the ends stay.
         let mut c = Mapping::new(7, Target::Dynamics);
         c.curve = 1.0;
+        // The cube and cube root in f64: rounding only.
         assert!((c.shape(0.125) - 0.5).abs() < 1e-12);
         c.curve = -1.0;
         assert!((c.shape(0.5) - 0.125).abs() < 1e-12);

@@ -393,6 +393,7 @@ mod tests {
             let bow = BowControl::default();
             let out: Vec<f64> = (0..24_000).map(|_| mpe.tick(bow).audio).collect();
             assert!(out.iter().all(|x| x.is_finite()));
+            // -60 dBFS: two bowed notes are far louder.
             assert!(crate::analysis::rms(&out[12_000..]) > 1e-3);
         }
 

@@ -238,7 +238,10 @@ mod tests {
         };
         let (ticked, _) = render(false);
         let (skipped, blocks) = render(true);
+        // D3 sleeps about 15 s after its release at 0.1 s and stays asleep to the next note
+        // at 20 s: some 450 blocks of 512.
         assert!(blocks > 100, "only {blocks} blocks skipped");
+        // -60 dBFS: the bowed notes are far louder.
         assert!(ticked.iter().any(|x| x.abs() > 1e-3));
         let differing = ticked
             .iter()

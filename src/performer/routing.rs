@@ -311,6 +311,8 @@ mod tests {
         p.note_off(52);
         p.note_on(53, 0.8);
         p.tick(bow);
+        // One sample into the stroke's ramp from rest (about 17 ms long,
+        // docs/playing-space.md): about 1e-4 m/s.
         assert!(p.bow().velocity_m_per_s.abs() < 0.01);
         for _ in 0..(0.2 * FS) as usize {
             p.tick(bow);
@@ -344,6 +346,7 @@ mod tests {
             cents
         };
         let firm = slide(0.8);
+        // The intonation table moves each place on the string by a few cents.
         assert!(
             (firm[0] - 300.0).abs() < 10.0,
             "a firm legato jumps: {}",
@@ -351,13 +354,17 @@ mod tests {
         );
         let soft = slide(0.3);
         // Rises monotonically from D3 to F3 over the glide time (0.12 s), then stays.
+        // 1e-9 cents: rounding.
         assert!(soft.windows(2).all(|w| w[1] >= w[0] - 1e-9));
         let at = |t: f64| soft[(t * FS / 64.0) as usize];
+        // The first 1.3 ms step of the 0.12 s glide moves about 3 cents, the table a few
+        // more.
         assert!(at(0.0) < 20.0, "{}", at(0.0));
         let half = at(0.5 * GLIDE_S_DEFAULT);
         // Halfway in time, halfway in semitones (within 20 cents: the intonation table
         // moves each place on the string by a few cents, and steps are 1.3 ms).
         assert!((half - 150.0).abs() < 20.0, "{half}");
+        // The glide is over (0.12 s): both sit on F3's stopped pitch, to rounding.
         assert!((at(0.25) - firm[firm.len() - 1]).abs() < 0.01);
     }
 
@@ -393,17 +400,22 @@ mod tests {
             }
         }
         // The bow stays on through the glide: every 10 ms of it sounds.
+        // -60 dBFS: a bowed note is far louder.
         assert!(audio.chunks(480).all(|c| crate::analysis::rms(c) > 1e-3));
         let at = |t: f64| cents[(t * FS / 64.0) as usize];
         // Rises monotonically from D3 to F3 over the glide time, then stays.
+        // 1e-9 cents: rounding.
         assert!(cents.windows(2).all(|w| w[1] >= w[0] - 1e-9));
+        // The first 1.3 ms step of the glide moves about 3 cents, the table a few more.
         assert!(at(0.0) < 20.0, "{}", at(0.0));
         // Halfway in time, halfway in semitones (within 20 cents: the intonation table
         // moves each place on the string by a few cents, and steps are 1.3 ms).
         let half = at(0.5 * GLIDE_S_DEFAULT);
         assert!((half - 150.0).abs() < 20.0, "{half}");
         let end = cents[cents.len() - 1];
+        // The thermal intonation table moves each place on the string by a few cents.
         assert!((end - 300.0).abs() < 15.0, "{end}");
+        // The glide is over by 0.2 s (it takes 0.12 s): the tuning stands still.
         assert!((at(0.2) - end).abs() < 0.01);
     }
 }

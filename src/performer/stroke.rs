@@ -323,6 +323,8 @@ mod tests {
         assert!((fast - ATTACK_FASTEST_S).abs() <= 2.0 / FS, "{fast}");
         assert!(slow > mid && mid > fast);
         assert_eq!((soft, mid_force), (1.0, 1.0));
+        // The accent decays over 40 ms (`ACCENT_S`): by the first sample it has lost 1/1920
+        // of itself.
         assert!((hard - (1.0 + ACCENT_MAX)).abs() < 0.01, "{hard}");
     }
 

@@ -41,6 +41,8 @@ pub(super) fn stick_velocity(p: &mut Performer, from: usize, to: usize) -> f64 {
     for i in 0..to {
         let frame = p.tick(bow);
         let rel = frame.bow_point_velocity_m_per_s - p.bow().velocity_m_per_s;
+        // Within 10 % of the bow: the playing-space map's sticking criterion
+        // (docs/playing-space.md).
         if i >= from && rel.abs() < 0.1 * bow.velocity_m_per_s {
             sum += frame.bow_point_velocity_m_per_s;
             n += 1;

@@ -972,12 +972,12 @@ mod tests {
         // step only if g changes sign along it, so the root lies within it; the bisection
         // stops at a bracket one tolerance wide. So one tolerance, and the bound, 2, leaves
         // room for g's curvature within a step near the adhesion map's corners (measured:
-        // 0.48 tolerances; 0.76 with a bristle three times stiffer). Before the kink test
-        // the stop trusted a short step from the steep side of the kink, where the slope
-        // is up to 2 |k1| steeper than on the other: 4.6 tolerances at 1e-2 m/s, and 50 with
-        // the stiffer bristle. The stop before that took a short damped step for
-        // convergence and missed by 80 to 460 tolerances at 1e-4 m/s, enough for the
-        // bristle to drift and grow a violin E7 bowed at 0.15 N to a peak of 375.
+        // 0.48 tolerances; 0.76 with a bristle three times stiffer). Without the kink test,
+        // a stop that trusts a short step from the steep side of the kink, where the slope
+        // is up to 2 |k1| steeper than on the other, misses by 4.6 tolerances at 1e-2 m/s,
+        // and 50 with the stiffer bristle; one that takes a short damped step for
+        // convergence misses by 80 to 460 tolerances at 1e-4 m/s, enough for the bristle
+        // to drift and grow a violin E7 bowed at 0.15 N to a peak of 375.
         let mut worst = 0.0f64;
         for (law, params) in [BristleLaw::LuGre, BristleLaw::ElastoPlastic]
             .into_iter()

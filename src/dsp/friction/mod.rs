@@ -379,6 +379,7 @@ mod tests {
         let f = c.solve(load, bow);
         assert!(c.is_sticking());
         assert!(f.abs() <= 0.4 * 1.1);
+        // Sticking solves v_s = v_b: f64 rounding at 0.1 m/s (an ulp is 1.4e-17).
         assert!((0.05 + LOAD_Y * f - 0.1).abs() < 1e-15);
     }
 

@@ -273,6 +273,7 @@ mod tests {
             (100.0, 4.0),
         ] {
             ftcs_step(k, &t, &mut next, 1, &[v; 3], &[1.0; 3]);
+            // The grid is NodeReal (f32): an ulp at 10 K is 1e-6.
             assert!((next[2] - want_middle).abs() < 1e-5, "v {v}: {}", next[2]);
             assert!(
                 next.iter().all(|x| *x >= 0.0 && *x <= 10.0),
