@@ -618,7 +618,7 @@ pub fn peers(seconds: f64, dir: &std::path::Path) -> Result<String, String> {
         let me = me.clone();
         PeerRow {
             name,
-            seconds: (seconds / 10.0).max(1.0),
+            seconds: (seconds / 10.0).max(0.1),
             goal,
             command: Box::new(move |secs: f64| {
                 let mut c = std::process::Command::new(&me);
@@ -659,7 +659,7 @@ pub fn peers(seconds: f64, dir: &std::path::Path) -> Result<String, String> {
             PeerGoal::TimesStk(1.5),
         ),
         render_row(
-            "elasto-plastic, reference tol.",
+            "elasto-plastic, reference tolerance",
             "elasto-plastic",
             None,
             PeerGoal::None,
@@ -690,8 +690,9 @@ pub fn peers(seconds: f64, dir: &std::path::Path) -> Result<String, String> {
         rows.iter()
             .map(|row| {
                 // Long enough that the difference is the steady sound, short enough for
-                // valgrind (about 50 times slower).
-                let short = if row.seconds < seconds { 0.25 } else { 2.0 };
+                // valgrind (about 50 times slower): 2 s and 4 s of a point-bow string,
+                // 0.25 s and 0.5 s of paper B's scenes, less for a short run.
+                let short = (0.5 * row.seconds).min(if row.seconds < seconds { 0.25 } else { 2.0 });
                 instructions_per_sample(&*row.command, short, 2.0 * short, row.name).ok()
             })
             .collect()

@@ -65,10 +65,10 @@ fn a_released_stopped_note_falls_12_db_under_the_next_note_on_another_string_wit
     // (instrument, released stopped note, next note on the neighbouring string), the next
     // note landing as the first is released (legato across strings, as in a phrase).
     let cases = [
-        (InstrumentKind::Cello, 46, 53), // Bb2 on G, then F3 on D
-        (InstrumentKind::Cello, 40, 47), // E2 on C, then B2 on G
-        (InstrumentKind::Cello, 52, 59), // E3 on D, then B3 on A
-        (InstrumentKind::Viola, 51, 58), // Eb3 on C, then Bb3 on G
+        (InstrumentKind::Cello, 46, 53),  // Bb2 on G, then F3 on D
+        (InstrumentKind::Cello, 40, 47),  // E2 on C, then B2 on G
+        (InstrumentKind::Cello, 52, 59),  // E3 on D, then B3 on A
+        (InstrumentKind::Viola, 51, 58),  // Eb3 on C, then Bb3 on G
         (InstrumentKind::Violin, 60, 66), // C4 on G, then F#4 on D
         (InstrumentKind::Violin, 71, 78), // B4 on A, then F#5 on E
     ];

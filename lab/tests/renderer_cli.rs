@@ -558,16 +558,23 @@ fn bench_peers_compares_with_stk_or_says_how_to_install_it() {
     let stdout = String::from_utf8_lossy(&run.stdout);
     let stderr = String::from_utf8_lossy(&run.stderr);
     if run.status.success() {
-        // Four rows, each with its ratio to STK (STK's own is 1).
+        // Every row of the speed table, the strings with their ratio to STK (STK's own
+        // is 1), paper B's scenes in % of a core, each with its goal and whether it is met.
         for row in [
-            "STK Bowed",
-            "hyperbolic string",
-            "elasto-plastic string",
-            "elasto-plastic, plugin tolerance",
+            "| STK Bowed |",
+            "| hyperbolic string (default) |",
+            "| elasto-plastic, plugin tolerance |",
+            "| elasto-plastic, reference tolerance |",
+            "| thermal cello N_B 60, C bowed |",
+            "| thermal cello N_B 60, C+G |",
+            "| thermal quartet, plugin quality |",
+            "| silence through the performer",
         ] {
-            assert!(stdout.contains(row), "{stdout}");
+            assert!(stdout.contains(row), "{row} missing from\n{stdout}");
         }
         assert!(stdout.contains("1.00x STK"), "{stdout}");
+        assert!(stdout.contains("% of a core"), "{stdout}");
+        assert_eq!(stdout.matches("| <= ").count(), 6, "six goals: {stdout}");
     } else {
         // No STK or g++ on this machine: one line that says how to get them.
         assert!(stderr.contains("install-peers.sh"), "{stderr}");
