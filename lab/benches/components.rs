@@ -131,7 +131,7 @@ fn performer_tick(c: &mut Criterion) {
     });
     group.bench_function("through the performer", |b| {
         b.iter(|| {
-            performer.tick_block(black_box(bow), &mut block);
+            performer.process(black_box(bow), &mut block);
             black_box(block[511])
         })
     });
@@ -150,7 +150,7 @@ fn performer_tick(c: &mut Criterion) {
     });
     group.bench_function("through the performer", |b| {
         b.iter(|| {
-            performer.tick_run(
+            performer.process_run(
                 block.len(),
                 || (black_box(bow), ()),
                 |k, (), frame, _, _| block[k] = frame.audio,

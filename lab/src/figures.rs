@@ -157,7 +157,7 @@ pub fn serafin_modal(out: &Path) -> Result<String, String> {
     let mut t = Vec::with_capacity(n);
     let (mut vr, mut vb, mut f) = (Vec::new(), Vec::new(), Vec::new());
     for i in 0..n {
-        let frame = scene.tick();
+        let frame = scene.tick(scene.preset_bow());
         t.push(1e3 * i as f64 / fs);
         vr.push(frame.contact.resonator_velocity_m_per_s);
         vb.push(frame.contact.exciter_velocity_m_per_s);

@@ -434,7 +434,7 @@ pub fn render_rubbed_with(
     let frames = (seconds * sample_rate_hz).round() as usize;
     let mut out = Rendered::with_capacity(sample_rate_hz, frames);
     for _ in 0..frames {
-        let frame = scene.tick();
+        let frame = scene.tick(scene.preset_bow());
         out.audio.push(frame.audio);
         out.bow_point_velocity_m_per_s
             .push(frame.contact.resonator_velocity_m_per_s);

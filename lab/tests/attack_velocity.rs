@@ -118,7 +118,8 @@ fn a_harder_note_velocity_starts_louder_and_both_speak_at_the_notes_pitch() {
                     kind.name()
                 ));
                 // An audible difference between velocities 30 and 120: 3 dB in the first
-                // 80 ms' peak, or 20 % in their spectral centroid.
+                // 80 ms' peak, or 20 % in their spectral centroid (each several times the
+                // just-noticeable difference of level, about 1 dB, and of brightness).
                 if louder < 3.0 && brighter < 1.2 {
                     failures.push(format!(
                         "{} {note} {name}: {louder:+.2} dB, x{brighter:.2}",

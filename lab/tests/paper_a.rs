@@ -329,7 +329,9 @@ fn switching_friction_law_while_a_note_sounds_gives_no_click_or_blow_up() {
 #[test]
 fn the_authors_modal_scenario_sticks_and_slips_while_the_bow_accelerates() {
     let mut scene = RubbedScene::new(RubbedPreset::PaperModal, 44_100.0).unwrap();
-    let frames: Vec<_> = (0..44_100).map(|_| scene.tick()).collect();
+    let frames: Vec<_> = (0..44_100)
+        .map(|_| scene.tick(scene.preset_bow()))
+        .collect();
     let bow_end = frames.last().unwrap().contact.exciter_velocity_m_per_s;
     let stick = frames
         .iter()
@@ -372,7 +374,7 @@ fn every_friction_sound_effect_preset_sounds_and_stays_bounded_with_every_law() 
             inst.set_friction_model(model);
             inst.note_on();
             let audio: Vec<f64> = (0..(2.0 * FS) as usize)
-                .map(|_| inst.tick(1.0, 1.0))
+                .map(|_| inst.tick_scaled(1.0, 1.0))
                 .collect();
             let late = rms(&audio[FS as usize..]);
             let peak = audio.iter().fold(0.0f64, |m, x| m.max(x.abs()));

@@ -151,7 +151,7 @@ impl Engine for RubbedInstrument {
     }
     fn tick(&mut self, bow: BowControl) -> Frame {
         Frame {
-            audio: self.tick_bow(&bow),
+            audio: self.tick(&bow),
             ..Frame::default()
         }
     }

@@ -183,7 +183,7 @@ impl Fingering {
         let due = self.glide_countdown == 0;
         let retune = due.then(|| {
             self.glide_countdown = self.glide_every;
-            self.advance_glides()
+            self.tick_glides()
         });
         self.glide_countdown -= 1;
         retune
@@ -201,7 +201,7 @@ impl Fingering {
 
     /// Moves every gliding finger one step toward its note. Returns the pitch (Hz) each
     /// string that moved and holds a note should now be tuned to.
-    fn advance_glides(&mut self) -> [Option<f64>; STRINGS] {
+    fn tick_glides(&mut self) -> [Option<f64>; STRINGS] {
         let mut retune = [None; STRINGS];
         let mut any = false;
         for i in 0..STRINGS {

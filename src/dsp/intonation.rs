@@ -91,7 +91,7 @@ impl TunedModel {
 }
 
 /// The free-decay pitch, Hz, that `string` of `kind` is stopped at to play MIDI `note`
-/// bent by `bend` semitones under a reference `reference` semitones from A4 = 440 Hz:
+/// bent by `bend_semitones` under a reference `reference` semitones from A4 = 440 Hz:
 /// equal temperament moved by `table`'s correction for `row` at the bent note's place on
 /// the string (`None`: tuned by the free decay). Both string instruments tune by it.
 pub fn tuned_hz(
@@ -100,7 +100,7 @@ pub fn tuned_hz(
     kind: InstrumentKind,
     string: usize,
     note: u8,
-    bend: f64,
+    bend_semitones: f64,
     reference: f64,
 ) -> f64 {
     let open = kind.open_notes()[string.min(STRINGS - 1)] as f64;
@@ -109,7 +109,7 @@ pub fn tuned_hz(
     // floor are sized for these ends).
     let margin = super::vocabulary::PITCH_BEND_SEMITONES;
     let top = open + MAX_STOP_SEMITONES as f64;
-    let played = (note as f64 + bend).clamp(open - margin, top + margin);
+    let played = (note as f64 + bend_semitones).clamp(open - margin, top + margin);
     let correction = table.map_or(0.0, |t| {
         t.correction_cents(row, kind, string, played - open)
     });

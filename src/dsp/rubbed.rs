@@ -21,7 +21,7 @@
 //! let mut scene = RubbedScene::new(RubbedPreset::WineGlass, 48_000.0).unwrap();
 //! let mut peak = 0.0f64;
 //! for _ in 0..4800 {
-//!     peak = peak.max(scene.tick().audio.abs());
+//!     peak = peak.max(scene.tick(scene.preset_bow()).audio.abs());
 //! }
 //! assert!(peak.is_finite());
 //! ```
@@ -277,13 +277,12 @@ impl RubbedScene {
         self.contact.is_sticking()
     }
 
-    /// One sample at the preset's velocity and force.
-    pub fn tick(&mut self) -> RubbedFrame {
-        let bow = BowInput {
+    /// The preset's own velocity and force.
+    pub fn preset_bow(&self) -> BowInput {
+        BowInput {
             velocity_m_per_s: self.spec.velocity_m_per_s,
             normal_force_n: self.spec.normal_force_n,
-        };
-        self.tick_with(bow)
+        }
     }
 
     /// One sample with an explicit exciter velocity and normal force. A modal exciter is
@@ -293,8 +292,8 @@ impl RubbedScene {
     /// ([`AnyFriction::high_speed_friction_n`]): the static curves have no viscous term,
     /// and a push above their `mu_d F_N` would never be balanced. (A fixed push
     /// accelerated the free mass without bound under a lighter force or a static law, and
-    /// it then struck the object at tens of m/s: found by the stress suite.)
-    pub fn tick_with(&mut self, bow: BowInput) -> RubbedFrame {
+    /// it then struck the object at tens of m/s.)
+    pub fn tick(&mut self, bow: BowInput) -> RubbedFrame {
         let f_n = bow.normal_force_n;
         let push_n = if f_n > 0.0 && self.spec.normal_force_n > 0.0 {
             let push =
@@ -340,7 +339,7 @@ const RUB_SLEEP_ENERGY_J: f64 = 1e-16;
 /// active object (force ramps over 20 ms), note off lifts it and the object rings on. The
 /// bow controls scale the preset's own velocity and force: 1.0 at the plugin's defaults
 /// (0.1 m/s, 1 N); a modal exciter (paper-modal) keeps its own target velocity, pushed in
-/// proportion to the force (see [`RubbedScene::tick_with`]). Every preset is built
+/// proportion to the force (see [`RubbedScene::tick`]). Every preset is built
 /// when the instrument is made, so switching never allocates; an object switched away from
 /// is lifted and rings on (no click) until it falls asleep.
 #[derive(Debug, Clone)]
@@ -353,7 +352,7 @@ pub struct RubbedInstrument {
 }
 
 /// The bow at which every rubbed preset plays at its own velocity and force: a bow of
-/// twice this velocity rubs twice as fast ([`RubbedInstrument::tick_bow`]).
+/// twice this velocity rubs twice as fast ([`RubbedInstrument::tick`]).
 pub const REFERENCE_BOW: BowControl = BowControl {
     velocity_m_per_s: 0.1,
     force_n: 1.0,
@@ -502,15 +501,15 @@ impl RubbedInstrument {
 
     /// One sample bowed with `bow` in SI units: the preset's own velocity and force are
     /// scaled by the bow's against [`REFERENCE_BOW`].
-    pub fn tick_bow(&mut self, bow: &BowControl) -> f64 {
-        self.tick(
+    pub fn tick(&mut self, bow: &BowControl) -> f64 {
+        self.tick_scaled(
             bow.velocity_m_per_s / REFERENCE_BOW.velocity_m_per_s,
             bow.force_n / REFERENCE_BOW.force_n,
         )
     }
 
     /// One sample; `velocity_scale` and `force_scale` multiply the preset's own values.
-    pub fn tick(&mut self, velocity_scale: f64, force_scale: f64) -> f64 {
+    pub fn tick_scaled(&mut self, velocity_scale: f64, force_scale: f64) -> f64 {
         let mut audio = 0.0;
         for (i, voice) in self.voices.iter_mut().enumerate() {
             if !voice.awake {
@@ -531,7 +530,7 @@ impl RubbedInstrument {
                 velocity_m_per_s: spec.velocity_m_per_s * velocity_scale,
                 normal_force_n: spec.normal_force_n * (force_scale * voice.bow_gain).max(0.0),
             };
-            audio += voice.scene.tick_with(bow).audio;
+            audio += voice.scene.tick(bow).audio;
         }
         audio
     }

@@ -126,11 +126,11 @@ pub trait StringBank {
         &mut self,
         resampler: &mut Resampler,
         out: &mut [f64],
-        mut step: impl InternalStep<Self>,
+        mut step: impl InternalSample<Self>,
     ) where
         Self: Sized,
     {
-        resampler.process(|| step.step(self), out);
+        resampler.process(|| step.tick(self), out);
     }
     /// The probed string's last internal sample: velocity at the bow and friction force.
     fn probe(&self) -> (f64, f64);
@@ -210,24 +210,24 @@ pub(super) struct Hands {
 
 /// One internal sample's work, handed to [`StringBank::render`]: a type with an
 /// always-inlined method rather than a closure, because a closure made outside a bank's
-/// `#[target_feature]` loop is compiled as its own function without the feature (the
-/// thermal instrument's per-sample work ran as baseline SSE2 code that way).
-pub trait InternalStep<B> {
+/// `#[target_feature]` loop is compiled as its own function without the feature, and the
+/// per-sample work would run as baseline SSE2 code.
+pub trait InternalSample<B> {
     /// Sets the bows for one internal sample and computes it.
-    fn step(&mut self, bank: &mut B) -> f64;
+    fn tick(&mut self, bank: &mut B) -> f64;
 }
 
-/// The player's hands with the bow of this host sample: [`InternalStep`] for
+/// The player's hands with the bow of this host sample: [`InternalSample`] for
 /// [`FourStrings::tick`].
-struct HandsStep<'a> {
+struct HandsSample<'a> {
     hands: &'a mut Hands,
     bow: BowControl,
 }
 
-impl<B: StringBank> InternalStep<B> for HandsStep<'_> {
+impl<B: StringBank> InternalSample<B> for HandsSample<'_> {
     #[inline(always)]
-    fn step(&mut self, bank: &mut B) -> f64 {
-        self.hands.step(bank, self.bow)
+    fn tick(&mut self, bank: &mut B) -> f64 {
+        self.hands.tick(bank, self.bow)
     }
 }
 
@@ -236,7 +236,7 @@ impl Hands {
     /// the bank's sample, asking for each string's bow as it computes it (the envelope,
     /// the weighting and the note's expression on the shared bow).
     #[inline(always)]
-    fn step<B: StringBank>(&mut self, bank: &mut B, bow: BowControl) -> f64 {
+    fn tick<B: StringBank>(&mut self, bank: &mut B, bow: BowControl) -> f64 {
         if self.lifting {
             self.lift_tick(bank);
         }
@@ -806,13 +806,13 @@ impl<B: StringBank> FourStrings<B> {
         let out = match &mut self.resampler {
             None if B::SAMPLE_IS_FLUSHED && self.pending.is_none() => {
                 // One internal sample, already audio: as it is.
-                let audio = self.hands.step(&mut self.bank, bow) * self.bank.output_gain();
+                let audio = self.hands.tick(&mut self.bank, bow) * self.bank.output_gain();
                 return self.finish(audio);
             }
-            None => self.hands.step(&mut self.bank, bow),
+            None => self.hands.tick(&mut self.bank, bow),
             Some(resampler) => {
                 let mut out = [0.0];
-                let step = HandsStep {
+                let step = HandsSample {
                     hands: &mut self.hands,
                     bow,
                 };

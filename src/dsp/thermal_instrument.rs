@@ -50,7 +50,7 @@ use super::bridge::{solve_junction, BridgeMode, ModalBridge};
 use super::intonation;
 use super::resample::Resampler;
 pub use super::strings::{FourStrings, RECONFIGURE_FADE_S};
-use super::strings::{InternalStep, StringBank, StringBow};
+use super::strings::{InternalSample, StringBank, StringBow};
 use super::thermal::{
     HairParams, ThermalBowControl, ThermalCapacity, ThermalParams, ThermalString, ThermalStringSpec,
 };
@@ -185,9 +185,9 @@ fn render_avx2(
     bank: &mut ThermalBank,
     resampler: &mut Resampler,
     out: &mut [f64],
-    mut step: impl InternalStep<ThermalBank>,
+    mut step: impl InternalSample<ThermalBank>,
 ) {
-    resampler.process(|| step.step(bank), out);
+    resampler.process(|| step.tick(bank), out);
 }
 
 /// Paper B's strings and modal bridge at the internal rate, with the bow's
@@ -325,7 +325,7 @@ impl StringBank for ThermalBank {
         &mut self,
         resampler: &mut Resampler,
         out: &mut [f64],
-        mut step: impl InternalStep<Self>,
+        mut step: impl InternalSample<Self>,
     ) {
         #[cfg(target_arch = "x86_64")]
         if self.wide_simd {
@@ -333,7 +333,7 @@ impl StringBank for ThermalBank {
             unsafe { render_avx2(self, resampler, out, step) };
             return;
         }
-        resampler.process(|| step.step(self), out);
+        resampler.process(|| step.tick(self), out);
     }
 
     fn probe(&self) -> (f64, f64) {

@@ -268,9 +268,9 @@ mod tests {
         model: FrictionModel,
         bow: BowControl,
         release_s: Option<f64>,
-        bend: f64,
+        bend_semitones: f64,
     ) -> Vec<ContactSample> {
-        waveguide_settled(model, bow, release_s, bend, SETTLE_S)
+        waveguide_settled(model, bow, release_s, bend_semitones, SETTLE_S)
     }
 
     /// [`waveguide`] after `settle_s` instead of `SETTLE_S`.
@@ -278,12 +278,12 @@ mod tests {
         model: FrictionModel,
         bow: BowControl,
         release_s: Option<f64>,
-        bend: f64,
+        bend_semitones: f64,
         settle_s: f64,
     ) -> Vec<ContactSample> {
         let mut cello = Instrument::new(InstrumentKind::Cello, FS);
         cello.set_friction_model(model);
-        cello.set_pitch_bend(bend);
+        cello.set_pitch_bend(bend_semitones);
         cello.note_on(D3);
         let release = release_s.map(|s| (s * FS) as usize);
         scope_window(

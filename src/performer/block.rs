@@ -62,7 +62,7 @@ fn write_frame(channels: &mut [&mut [f32]], sample: usize, audio: f64) {
     }
 }
 
-/// Samples of the block rendered in one call to [`Performer::tick_block`].
+/// Samples of the block rendered in one call to [`Performer::process`].
 const CHUNK: usize = 64;
 
 impl Performer {
@@ -104,8 +104,8 @@ impl Performer {
     ///
     /// A block with nothing sounding and nothing landing is silence without a per-sample
     /// call (the gesture's clocks still advance). Otherwise the block is cut at its
-    /// events into runs: a settled run renders in chunks ([`Performer::tick_block`]), a
-    /// moving or listened one sample by sample ([`Performer::tick_run`]); the same samples
+    /// events into runs: a settled run renders in chunks ([`Performer::process`]), a
+    /// moving or listened one sample by sample ([`Performer::process_run`]); the same samples
     /// either way.
     pub fn render_block(
         &mut self,
@@ -156,7 +156,7 @@ impl Performer {
         let mut at = from;
         while at < to {
             let n = (to - at).min(CHUNK);
-            self.tick_block(bow, &mut chunk[..n]);
+            self.process(bow, &mut chunk[..n]);
             for (k, audio) in chunk[..n].iter().enumerate() {
                 write_frame(out, at + k, *audio * gain);
             }
@@ -174,7 +174,7 @@ impl Performer {
         controls: &mut impl FnMut() -> (BowControl, f64),
         mut live: Option<&mut (dyn FnMut(&Frame, &BowControl, &Performer) + 'b)>,
     ) {
-        self.tick_run(to - from, controls, |k, gain, frame, played, performer| {
+        self.process_run(to - from, controls, |k, gain, frame, played, performer| {
             if let Some(live) = live.as_deref_mut() {
                 live(frame, played, performer);
             }

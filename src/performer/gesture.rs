@@ -140,7 +140,7 @@ impl Performer {
 
     /// One vibrato update of the drift (every [`VIBRATO_EVERY`] samples): each wander glides
     /// toward its target, and a new target is drawn every [`VIBRATO_DRIFT_S`].
-    pub(super) fn advance_drift(&mut self) {
+    pub(super) fn tick_drift(&mut self) {
         let fs = self.sample_rate_hz;
         let g = &mut self.gesture;
         let updates = (VIBRATO_DRIFT_S * fs / VIBRATO_EVERY as f64).max(1.0);
@@ -174,7 +174,7 @@ impl Performer {
     #[inline]
     pub(super) fn shape(&mut self, bow: BowControl) -> BowControl {
         if self.gesture.vibrato_cents > 0.0 || self.gesture.vibrato_now != 0.0 {
-            self.advance_vibrato();
+            self.tick_vibrato();
         }
         let bow = self.direct.apply(bow);
         let (speed, landing) = if self.stroke.is_settled() {
@@ -227,7 +227,7 @@ impl Performer {
     /// One sample of the vibrato: its clock runs while the mod wheel is up (so the onset
     /// delay counts from the note or from the wheel, whichever is later), and the finger
     /// moves every [`VIBRATO_EVERY`] samples.
-    pub(super) fn advance_vibrato(&mut self) {
+    pub(super) fn tick_vibrato(&mut self) {
         let g = &mut self.gesture;
         g.since_note = g.since_note.saturating_add(1);
         g.phase += g.phase_step;
@@ -236,7 +236,7 @@ impl Performer {
         }
         if g.countdown == 0 {
             g.countdown = VIBRATO_EVERY;
-            self.advance_drift();
+            self.tick_drift();
             let now = if self.gesture.vibrato_cents > 0.0 {
                 self.vibrato_semitones()
             } else {

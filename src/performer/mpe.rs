@@ -188,11 +188,11 @@ impl Mpe {
 
     /// A pitch-bend wheel on `channel` (-1..=1): `true` if it is a member channel's (its
     /// note's own), `false` if it bends every note.
-    pub fn pitch_bend(&mut self, channel: u8, wheel: f64) -> bool {
+    pub fn pitch_bend(&mut self, channel: u8, wheel_position: f64) -> bool {
         if !self.is_member(channel) {
             return false;
         }
-        self.channels[channel as usize].wheel_position = wheel.clamp(-1.0, 1.0);
+        self.channels[channel as usize].wheel_position = wheel_position.clamp(-1.0, 1.0);
         true
     }
 

@@ -83,7 +83,7 @@ impl Performer {
             }
         }
         if self.rubbed.is_sounding() {
-            frame.audio += self.rubbed.tick_bow(&bow);
+            frame.audio += self.rubbed.tick(&bow);
         }
         frame
     }
@@ -111,7 +111,7 @@ impl Performer {
     /// the waveguide strings sound, the strings run alone over the rest (the gesture has
     /// nothing to do per sample), which is what makes the performance layer cost nothing
     /// per sample.
-    pub fn tick_block(&mut self, bow: BowControl, out: &mut [f64]) {
+    pub fn process(&mut self, bow: BowControl, out: &mut [f64]) {
         let mut i = 0;
         while i < out.len() {
             if !self.others_awake {
@@ -138,7 +138,7 @@ impl Performer {
     /// on the bow (the plugin's per-sample path while automation moves or a live view is
     /// open).
     #[inline]
-    pub fn tick_run<C>(
+    pub fn process_run<C>(
         &mut self,
         n: usize,
         mut next: impl FnMut() -> (BowControl, C),
@@ -276,7 +276,7 @@ mod tests {
             for (at, n) in spans(&marks, block) {
                 events(&mut p, at);
                 let mut out = vec![0.0; n];
-                p.tick_block(bow, &mut out);
+                p.process(bow, &mut out);
                 got.extend(out.iter().map(|x| x.to_bits()));
             }
             assert_eq!(got, want, "blocks of {block}");
@@ -331,7 +331,7 @@ mod tests {
             for (at, n) in spans(&marks, run) {
                 events(&mut p, at);
                 let mut k_next = at;
-                p.tick_run(
+                p.process_run(
                     n,
                     || {
                         k_next += 1;
