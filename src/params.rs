@@ -131,6 +131,9 @@ pub enum ArticulationChoice {
     #[id = "spiccato"]
     #[name = "Spiccato"]
     Spiccato,
+    #[id = "col-legno"]
+    #[name = "Col legno"]
+    ColLegno,
 }
 
 /// What sets the tremolo's strokes ([`crate::performer::articulation::TremoloSync`]).
@@ -164,6 +167,7 @@ impl From<ArticulationChoice> for crate::performer::Articulation {
             ArticulationChoice::Pizzicato => Self::Pizzicato,
             ArticulationChoice::Tremolo => Self::Tremolo,
             ArticulationChoice::Spiccato => Self::Spiccato,
+            ArticulationChoice::ColLegno => Self::ColLegno,
         }
     }
 }

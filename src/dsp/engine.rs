@@ -16,7 +16,7 @@
 
 use super::rubbed::RubbedInstrument;
 use super::strings::{FourStrings, StringBank};
-use super::vocabulary::{BowControl, Frame, NoteExpression, Pluck};
+use super::vocabulary::{BowControl, Frame, NoteExpression, Pluck, Strike};
 
 /// An instrument the notes play.
 pub trait Engine {
@@ -30,6 +30,11 @@ pub trait Engine {
     /// Plucks `note` (pizzicato) with `pluck`: the string it went to, `None` if the
     /// engine cannot pluck it (engines without plucked strings: always).
     fn pluck(&mut self, _note: u8, _pluck: Pluck) -> Option<usize> {
+        None
+    }
+    /// Strikes `note` with the bow's stick (col legno battuto): the string it went to,
+    /// `None` if the engine cannot (engines without struck strings: always).
+    fn strike(&mut self, _note: u8, _strike: Strike) -> Option<usize> {
         None
     }
     /// Lifts the bow from `note` (and, on strings, the finger that stops it).
@@ -79,6 +84,9 @@ impl<B: StringBank> Engine for FourStrings<B> {
     }
     fn pluck(&mut self, note: u8, pluck: Pluck) -> Option<usize> {
         FourStrings::pluck(self, note, pluck)
+    }
+    fn strike(&mut self, note: u8, strike: Strike) -> Option<usize> {
+        FourStrings::strike(self, note, strike)
     }
     fn note_off(&mut self, note: u8) {
         FourStrings::note_off(self, note)

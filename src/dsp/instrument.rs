@@ -170,6 +170,12 @@ impl StringBank for WaveguideBank {
         string.is_playable()
     }
 
+    fn strike(&mut self, i: usize, strike: Strike) -> bool {
+        let string = &mut self.voices[i].string;
+        string.strike(strike.mass_kg, strike.velocity_m_per_s);
+        string.is_playable()
+    }
+
     fn wake(&mut self, i: usize) {
         let voice = &mut self.voices[i];
         voice.awake = voice.string.is_playable();

@@ -37,7 +37,7 @@ use super::fingering::{BowEnvelope, Fingering};
 use super::intonation::IntonationTable;
 use super::resample::Resampler;
 use super::vocabulary::{
-    BowControl, Frame, InstrumentKind, NoteExpression, Pluck, BOW_RAMP_S, MAX_NOTE_BETA,
+    BowControl, Frame, InstrumentKind, NoteExpression, Pluck, Strike, BOW_RAMP_S, MAX_NOTE_BETA,
     MAX_WEIGHTED_FORCE_N, MIN_NOTE_BETA, STRINGS,
 };
 
@@ -99,6 +99,12 @@ pub trait StringBank {
     /// `width` is the finger's contact over the vibrating length. False where the bank's
     /// strings cannot be plucked (nothing changes).
     fn pluck(&mut self, _i: usize, _displacement_m: f64, _position_beta: f64, _width: f64) -> bool {
+        false
+    }
+    /// Strikes string `i` at its bow point with the bow's stick (col legno battuto) as
+    /// [`super::waveguide::WaveguideString::strike`]. False where the bank's strings cannot
+    /// be struck (nothing changes); banks that pluck strike too.
+    fn strike(&mut self, _i: usize, _strike: Strike) -> bool {
         false
     }
     /// A bow landed on string `i`: it is computed from the next sample.
@@ -491,6 +497,24 @@ impl<B: StringBank> FourStrings<B> {
         // Past the middle of a short stopped string the hand plucks its middle.
         let beta = (pluck.from_bridge_m / vibrating_m).clamp(MIN_NOTE_BETA, 0.5);
         if !self.bank.pluck(index, pluck.displacement_m, beta, width) {
+            return None;
+        }
+        self.bank.wake(index);
+        self.hands.probed = index;
+        Some(index)
+    }
+
+    /// Stops the string for `note` and strikes it at the bow point with the bow's stick
+    /// (col legno battuto): no bow hair lands, and a bow on that string lifts; the string
+    /// then rings as a plucked one does. Returns the string, or `None` if no string can
+    /// play the note or the strings cannot be struck (then nothing sounds).
+    pub fn strike(&mut self, note: u8, strike: Strike) -> Option<usize> {
+        if !B::PLUCKABLE {
+            return None;
+        }
+        let index = self.stop_for(note, true)?;
+        self.hands.bows[index].bowed = false;
+        if !self.bank.strike(index, strike) {
             return None;
         }
         self.bank.wake(index);

@@ -368,6 +368,15 @@ pub struct Pluck {
     pub width_m: f64,
 }
 
+/// The bow's stick striking the string at the bow point (col legno battuto).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Strike {
+    /// The stick's effective mass at the point of impact, kg.
+    pub mass_kg: f64,
+    /// How fast it arrives, m/s.
+    pub velocity_m_per_s: f64,
+}
+
 /// One sample of output with the probed string's contact signals.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Frame {

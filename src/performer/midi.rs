@@ -135,11 +135,12 @@ impl Performer {
                 self.direct.set_controller(direct::CC_BOW_POSITION, x);
             }
             Target::Portamento => self.gesture.portamento_pedal = (x * 127.0).round() >= 64.0,
-            Target::Pizzicato | Target::Tremolo | Target::Spiccato => {
+            Target::Pizzicato | Target::Tremolo | Target::Spiccato | Target::ColLegno => {
                 let on = match target {
                     Target::Pizzicato => Articulation::Pizzicato,
                     Target::Tremolo => Articulation::Tremolo,
-                    _ => Articulation::Spiccato,
+                    Target::Spiccato => Articulation::Spiccato,
+                    _ => Articulation::ColLegno,
                 };
                 let down = (x * 127.0).round() >= 64.0;
                 self.set_articulation(if down { on } else { Articulation::Arco })

@@ -42,6 +42,8 @@ pub const TREMOLO_CC: u8 = 103;
 pub const SPICCATO_CC: u8 = 104;
 /// The controller that puts the mute on in the default map (undefined in MIDI too).
 pub const CON_SORDINO_CC: u8 = 105;
+/// The controller that switches col legno in the default map (undefined in MIDI too).
+pub const COL_LEGNO_CC: u8 = 106;
 
 /// Most mappings a map holds.
 pub const MAX_MAPPINGS: usize = 16;
@@ -76,10 +78,13 @@ pub enum Target {
     Spiccato,
     /// A mute on the bridge while the value is 0.5 or more (con sordino), none below.
     ConSordino,
+    /// Col legno (battuto) while the value is 0.5 or more, arco below it.
+    ColLegno,
 }
 
 impl Target {
-    pub const ALL: [Target; 12] = [
+    /// In the order saved maps index them: new targets go at the end.
+    pub const ALL: [Target; 13] = [
         Target::Dynamics,
         Target::VibratoDepth,
         Target::VibratoRate,
@@ -92,6 +97,7 @@ impl Target {
         Target::Tremolo,
         Target::Spiccato,
         Target::ConSordino,
+        Target::ColLegno,
     ];
 
     /// The name the editor shows.
@@ -109,6 +115,7 @@ impl Target {
             Target::Tremolo => "Tremolo",
             Target::Spiccato => "Spiccato",
             Target::ConSordino => "Con sordino (mute)",
+            Target::ColLegno => "Col legno",
         }
     }
 
@@ -208,6 +215,7 @@ impl Default for MidiMap {
             Mapping::new(TREMOLO_CC, Target::Tremolo),
             Mapping::new(SPICCATO_CC, Target::Spiccato),
             Mapping::new(CON_SORDINO_CC, Target::ConSordino),
+            Mapping::new(COL_LEGNO_CC, Target::ColLegno),
         ] {
             map.add(m);
         }

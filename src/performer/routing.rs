@@ -34,10 +34,12 @@ impl Performer {
             state: NoteState::default(),
         };
         self.steady = None;
-        if self.articulation() == Articulation::Pizzicato
-            && !matches!(self.source, Source::Rubbed(_))
-        {
-            return self.pluck_note(note, velocity);
+        if !matches!(self.source, Source::Rubbed(_)) {
+            match self.articulation() {
+                Articulation::Pizzicato => return self.pluck_note(note, velocity),
+                Articulation::ColLegno => return self.strike_note(note, velocity),
+                _ => {}
+            }
         }
         let separate = !self.held.iter().any(|&h| h);
         // Portamento: a legato note played softly, or any legato note with CC65 down,
