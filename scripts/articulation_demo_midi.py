@@ -1,13 +1,15 @@
 #!/usr/bin/env python3
 """Writes the articulation demos' MIDI files into assets/demos/midi/ (standard MIDI files,
 format 0, 480 ticks a beat, 60 bpm), each switching articulation by keyswitch (C0 arco,
-C#0 pizzicato, D0 tremolo, D#0 spiccato):
+C#0 pizzicato, D0 tremolo, D#0 spiccato, E0 col legno):
 
 - pachelbel-ground-keyswitch.mid: J. Pachelbel's canon in D, the ground bass (public
   domain) on the double bass, played twice: pizzicato, then arco;
 - cello-tremolo-keyswitch.mid: a cello line in half notes under tremolo;
 - violin-spiccato-keyswitch.mid: a violin scale in sixteenths, spiccato, then the same
-  notes arco (keyswitch C0)."""
+  notes arco (keyswitch C0);
+- viola-col-legno-keyswitch.mid: a viola ostinato in eighths struck col legno, growing
+  louder, then its last bar arco (keyswitch C0)."""
 import struct
 import sys
 from pathlib import Path
@@ -63,3 +65,11 @@ part, t = notes(20, SCALE, 0.25, 0.6, 100)
 events = keyswitch(0, 15) + part + keyswitch(t + TPB // 2, 12)
 part, _ = notes(t + TPB, SCALE, 0.25, 0.95, 100)
 write(out / "violin-spiccato-keyswitch.mid", events + part)
+OSTINATO = [55, 55, 55, 62, 55, 55, 62, 60] * 2 + [55, 55, 55, 62, 63, 62, 60, 58]
+events, t = keyswitch(0, 16), 20
+for i, note in enumerate(OSTINATO):
+    part, t = notes(t, [note], 0.5, 0.5, 50 + 3 * i)
+    events += part
+events += keyswitch(t + TPB // 2, 12)
+part, _ = notes(t + TPB, OSTINATO[-8:], 0.5, 0.95, 100)
+write(out / "viola-col-legno-keyswitch.mid", events + part)

@@ -25,6 +25,9 @@ pub enum MidiEvent {
     Controller(u8, u8),
     /// Channel pressure, 7-bit.
     Pressure(u8),
+    /// The file's tempo from here on, microseconds a beat (metrical files only; the
+    /// performer takes it as a host's transport tempo, block by block).
+    Tempo(u32),
 }
 
 /// An event at an output sample.
@@ -116,12 +119,25 @@ pub fn read_events(
     let mut tick_s = fixed_tick_s.unwrap_or(0.5 / ticks_per_beat);
     let (mut last_tick, mut seconds) = (0u64, 0.0f64);
     let mut out = Vec::new();
+    if fixed_tick_s.is_none() {
+        // A metrical file plays at 120 bpm until its tempo says otherwise.
+        out.push(Timed {
+            sample: 0,
+            channel: 0,
+            event: MidiEvent::Tempo(500_000),
+        });
+    }
     for (tick, _, _, item) in items {
         seconds += (tick - last_tick) as f64 * tick_s;
         last_tick = tick;
         match item {
             Item::Tempo(us) if fixed_tick_s.is_none() => {
                 tick_s = us.max(1) as f64 * 1e-6 / ticks_per_beat;
+                out.push(Timed {
+                    sample: (seconds * sample_rate_hz).round() as u64,
+                    channel: 0,
+                    event: MidiEvent::Tempo(us.max(1)),
+                });
             }
             Item::Tempo(_) => {}
             Item::Event(channel, event) => out.push(Timed {
@@ -220,6 +236,10 @@ fn perform_probing(
     mut probe: Option<&mut Vec<ContactSample>>,
 ) -> Result<Vec<f32>, String> {
     let block = how.block.max(1);
+    let mut setup = how.setup.clone();
+    // The file's tempo reaches the performer as a host's transport tempo does: at the
+    // start of each block.
+    let mut tempo_next = 0;
     let mut performer = Performer::new(how.setup.instrument);
     performer.set_user_bridge(how.setup.instrument, how.bridge.clone());
     performer.activate(&how.setup, how.sample_rate_hz)?;
@@ -233,7 +253,13 @@ fn perform_probing(
     let mut buffer = vec![0.0f32; block];
     loop {
         // As the plugin plays a host block.
-        performer.configure(&how.setup);
+        while let Some(e) = events.get(tempo_next).filter(|e| e.sample <= done) {
+            if let MidiEvent::Tempo(us) = e.event {
+                setup.tempo_bpm = Some(60e6 / us as f64);
+            }
+            tempo_next += 1;
+        }
+        performer.configure(&setup);
         let end = done + block as u64;
         let probing = probe.is_some();
         let mut record = |frame: &Frame, played: &BowControl, _: &Performer| {
@@ -247,10 +273,12 @@ fn perform_probing(
         };
         let status = performer.render_block(
             &mut [&mut buffer[..]],
-            || {
+            || loop {
                 let e = events.get(next).filter(|e| e.sample < end)?;
                 next += 1;
-                Some(((e.sample.max(done) - done) as usize, event_of(e)))
+                if let Some(event) = event_of(e) {
+                    return Some(((e.sample.max(done) - done) as usize, event));
+                }
             },
             || (how.bow, how.gain),
             || true,
@@ -278,10 +306,10 @@ fn perform_probing(
 }
 
 /// The performer's event for a file's (values as nice-plug hands them to the plugin:
-/// 0..=1 in f32).
-fn event_of(e: &Timed) -> Event {
+/// 0..=1 in f32); `None` for the tempo, which is no event.
+fn event_of(e: &Timed) -> Option<Event> {
     let channel = e.channel;
-    match e.event {
+    Some(match e.event {
         MidiEvent::NoteOn(note, v) => Event::NoteOn {
             channel,
             note,
@@ -301,7 +329,9 @@ fn event_of(e: &Timed) -> Event {
             channel,
             pressure: v as f32 / 127.0,
         },
-    }
+        // The tempo is the transport's, set at each block.
+        MidiEvent::Tempo(_) => return None,
+    })
 }
 
 /// `colophony render --midi FILE`: reads `midi`, plays it as [`perform`] (blocks of 512),
@@ -406,6 +436,45 @@ mod tests {
         }
     }
 
+    /// A synced tremolo in a file follows the file's tempo, as it follows a host's: at
+    /// 90 bpm a sixteenth lasts 1/6 s, so the bow turns 6 times a second (free, at the
+    /// default rate, 12). Counted on the probe's friction, its sign over 5 ms windows
+    /// (the mean friction force points along the bow's motion), over 3 s of cello D3.
+    /// Tolerance 2 reversals: the window straddling a turn, at either end.
+    #[test]
+    fn a_synced_tremolo_follows_the_files_tempo() {
+        let tempo = |us| TrackEventKind::Meta(MetaMessage::Tempo(u24::new(us)));
+        let bytes = file(
+            Timing::Metrical(u15::new(480)),
+            vec![vec![
+                ev(0, tempo(666_667)),
+                ev(0, note(true, 50, 100)),
+                ev(4 * 480 + 240, note(false, 50, 0)),
+            ]],
+        );
+        let events = read_events(&bytes, None, 48_000.0).unwrap();
+        let reversals = |sync| {
+            let mut how = Performance::plugin_defaults(
+                colophony::dsp::vocabulary::InstrumentKind::Cello,
+                Some(colophony::dsp::friction::FrictionModel::Hyperbolic),
+                48_000.0,
+            );
+            how.setup.articulation = colophony::performer::Articulation::Tremolo;
+            how.setup.tremolo_sync = sync;
+            let (_, probe) = perform_probed(&events, &how).unwrap();
+            let signs: Vec<bool> = probe[..3 * 48_000]
+                .chunks(240)
+                .map(|w| w.iter().map(|c| c.mu as f64).sum::<f64>() > 0.0)
+                .collect();
+            signs.windows(2).filter(|p| p[0] != p[1]).count()
+        };
+        let synced = reversals(colophony::performer::articulation::TremoloSync::Sixteenths);
+        let free = reversals(colophony::performer::articulation::TremoloSync::Free);
+        eprintln!("tremolo over 3 s: synced to 90 bpm {synced} reversals, free {free}");
+        assert!((synced as i64 - 18).abs() <= 2, "{synced}");
+        assert!((free as i64 - 36).abs() <= 2, "{free}");
+    }
+
     #[test]
     fn the_tempo_map_of_any_track_times_the_notes() {
         // 480 ticks a beat; 120 bpm, then 60 bpm from beat 1 (set in track 0); notes in
@@ -424,8 +493,13 @@ mod tests {
             ],
         );
         let got = read_events(&bytes, None, 48_000.0).unwrap();
+        // The tempo goes with them: 120 bpm from the start (a metrical file's default,
+        // then track 0's own), 60 bpm from beat 1.
         let want = [
+            (0, MidiEvent::Tempo(500_000)),
+            (0, MidiEvent::Tempo(500_000)),
             (0, MidiEvent::NoteOn(50, 100)),
+            (24_000, MidiEvent::Tempo(1_000_000)),
             (24_000, MidiEvent::NoteOff(50)),
             (24_000, MidiEvent::NoteOn(52, 90)),
             // A note-on of velocity 0 is a note-off.

@@ -84,6 +84,8 @@ pub struct WaveguideBank {
     body_asleep: bool,
     /// A mute on the bridge (con sordino, [`super::body::muted`]).
     muted: bool,
+    /// A stick is striking a string (col legno): [`WaveguideBank::sample_struck`].
+    struck: bool,
 }
 
 /// The four waveguide strings of a violin, viola, cello or double bass with a shared bow, note
@@ -173,6 +175,7 @@ impl StringBank for WaveguideBank {
     fn strike(&mut self, i: usize, strike: Strike) -> bool {
         let string = &mut self.voices[i].string;
         string.strike(strike.mass_kg, strike.velocity_m_per_s);
+        self.struck |= string.is_struck();
         string.is_playable()
     }
 
@@ -201,46 +204,11 @@ impl StringBank for WaveguideBank {
     /// fade, the probe and the closure that hands each string its bow), and 632 with
     /// this inlined into an out-of-line tick.
     #[inline(never)]
-    fn sample(&mut self, probed: usize, mut bow_of: impl FnMut(usize) -> StringBow) -> f64 {
-        // `tick` checked that something is awake; sleep changes only between blocks.
-        let skipping = self.skipping;
-        self.body_asleep = false;
-        let mut bridge = 0.0;
-        // The bridge force of the strings at twice the bank's rate, a pair a bank sample.
-        let mut fine = [0.0; 2];
-        let mut any_fine = false;
-        for (i, voice) in self.voices.iter_mut().enumerate() {
-            if !voice.awake && skipping {
-                continue;
-            }
-            let bow = bow_of(i);
-            voice.string.set_bow_position(bow.position_beta);
-            let input = BowInput {
-                velocity_m_per_s: bow.velocity_m_per_s,
-                normal_force_n: bow.force,
-            };
-            if self.oversample[i] == 1 {
-                let out = voice.string.tick(&mut voice.contact, input);
-                bridge += out.bridge_force_n;
-                if i == probed {
-                    self.probe = (out.bow_point_velocity_m_per_s, out.friction_force_n);
-                }
-            } else {
-                // The bow is held over the string's two samples; the probe is the later's.
-                any_fine = true;
-                for force in &mut fine {
-                    let out = voice.string.tick(&mut voice.contact, input);
-                    *force += out.bridge_force_n;
-                    if i == probed {
-                        self.probe = (out.bow_point_velocity_m_per_s, out.friction_force_n);
-                    }
-                }
-            }
+    fn sample(&mut self, probed: usize, bow_of: impl FnMut(usize) -> StringBow) -> f64 {
+        if self.struck {
+            return self.sample_struck(probed, bow_of);
         }
-        if any_fine {
-            bridge += self.decimator.tick(fine[0], fine[1]);
-        }
-        super::filters::flush_tiny(self.body.tick(bridge) * self.output_scale)
+        self.sample_as::<false>(probed, bow_of)
     }
 
     fn probe(&self) -> (f64, f64) {
@@ -318,6 +286,75 @@ impl StringBank for WaveguideBank {
 
     fn configure(&mut self, _settings: ()) -> Result<(), String> {
         Ok(())
+    }
+}
+
+impl WaveguideBank {
+    /// [`StringBank::sample`] while a stick strikes a string (col legno): the struck
+    /// strings take the stick's contact ([`WaveguideString::tick_struck`]). Out of line,
+    /// off the bowed strings' path: a few milliseconds a note.
+    #[cold]
+    #[inline(never)]
+    fn sample_struck(&mut self, probed: usize, bow_of: impl FnMut(usize) -> StringBow) -> f64 {
+        let out = self.sample_as::<true>(probed, bow_of);
+        self.struck = self.voices.iter().any(|v| v.string.is_struck());
+        out
+    }
+
+    /// One internal sample of every awake string and the body; with `STRUCK`, a struck
+    /// string ticks as struck.
+    #[inline(always)]
+    fn sample_as<const STRUCK: bool>(
+        &mut self,
+        probed: usize,
+        mut bow_of: impl FnMut(usize) -> StringBow,
+    ) -> f64 {
+        let tick = |voice: &mut StringVoice, input: BowInput| {
+            if STRUCK && voice.string.is_struck() {
+                voice.string.tick_struck(&mut voice.contact, input)
+            } else {
+                voice.string.tick(&mut voice.contact, input)
+            }
+        };
+        // `tick` checked that something is awake; sleep changes only between blocks.
+        let skipping = self.skipping;
+        self.body_asleep = false;
+        let mut bridge = 0.0;
+        // The bridge force of the strings at twice the bank's rate, a pair a bank sample.
+        let mut fine = [0.0; 2];
+        let mut any_fine = false;
+        for (i, voice) in self.voices.iter_mut().enumerate() {
+            if !voice.awake && skipping {
+                continue;
+            }
+            let bow = bow_of(i);
+            voice.string.set_bow_position(bow.position_beta);
+            let input = BowInput {
+                velocity_m_per_s: bow.velocity_m_per_s,
+                normal_force_n: bow.force,
+            };
+            if self.oversample[i] == 1 {
+                let out = tick(voice, input);
+                bridge += out.bridge_force_n;
+                if i == probed {
+                    self.probe = (out.bow_point_velocity_m_per_s, out.friction_force_n);
+                }
+            } else {
+                // The bow is held over the string's two samples; the probe is the later's.
+                any_fine = true;
+                for force in &mut fine {
+                    let out = tick(voice, input);
+                    *force += out.bridge_force_n;
+                    if i == probed {
+                        self.probe = (out.bow_point_velocity_m_per_s, out.friction_force_n);
+                    }
+                }
+            }
+        }
+        if any_fine {
+            bridge += self.decimator.tick(fine[0], fine[1]);
+        }
+        super::filters::flush_tiny(self.body.tick(bridge) * self.output_scale)
     }
 }
 
@@ -406,6 +443,7 @@ impl Instrument {
             skipping: true,
             body_asleep: true,
             muted: false,
+            struck: false,
         };
         Self::from_bank(
             bank,

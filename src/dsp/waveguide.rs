@@ -597,6 +597,28 @@ impl WaveguideString {
     /// share the time index `t`.
     #[inline(always)]
     pub fn tick(&mut self, contact: &mut impl FrictionContact, bow: BowInput) -> StringOutput {
+        self.tick_as::<false>(contact, bow)
+    }
+
+    /// [`WaveguideString::tick`] while the stick strikes ([`WaveguideString::strike`],
+    /// [`WaveguideString::is_struck`]): the stick's contact at the bow point instead of
+    /// the bow's (the bow's contact is left as it is).
+    #[inline(always)]
+    pub fn tick_struck(
+        &mut self,
+        contact: &mut impl FrictionContact,
+        bow: BowInput,
+    ) -> StringOutput {
+        self.tick_as::<true>(contact, bow)
+    }
+
+    /// [`WaveguideString::tick`] (`STRUCK` false) or [`WaveguideString::tick_struck`].
+    #[inline(always)]
+    fn tick_as<const STRUCK: bool>(
+        &mut self,
+        contact: &mut impl FrictionContact,
+        bow: BowInput,
+    ) -> StringOutput {
         if !self.playable {
             return StringOutput::default();
         }
@@ -616,23 +638,23 @@ impl WaveguideString {
             free_velocity_m_per_s: v_h + torsion.state + hair.state,
             admittance_s_per_kg: admittance + torsion.y0 + hair.y0,
         };
-        let (force, twist, v_hair) = if self.striker.samples_left == 0 {
+        let (force, v_t, v_hair) = if !STRUCK {
             let force = contact.solve(load, bow);
+            let v_t = torsion.velocity(force);
+            torsion.finish(force, v_t);
             let v_hair = hair.velocity(force);
             hair.finish(force, v_hair);
-            (force, force, v_hair)
+            (force, v_t, v_hair)
         } else {
-            // The stick's wood meets the string square on: its push passes through the
-            // string's axis (no twist, unlike the hair's grip on the surface) and no hair
-            // lies between them.
-            let force = self
-                .striker
-                .push(v_h, admittance, 1.0 / self.sample_rate_hz);
-            (force, 0.0, 0.0)
+            struck_junction(
+                &mut self.striker,
+                torsion,
+                v_h,
+                admittance,
+                1.0 / self.sample_rate_hz,
+            )
         };
         let dv = force * admittance;
-        let v_t = torsion.velocity(twist);
-        torsion.finish(twist, v_t);
         self.right[ir] += dv;
         self.left[il] += dv;
 
@@ -672,6 +694,25 @@ struct Striker {
     /// Samples of contact left before the stick is taken away whatever the string does
     /// ([`MAX_STRIKE_S`]).
     samples_left: u32,
+}
+
+/// The bow junction while the stick strikes ([`WaveguideString::strike`]): the contact
+/// force, the torsion's velocity and the hair's (none), for the string's free velocity
+/// `v_h` and admittance `admittance` over a sample of `dt`. The stick's wood meets the
+/// string square on, so its push passes through the string's axis (no twist, unlike the
+/// hair's grip on the surface) and no hair lies between them.
+#[inline(always)]
+fn struck_junction(
+    striker: &mut Striker,
+    torsion: &mut HighPassAdmittance,
+    v_h: f64,
+    admittance: f64,
+    dt: f64,
+) -> (f64, f64, f64) {
+    let force = striker.push(v_h, admittance, dt);
+    let v_t = torsion.velocity(0.0);
+    torsion.finish(0.0, v_t);
+    (force, v_t, 0.0)
 }
 
 /// The longest a striking stick stays on the string, s: the player lifts it within a few
@@ -924,7 +965,7 @@ mod tests {
                     s.strike(mass, u0);
                     let mut samples = 0;
                     while s.is_struck() {
-                        s.tick(&mut contact, lifted);
+                        s.tick_struck(&mut contact, lifted);
                         samples += 1;
                     }
                     let u1 = s.striker.velocity_m_per_s;

@@ -630,8 +630,9 @@ mod tests {
         assert!(after < 0.25 * ringing, "{ringing} then {after}");
     }
 
-    /// The keyswitch octave's C, C#, D and D# choose arco, pizzicato, tremolo and
-    /// spiccato and are no notes; the other keys of the octave and every key the instrument plays are notes.
+    /// The keyswitch octave's C, C#, D, D# and E choose arco, pizzicato, tremolo, spiccato
+    /// and col legno and are no notes; the other keys of the octave and every key the
+    /// instrument plays are notes.
     #[test]
     fn the_keyswitch_octave_chooses_the_articulation_below_the_range() {
         for kind in InstrumentKind::ALL {
@@ -639,7 +640,8 @@ mod tests {
             assert_eq!(keyswitch(13, 0, kind), Some(Articulation::Pizzicato));
             assert_eq!(keyswitch(14, 0, kind), Some(Articulation::Tremolo));
             assert_eq!(keyswitch(15, 0, kind), Some(Articulation::Spiccato));
-            assert_eq!(keyswitch(16, 0, kind), None, "no fifth articulation yet");
+            assert_eq!(keyswitch(16, 0, kind), Some(Articulation::ColLegno));
+            assert_eq!(keyswitch(17, 0, kind), None, "no sixth articulation");
             assert_eq!(keyswitch(0, -1, kind), Some(Articulation::Arco));
             assert_eq!(keyswitch(25, 1, kind), Some(Articulation::Pizzicato));
             for note in kind.open_notes()[0]..128 {
