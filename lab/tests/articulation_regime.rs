@@ -50,7 +50,10 @@ fn probe(setup: &Setup, note: u8, seconds: f64, every_s: Option<f64>) -> Vec<Con
 
 /// Counts of Helmholtz motion among `regimes`, and the others by name.
 fn tally(regimes: &[Option<Regime>]) -> (usize, usize, String) {
-    let helm = regimes.iter().filter(|r| **r == Some(Regime::Helmholtz)).count();
+    let helm = regimes
+        .iter()
+        .filter(|r| **r == Some(Regime::Helmholtz))
+        .count();
     let mut others = std::collections::BTreeMap::new();
     for r in regimes.iter().filter(|r| **r != Some(Regime::Helmholtz)) {
         *others.entry(format!("{r:?}")).or_insert(0) += 1;
@@ -96,7 +99,11 @@ fn tremolo_and_spiccato_regime_survey() {
                         (false, Some(a)) => {
                             if (i - a) as f64 >= 5.0 * period {
                                 let half = a + (i - a) / 2;
-                                spicc.push(classify_regime(&samples[half..i], FS as f32, f0 as f32));
+                                spicc.push(classify_regime(
+                                    &samples[half..i],
+                                    FS as f32,
+                                    f0 as f32,
+                                ));
                             }
                             start = None;
                         }
@@ -105,7 +112,9 @@ fn tremolo_and_spiccato_regime_survey() {
                 }
             }
             let (h, n, others) = tally(&trem);
-            println!("{kind:?} {law:?} tremolo: {h} of {n} strokes in Helmholtz motion; others {others}");
+            println!(
+                "{kind:?} {law:?} tremolo: {h} of {n} strokes in Helmholtz motion; others {others}"
+            );
             let (h, n, others) = tally(&spicc);
             println!("{kind:?} {law:?} spiccato: {h} of {n} contacts in Helmholtz motion; others {others}");
         }

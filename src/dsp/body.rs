@@ -112,6 +112,19 @@ impl BodyModes {
         y
     }
 
+    /// Takes `other`'s modes and gains, keeping the ringing state: a mute put on or taken
+    /// off moves the bridge's modes while they sound, and the output goes on from where it
+    /// is (`y = b0 x + s1`: the state carries it) instead of restarting from rest, which
+    /// clicks. Modes `other` does not have fall silent.
+    pub fn retune(&mut self, other: &BodyModes) {
+        let (s1, s2) = (self.s1, self.s2);
+        *self = other.clone();
+        for k in 0..self.count {
+            self.s1[k] = s1[k];
+            self.s2[k] = s2[k];
+        }
+    }
+
     pub fn reset(&mut self) {
         self.s1 = [0.0; MAX_BODY_MODES];
         self.s2 = [0.0; MAX_BODY_MODES];

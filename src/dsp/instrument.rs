@@ -84,8 +84,13 @@ pub struct WaveguideBank {
     body_asleep: bool,
     /// A mute on the bridge (con sordino, [`super::body::muted`]).
     muted: bool,
-    /// A stick is striking a string (col legno): [`WaveguideBank::sample_struck`].
-    struck: bool,
+    /// A stick is striking a string (col legno), or the body is moving to a mute's modes:
+    /// [`WaveguideBank::sample_slow`].
+    slow: bool,
+    /// The body before the mute went on or came off, faded out over the next
+    /// `body_fade_left` samples as the new one fades in (`MUTE_FADE_S`).
+    body_before: BodyModes,
+    body_fade_left: u32,
 }
 
 /// The four waveguide strings of a violin, viola, cello or double bass with a shared bow, note
@@ -162,7 +167,13 @@ impl StringBank for WaveguideBank {
     fn set_mute(&mut self, on: bool) {
         if on != self.muted {
             self.muted = on;
-            self.body = self.body_of(self.kind);
+            // The new modes start from the old ones' ringing state; the old body rings on
+            // as it fades out.
+            self.body_before = self.body.clone();
+            let body = self.body_of(self.kind);
+            self.body.retune(&body);
+            self.body_fade_left = (MUTE_FADE_S * self.sample_rate_hz).round() as u32;
+            self.slow = true;
         }
     }
 
@@ -175,7 +186,7 @@ impl StringBank for WaveguideBank {
     fn strike(&mut self, i: usize, strike: Strike) -> bool {
         let string = &mut self.voices[i].string;
         string.strike(strike.mass_kg, strike.velocity_m_per_s);
-        self.struck |= string.is_struck();
+        self.slow |= string.is_struck();
         string.is_playable()
     }
 
@@ -205,8 +216,8 @@ impl StringBank for WaveguideBank {
     /// this inlined into an out-of-line tick.
     #[inline(never)]
     fn sample(&mut self, probed: usize, bow_of: impl FnMut(usize) -> StringBow) -> f64 {
-        if self.struck {
-            return self.sample_struck(probed, bow_of);
+        if self.slow {
+            return self.sample_slow(probed, bow_of);
         }
         self.sample_as::<false>(probed, bow_of)
     }
@@ -278,6 +289,7 @@ impl StringBank for WaveguideBank {
             voice.awake = false;
         }
         self.body.reset();
+        self.body_fade_left = 0;
         self.decimator.reset();
         self.probe = (0.0, 0.0);
     }
@@ -290,27 +302,28 @@ impl StringBank for WaveguideBank {
 }
 
 impl WaveguideBank {
-    /// [`StringBank::sample`] while a stick strikes a string (col legno): the struck
-    /// strings take the stick's contact ([`WaveguideString::tick_struck`]). Out of line,
-    /// off the bowed strings' path: a few milliseconds a note.
+    /// [`StringBank::sample`] while a stick strikes a string (col legno: the struck
+    /// strings take the stick's contact, [`WaveguideString::tick_struck`]) or the body
+    /// fades to a mute's modes. Out of line, off the bowed strings' path: a few
+    /// milliseconds at a time.
     #[cold]
     #[inline(never)]
-    fn sample_struck(&mut self, probed: usize, bow_of: impl FnMut(usize) -> StringBow) -> f64 {
+    fn sample_slow(&mut self, probed: usize, bow_of: impl FnMut(usize) -> StringBow) -> f64 {
         let out = self.sample_as::<true>(probed, bow_of);
-        self.struck = self.voices.iter().any(|v| v.string.is_struck());
+        self.slow = self.body_fade_left > 0 || self.voices.iter().any(|v| v.string.is_struck());
         out
     }
 
-    /// One internal sample of every awake string and the body; with `STRUCK`, a struck
-    /// string ticks as struck.
+    /// One internal sample of every awake string and the body; with `SLOW`, a struck
+    /// string ticks as struck and a fading body fades.
     #[inline(always)]
-    fn sample_as<const STRUCK: bool>(
+    fn sample_as<const SLOW: bool>(
         &mut self,
         probed: usize,
         mut bow_of: impl FnMut(usize) -> StringBow,
     ) -> f64 {
         let tick = |voice: &mut StringVoice, input: BowInput| {
-            if STRUCK && voice.string.is_struck() {
+            if SLOW && voice.string.is_struck() {
                 voice.string.tick_struck(&mut voice.contact, input)
             } else {
                 voice.string.tick(&mut voice.contact, input)
@@ -354,9 +367,23 @@ impl WaveguideBank {
         if any_fine {
             bridge += self.decimator.tick(fine[0], fine[1]);
         }
-        super::filters::flush_tiny(self.body.tick(bridge) * self.output_scale)
+        let body = if SLOW && self.body_fade_left > 0 {
+            // Linear: the new body from 0 to 1 over the fade, the old from 1 to 0.
+            let total = (MUTE_FADE_S * self.sample_rate_hz).max(1.0);
+            let new = 1.0 - self.body_fade_left as f64 / total;
+            self.body_fade_left -= 1;
+            new * self.body.tick(bridge) + (1.0 - new) * self.body_before.tick(bridge)
+        } else {
+            self.body.tick(bridge)
+        };
+        super::filters::flush_tiny(body * self.output_scale)
     }
 }
+
+/// How long the body takes to move to a mute's modes and back, s: the old body fades out
+/// as the new fades in, so the switch does not click (a player takes longer to slide a
+/// mute on).
+pub const MUTE_FADE_S: f64 = 0.05;
 
 impl Instrument {
     /// The instrument the plugin plays at host rate `host_rate_hz`: strings and body at
@@ -443,7 +470,9 @@ impl Instrument {
             skipping: true,
             body_asleep: true,
             muted: false,
-            struck: false,
+            slow: false,
+            body_before: BodyModes::new(&kind.body_modes(), 1.0, sample_rate_hz),
+            body_fade_left: 0,
         };
         Self::from_bank(
             bank,
