@@ -105,6 +105,8 @@ fn every_demo_command_renders_its_file_with_the_same_length_level_and_pitch() {
     let out_dir = std::env::temp_dir().join(format!("colophony-demos-{}", std::process::id()));
     std::fs::create_dir_all(&out_dir).unwrap();
     let list = demos();
+    // 15: the instruments', friction laws', papers' and rubbed objects' demos; the five
+    // articulation demos make 20. Fewer means the file or its parsing lost lines.
     assert!(list.len() >= 15, "the demo list lost lines: {}", list.len());
     for demo in &list {
         let fresh = out_dir.join(&demo.file);

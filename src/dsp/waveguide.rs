@@ -1036,6 +1036,9 @@ mod tests {
                         "beta {beta}, w {width}, partial {n}: {db:+.2} dB"
                     );
                 } else {
+                    // Measured 0.003-0.017 at the nodes (beta 0.2: partials 5 and 10; 0.25:
+                    // 4 and 8), and the theory's 0.037 and 0.017 for the two partials near
+                    // one; 0.05 is the line under which a partial is checked here.
                     assert!(m < 0.05, "beta {beta}: partial {n} at a node reads {m:.3}");
                 }
             }

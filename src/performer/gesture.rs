@@ -343,6 +343,8 @@ mod tests {
         let regime = classify_regime(tail, FS as f32, f0 as f32);
         let v: Vec<f64> = tail.iter().map(|s| s.string_velocity as f64).collect();
         let v_b = played.velocity_m_per_s;
+        // 0.05 v_b as the playing-space map measures a cell (lab/src/playing_space.rs). It
+        // sets only the strict slip fraction, unread here: the half-jump one decides.
         let stats = crate::analysis::slip_stats(&v, v_b, FS, f0, 0.05 * v_b);
         let beta = played.position_beta;
         let helmholtz =
