@@ -60,7 +60,7 @@ fn a_midi_file_rendered_offline_gives_the_plugins_bits() {
             MidiEvent::NoteOff(n) => Event::note_off(n),
             MidiEvent::PitchBend(raw) => Event::pitch_bend((raw as f64 - 8192.0) / 8192.0),
             MidiEvent::Controller(cc, value) => host::Event::Controller { cc, value },
-            MidiEvent::Pressure(_) => unreachable!("not in this score"),
+            MidiEvent::Pressure(_) | MidiEvent::Tempo(_) => unreachable!("not in this score"),
         };
         score.push(e.sample, event);
     }
