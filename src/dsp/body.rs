@@ -43,6 +43,27 @@ pub fn muted(mode: BodyMode, scale: f64) -> BodyMode {
     }
 }
 
+/// [`muted`] for a mode of the thermal model's 2x2 bridge: the same mass on the same
+/// modes, so their frequency and bandwidth fall by `sqrt(1 / (1 + r))` (the Q kept, as in
+/// [`muted`]) and their gain by `1 / (1 + r)`.
+pub fn muted_bridge_mode(mode: BridgeMode, scale: f64) -> BridgeMode {
+    if mode.freq_hz < BRIDGE_MODES_FROM_HZ * scale {
+        return mode;
+    }
+    let loaded = 1.0 + MUTE_MASS_RATIO;
+    let mut gain = mode.gain;
+    for row in &mut gain {
+        for g in row {
+            *g /= loaded;
+        }
+    }
+    BridgeMode {
+        freq_hz: mode.freq_hz / loaded.sqrt(),
+        bandwidth_hz: mode.bandwidth_hz / loaded.sqrt(),
+        gain,
+    }
+}
+
 pub use super::vocabulary::BodyMode;
 
 /// The modes as parallel band-pass biquads ([`Bandpass`]'s transposed direct form II),

@@ -204,11 +204,40 @@ fn psd_pinv(g: [[f64; 2]; 2]) -> [[f64; 2]; 2] {
     pinv
 }
 
+impl Section {
+    /// `mode` at `sample_rate_hz` by the bilinear transform; `None` at or above Nyquist.
+    fn of(mode: &BridgeMode, sample_rate_hz: f64) -> Option<Self> {
+        if mode.freq_hz >= 0.5 * sample_rate_hz {
+            return None;
+        }
+        let k = 2.0 * sample_rate_hz;
+        let w = k * (PI * mode.freq_hz / sample_rate_hz).tan();
+        let bw = 2.0 * PI * mode.bandwidth_hz;
+        let d = k * k + bw * k + w * w;
+        let mut gain = [[0.0; 2]; 2];
+        for i in 0..2 {
+            for j in 0..2 {
+                gain[i][j] = mode.gain[i][j] * k / d;
+            }
+        }
+        let a1 = 2.0 * (w * w - k * k) / d;
+        Some(Section {
+            a1,
+            a2: (k * k - bw * k + w * w) / d,
+            gain,
+            storage: section_storage(a1, k, bw, w),
+            gain_pinv: psd_pinv(gain),
+        })
+    }
+}
+
 /// `Y(z)` at one sample rate (see the module doc).
 #[derive(Debug, Clone)]
 pub struct ModalBridge {
     /// The continuous-time modes, validated (kept to rebuild the sections at a new rate).
     modes: Vec<BridgeMode>,
+    /// The modes as built, before [`ModalBridge::transform_modes`] changed them.
+    built: Vec<BridgeMode>,
     sections: Vec<Section>,
     /// The sections' coefficients and states, four to a block (section `i` in block
     /// `i / 4`, lane `i % 4`).
@@ -231,6 +260,7 @@ impl ModalBridge {
         }
         let mut bridge = Self {
             modes: modes.to_vec(),
+            built: modes.to_vec(),
             sections: Vec::with_capacity(modes.len()),
             lanes: Vec::with_capacity(modes.len().div_ceil(LANES)),
             hist: [0.0; 2],
@@ -252,28 +282,14 @@ impl ModalBridge {
         self.sections.clear();
         let mut r0 = [[0.0; 2]; 2];
         for mode in &self.modes {
-            if mode.freq_hz >= 0.5 * sample_rate_hz {
-                continue;
-            }
-            let k = 2.0 * sample_rate_hz;
-            let w = k * (PI * mode.freq_hz / sample_rate_hz).tan();
-            let bw = 2.0 * PI * mode.bandwidth_hz;
-            let d = k * k + bw * k + w * w;
-            let mut gain = [[0.0; 2]; 2];
-            for i in 0..2 {
-                for j in 0..2 {
-                    gain[i][j] = mode.gain[i][j] * k / d;
-                    r0[i][j] += gain[i][j];
+            if let Some(section) = Section::of(mode, sample_rate_hz) {
+                for (i, row) in r0.iter_mut().enumerate() {
+                    for (j, r) in row.iter_mut().enumerate() {
+                        *r += section.gain[i][j];
+                    }
                 }
+                self.sections.push(section);
             }
-            let a1 = 2.0 * (w * w - k * k) / d;
-            self.sections.push(Section {
-                a1,
-                a2: (k * k - bw * k + w * w) / d,
-                gain,
-                storage: section_storage(a1, k, bw, w),
-                gain_pinv: psd_pinv(gain),
-            });
         }
         self.r0 = r0;
         self.lanes.clear();
@@ -291,6 +307,41 @@ impl ModalBridge {
             self.lanes.push(lanes);
         }
         self.hist = [0.0; 2];
+    }
+
+    /// Rebuilds the bridge from its modes as built, each passed through `change` (a mute's
+    /// mass on the bridge: [`super::body::muted`]; the identity takes it off), keeping
+    /// the sections' ringing state where every mode keeps its section. Never allocates.
+    pub fn transform_modes(&mut self, change: impl Fn(BridgeMode) -> BridgeMode) {
+        for (mode, built) in self.modes.iter_mut().zip(&self.built) {
+            *mode = change(*built);
+        }
+        let fs = self.sample_rate_hz;
+        let kept = self.modes.iter().filter(|m| m.freq_hz < 0.5 * fs).count();
+        if kept != self.sections.len() {
+            self.set_sample_rate(fs);
+            return;
+        }
+        let mut r0 = [[0.0; 2]; 2];
+        let mut k = 0;
+        for mode in &self.modes {
+            let Some(section) = Section::of(mode, fs) else {
+                continue;
+            };
+            let lanes = &mut self.lanes[k / LANES];
+            let l = k % LANES;
+            lanes.a1.0[l] = section.a1;
+            lanes.a2.0[l] = section.a2;
+            for c in 0..2 {
+                for d in 0..2 {
+                    lanes.gain[c][d].0[l] = section.gain[c][d];
+                    r0[c][d] += section.gain[c][d];
+                }
+            }
+            self.sections[k] = section;
+            k += 1;
+        }
+        self.r0 = r0;
     }
 
     /// Section `i`'s states `(z1, z2)`, each over the two channels.
@@ -553,6 +604,38 @@ mod tests {
             );
         }
         assert_eq!(scalar.energy_j().to_bits(), vector.energy_j().to_bits());
+    }
+
+    /// Moving the modes keeps the bridge ringing: the identity changes no bit of what
+    /// follows, and a mute put on and taken off again gives back the bridge as built
+    /// (its response at every mode, to the bit), its state carried through.
+    #[test]
+    fn transforming_the_modes_keeps_the_state_and_the_identity_changes_nothing() {
+        let modes = generic_cello_bridge();
+        let mut touched = ModalBridge::new(&modes, 96_000.0).unwrap();
+        let mut x = 0.321_f64;
+        let mut force = || {
+            x = 3.99 * x * (1.0 - x);
+            [x - 0.5, 0.3 - x]
+        };
+        for _ in 0..1000 {
+            touched.tick(force());
+        }
+        let mut left = touched.clone();
+        touched.transform_modes(|m| m);
+        for n in 0..1000 {
+            let f = force();
+            let (a, b) = (touched.tick(f), left.tick(f));
+            assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits), "sample {n}");
+        }
+        let before = touched.energy_j();
+        touched.transform_modes(|m| crate::dsp::body::muted_bridge_mode(m, 1.0));
+        assert!(touched.energy_j() > 0.0, "still ringing");
+        assert!(before > 0.0);
+        touched.transform_modes(|m| m);
+        for m in &modes {
+            assert_eq!(touched.response(m.freq_hz), left.response(m.freq_hz));
+        }
     }
 
     #[test]

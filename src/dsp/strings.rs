@@ -475,7 +475,8 @@ impl<B: StringBank> FourStrings<B> {
     }
 
     /// Puts a mute on the bridge (con sordino) or takes it off: the bridge's modes carry
-    /// its mass ([`super::body::muted`]). The thermal model's bridge takes none.
+    /// its mass ([`super::body::muted`]; on the thermal model's modal bridge
+    /// [`super::body::muted_bridge_mode`]).
     pub fn set_mute(&mut self, on: bool) {
         self.bank.set_mute(on);
     }

@@ -206,6 +206,8 @@ pub struct ThermalBank {
     awake: bool,
     /// AVX2 detected at run time ([`render_avx2`]).
     wide_simd: bool,
+    /// A mute on the bridge (con sordino, [`super::body::muted_bridge_mode`]).
+    muted: bool,
 }
 
 /// Paper B's four-string instrument at the host rate (see the module doc):
@@ -266,6 +268,30 @@ impl StringBank for ThermalBank {
 
     fn internal_rate_hz(&self) -> f64 {
         Self::internal_rate(self.kind, &self.wave_speeds, self.settings)
+    }
+
+    /// The mute's mass on the bridge's modes from the bridge hill up, as on the point-bow
+    /// body: the bridge keeps its ringing state, and each string is retuned at its pitch
+    /// for the bridge's new phase delay.
+    fn set_mute(&mut self, on: bool) {
+        if on == self.muted {
+            return;
+        }
+        self.muted = on;
+        let scale = self.kind.spec().body_scale;
+        self.core.bridge.transform_modes(|mode| {
+            if on {
+                super::body::muted_bridge_mode(mode, scale)
+            } else {
+                mode
+            }
+        });
+        for i in 0..STRINGS {
+            let f0 = self.core.strings[i].fundamental_hz();
+            if f0 > 0.0 {
+                self.tune(i, f0);
+            }
+        }
     }
 
     /// The force in newtons is spread evenly over the bow's width: `F_b = F / w` (N/m).
@@ -514,6 +540,7 @@ impl ThermalInstrument {
             output_scale: kind.output_scale_per_n(),
             awake: false,
             wide_simd: super::detect_wide_simd(),
+            muted: false,
         };
         let resampler = Box::new(Resampler::with_capacity(rate, host_rate_hz, max_rate)?);
         let mut instrument = Self::from_bank(
