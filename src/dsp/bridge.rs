@@ -361,7 +361,7 @@ impl ModalBridge {
     }
 
     /// Energy the bridge holds, J: for every section, the storage of its scalar filter
-    /// ([`section_storage`]) in the eigen-directions of its gain `R = Q L Q^T`. The input
+    /// (`section_storage`) in the eigen-directions of its gain `R = Q L Q^T`. The input
     /// `R F` gives the outputs `Q L H(Q^T F)` and the supply `F . v = sum_k l_k xi_k H(xi_k)`
     /// (`xi = Q^T F`), while the states along `Q` are `l_k` times those of `H` driven by
     /// `xi_k`; so the storage is `sum_k S(Q^T z)_k / l_k`, the quadratic form in `R^+`.

@@ -11,7 +11,7 @@
 //!
 //! The table does what the player's ear does, once, offline: for every friction model,
 //! instrument, string and semitone above the open string (0..=
-//! [`MAX_STOP_SEMITONES`](super::vocabulary::MAX_STOP_SEMITONES)) it holds the cents the
+//! [`super::vocabulary::MAX_STOP_SEMITONES`]) it holds the cents the
 //! note is moved so that bowing it at the plugin's defaults (0.1 m/s, 1 N on the knob,
 //! String Weight on for the point laws, beta 0.1) sounds at equal temperament. It is
 //! measured through the same engines the plugin plays by `colophony bench intonation`

@@ -396,7 +396,7 @@ impl Resampler {
     }
 
     /// A resampler for one fixed pair of rates: where their ratio (after stage 1) is a
-    /// fraction with a denominator up to [`MAX_PHASES`] (every pair of the usual rates),
+    /// fraction with a denominator up to `MAX_PHASES` (every pair of the usual rates),
     /// the kernel of each output phase is precomputed and an output sample costs one dot
     /// product (about a quarter of [`Resampler::new`]'s table walk). The same output to
     /// the table's interpolation error.

@@ -9,7 +9,7 @@
 pub const MAX_CORRECTION_CENTS: f64 = 50.0;
 
 /// The rate the point-bow strings and their body run at, whatever the host's: the output
-/// is resampled to the host rate ([`Resampler`]). The bowed string's regime (Helmholtz
+/// is resampled to the host rate ([`super::resample::Resampler`]). The bowed string's regime (Helmholtz
 /// motion or a double slip: both are stable over much of the window, and which one an
 /// attack falls into changes with any detail of the discretisation) and its pitch then do
 /// not depend on the project's rate, and the intonation table, measured at this rate,
@@ -106,7 +106,7 @@ pub struct InstrumentSpec {
     pub q_hi: f64,
     /// Vibrating length of the open strings, m.
     pub string_length_m: f64,
-    /// The generic body's modal frequencies over the violin's ([`InstrumentKind::body_modes`]).
+    /// The generic body's modal frequencies over the violin's (`InstrumentKind::body_modes`).
     pub body_scale: f64,
     /// How many times [`INTERNAL_RATE_HZ`] each point-bow string runs at
     /// ([`InstrumentKind::point_oversampling`]).
@@ -246,7 +246,7 @@ impl InstrumentKind {
     }
 
     /// What the bow force is multiplied by on string `index` when the strings are weighted
-    /// ([`Instrument::set_string_weighting`]): the string's impedance over
+    /// ([`super::strings::FourStrings::set_string_weighting`]): the string's impedance over
     /// [`WEIGHT_REFERENCE_Z0`]. Schelleng's limits are both proportional to `Z0` (with the
     /// dashpot bridge `R = 2 Q1 Z0 / pi`, docs/literature-values.md), so one force parameter then
     /// keeps the same place in every string's window, as a player leans into the heavy

@@ -441,7 +441,7 @@ impl WaveguideString {
 
     /// Strikes the string at the bow point with the bow's stick (col legno battuto): a
     /// rigid `mass_kg` arriving at `velocity_m_per_s`, which pushes the string until the
-    /// string would pull it back ([`Striker`]); the bow's friction plays no part while it
+    /// string would pull it back (the stick's contact, `Striker`); the bow's friction plays no part while it
     /// does. The string takes from the stick what the stick loses: momentum
     /// `m (u0 - u1)` and, the contact being lossless, energy `m (u0^2 - u1^2) / 2`.
     pub fn strike(&mut self, mass_kg: f64, velocity_m_per_s: f64) {

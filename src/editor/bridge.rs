@@ -33,7 +33,7 @@ pub struct BridgeBar {
 }
 
 /// A folder's subfolders and bridge files (`.json`), folders first, each sorted by name;
-/// at most [`MAX_ENTRIES`]. An unreadable folder lists nothing.
+/// at most `MAX_ENTRIES`. An unreadable folder lists nothing.
 pub fn bridge_entries(folder: &Path) -> Vec<(std::path::PathBuf, bool)> {
     let Ok(read) = std::fs::read_dir(folder) else {
         return Vec::new();

@@ -9,7 +9,7 @@
 //! * [`bridge`]: the instrument's bridge: load a fitted one, or the shipped one.
 //! * [`midi_map_page`]: the MIDI map page: controllers to targets, ranges, curves, learn.
 //! * [`presets`]: the preset selector and "save as" ([`crate::presets`]).
-//! * [`regime`]: the regime the string is in, classified from the live samples (pure).
+//! * [`crate::measure::regime`]: the regime the string is in, classified from the live samples (pure).
 //! * This file: the window glue. [`ColophonyEditor`] is the plugin's `Editor`;
 //!   [`EditorState`] is the window size saved with the plugin state
 //!   (`#[persist = "editor-state"]` in [`crate::params::ColophonyParams`]); [`EditorLink`]

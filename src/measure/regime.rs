@@ -2,7 +2,7 @@
 //!
 //! Schelleng's diagram names what a bowed string does at a given force and velocity;
 //! [`classify_regime`] names what the simulation actually does, from the samples the editor
-//! already copies out of the [`super::live::Scope`] ring, so the side panel can show it
+//! already copies out of the [`crate::editor::live::Scope`] ring, so the side panel can show it
 //! beside the regime the Schelleng window predicts. Nothing is computed on the audio thread.
 //!
 //! **How.** A sample slips where the string moves away from the bow:

@@ -126,7 +126,7 @@ pub struct ThermalParams {
 }
 
 impl Default for ThermalParams {
-    /// Paper B publishes none of these (docs/literature-values.md §1.3: [NF]). Chosen by
+    /// Paper B publishes none of these (docs/literature-values.md §1.3: \[NF\]). Chosen by
     /// measurement (`colophony bench thermal-constants`, docs/playing-space.md, "Choosing
     /// the thermal constants") so that the contact sticks across each string's Schelleng
     /// window, the plugin's default 1 N lies inside every string's window, paper B's own
@@ -303,7 +303,7 @@ pub struct HairParams {
 
 impl Default for HairParams {
     /// Horizontal: the lumped ribbon of Matusiak's code (k 4.83e4 N/m, d 5.77 kg/s over
-    /// 1 cm; docs/literature-values.md §1.5) per metre. Vertical: [NF] in paper B; a ribbon of ~50
+    /// 1 cm; docs/literature-values.md §1.5) per metre. Vertical: \[NF\] in paper B; a ribbon of ~50
     /// active hairs (0.1 g/m each, so 5 g/m) on the bow's vertical stiffness, chosen at the
     /// same per-metre stiffness and damping as the horizontal hair.
     fn default() -> Self {
