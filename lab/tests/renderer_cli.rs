@@ -190,12 +190,17 @@ fn paper_figures_are_written_as_png() {
         );
         let bytes = std::fs::read(&out).unwrap();
         assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{name} is not a PNG");
-        // Measured 124-766 KB. A blank white canvas is 13 KB at the Serafin figures'
-        // 1400 x 560 but 21-40 KB at the Maestre figures' heights: 20 KB fails a blank
-        // Serafin figure or a cut-off file.
+        // Not blank: more than twice a blank white canvas of its size, drawn by the same
+        // library (measured 124-766 KB against blanks of 13-40 KB; a cut-off file or an
+        // empty chart comes near the blank's size).
+        let (w, h) = (
+            u32::from_be_bytes(bytes[16..20].try_into().unwrap()),
+            u32::from_be_bytes(bytes[20..24].try_into().unwrap()),
+        );
+        let blank = blank_png_bytes(w, h);
         assert!(
-            bytes.len() > 20_000,
-            "{name}: suspiciously small ({} bytes)",
+            bytes.len() > 2 * blank,
+            "{name}: {} bytes, a blank {w} x {h} canvas {blank}",
             bytes.len()
         );
     }
@@ -586,4 +591,16 @@ fn bench_peers_compares_with_stk_or_says_how_to_install_it() {
         assert!(stderr.contains("install-peers.sh"), "{stderr}");
         assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
     }
+}
+
+/// The size of a blank white `w` x `h` PNG as the figures' plotting library writes it.
+fn blank_png_bytes(w: u32, h: u32) -> usize {
+    use plotters::prelude::*;
+    let path = scratch(&format!("blank-{w}x{h}.png"));
+    {
+        let root = BitMapBackend::new(&path, (w, h)).into_drawing_area();
+        root.fill(&WHITE).unwrap();
+        root.present().unwrap();
+    }
+    std::fs::read(&path).unwrap().len()
 }
