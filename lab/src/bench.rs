@@ -546,15 +546,13 @@ fn child_cpu_s(cmd: &mut std::process::Command, what: &str) -> Result<f64, Strin
 /// Rounds of [`peers`]: every process runs this many times, interleaved.
 const PEER_ROUNDS: usize = 5;
 
-/// How a [`peers`] row is judged.
-#[derive(Clone, Copy)]
-enum PeerGoal {
-    /// CPU over STK's, at most this.
-    TimesStk(f64),
-    /// CPU over the audio's length, at most this many % of one core.
-    PercentOfCore(f64),
-    /// Measured for the table, no goal.
-    None,
+/// What a [`peers`] row's CPU time is measured against.
+#[derive(Clone, Copy, PartialEq)]
+enum PeerMeasure {
+    /// STK's CPU time in the same round (a point-bow string's whole process).
+    TimesStk,
+    /// The audio's length: % of one core (paper B's scenes).
+    PercentOfCore,
 }
 
 /// One whole process [`peers`] times: a command for `seconds` of audio.
@@ -562,7 +560,9 @@ struct PeerRow {
     name: &'static str,
     /// Seconds of audio the timed process renders.
     seconds: f64,
-    goal: PeerGoal,
+    measure: PeerMeasure,
+    /// The most the measure may be, if the row has a goal.
+    goal: Option<f64>,
     command: Box<dyn Fn(f64) -> std::process::Command>,
 }
 
@@ -598,6 +598,7 @@ pub fn peers(seconds: f64, dir: &std::path::Path) -> Result<String, String> {
             PeerRow {
                 name,
                 seconds,
+                measure: PeerMeasure::TimesStk,
                 goal,
                 command: Box::new(move |secs: f64| {
                     let mut c = std::process::Command::new(&me);
@@ -619,6 +620,7 @@ pub fn peers(seconds: f64, dir: &std::path::Path) -> Result<String, String> {
         PeerRow {
             name,
             seconds: (seconds / 10.0).max(0.1),
+            measure: PeerMeasure::PercentOfCore,
             goal,
             command: Box::new(move |secs: f64| {
                 let mut c = std::process::Command::new(&me);
@@ -632,7 +634,8 @@ pub fn peers(seconds: f64, dir: &std::path::Path) -> Result<String, String> {
         PeerRow {
             name: "STK Bowed",
             seconds,
-            goal: PeerGoal::None,
+            measure: PeerMeasure::TimesStk,
+            goal: None,
             command: Box::new({
                 let (stk, dir, d3_hz) = (stk.clone(), dir.to_path_buf(), d3_hz.clone());
                 move |secs: f64| {
@@ -644,41 +647,24 @@ pub fn peers(seconds: f64, dir: &std::path::Path) -> Result<String, String> {
                 }
             }),
         },
-        render_row(
-            "hyperbolic string (default)",
-            "hyperbolic",
-            None,
-            PeerGoal::TimesStk(0.5),
-        ),
+        render_row("hyperbolic string (default)", "hyperbolic", None, Some(0.5)),
         // The plugin solves to the good preset's tolerance (1e-4 m/s, src/quality.rs; its
         // error is in docs/precision.md): what the plugin's elasto-plastic string costs.
         render_row(
             "elasto-plastic, plugin tolerance",
             "elasto-plastic",
             Some("good"),
-            PeerGoal::TimesStk(1.5),
+            Some(1.5),
         ),
         render_row(
             "elasto-plastic, reference tolerance",
             "elasto-plastic",
             None,
-            PeerGoal::None,
+            None,
         ),
-        scene_row(
-            "thermal cello N_B 60, C bowed",
-            "cello-c",
-            PeerGoal::PercentOfCore(3.0),
-        ),
-        scene_row(
-            "thermal cello N_B 60, C+G",
-            "cello-cg",
-            PeerGoal::PercentOfCore(5.0),
-        ),
-        scene_row(
-            "thermal quartet, plugin quality",
-            "quartet",
-            PeerGoal::PercentOfCore(15.0),
-        ),
+        scene_row("thermal cello N_B 60, C bowed", "cello-c", Some(3.0)),
+        scene_row("thermal cello N_B 60, C+G", "cello-cg", Some(5.0)),
+        scene_row("thermal quartet, plugin quality", "quartet", Some(15.0)),
     ];
     let mut cpu = vec![Vec::with_capacity(PEER_ROUNDS); rows.len()];
     for _round in 0..PEER_ROUNDS {
@@ -692,7 +678,10 @@ pub fn peers(seconds: f64, dir: &std::path::Path) -> Result<String, String> {
                 // Long enough that the difference is the steady sound, short enough for
                 // valgrind (about 50 times slower): 2 s and 4 s of a point-bow string,
                 // 0.25 s and 0.5 s of paper B's scenes, less for a short run.
-                let short = (0.5 * row.seconds).min(if row.seconds < seconds { 0.25 } else { 2.0 });
+                let short = (0.5 * row.seconds).min(match row.measure {
+                    PeerMeasure::TimesStk => 2.0,
+                    PeerMeasure::PercentOfCore => 0.25,
+                });
                 instructions_per_sample(&*row.command, short, 2.0 * short, row.name).ok()
             })
             .collect()
@@ -714,47 +703,27 @@ pub fn peers(seconds: f64, dir: &std::path::Path) -> Result<String, String> {
     ];
     for ((row, times), instr) in rows.iter().zip(&cpu).zip(&instructions) {
         let (b, w) = (best(times), worst(times));
-        let (measured, range, goal, met) = match row.goal {
-            PeerGoal::TimesStk(_) | PeerGoal::None if row.seconds == seconds => {
-                let per_round: Vec<f64> = times.iter().zip(&cpu[0]).map(|(t, s)| t / s).collect();
-                let ratio = b / stk_best;
-                let goal_text = match row.goal {
-                    PeerGoal::TimesStk(g) => format!("<= {g}x STK"),
-                    _ => String::new(),
-                };
-                let met = match row.goal {
-                    PeerGoal::TimesStk(g) => {
-                        if ratio <= g {
-                            "yes"
-                        } else {
-                            "no"
-                        }
-                    }
-                    _ => "",
-                };
-                (
-                    format!("{ratio:.2}x STK"),
-                    format!("{:.2}-{:.2}x", best(&per_round), worst(&per_round)),
-                    goal_text,
-                    met,
-                )
-            }
-            _ => {
-                let percent = 100.0 * b / row.seconds;
-                let (goal_text, met) = match row.goal {
-                    PeerGoal::PercentOfCore(g) => {
-                        (format!("<= {g} %"), if percent <= g { "yes" } else { "no" })
-                    }
-                    _ => (String::new(), ""),
-                };
-                (
-                    format!("{percent:.1} % of a core"),
-                    format!("{:.1}-{:.1} %", percent, 100.0 * w / row.seconds),
-                    goal_text,
-                    met,
-                )
-            }
+        // Each round's value, the best's, and its unit.
+        let (per_round, value, unit): (Vec<f64>, f64, &str) = match row.measure {
+            PeerMeasure::TimesStk => (
+                times.iter().zip(&cpu[0]).map(|(t, s)| t / s).collect(),
+                b / stk_best,
+                "x STK",
+            ),
+            PeerMeasure::PercentOfCore => (
+                times.iter().map(|t| 100.0 * t / row.seconds).collect(),
+                100.0 * b / row.seconds,
+                " % of a core",
+            ),
         };
+        let (measured, range) = (
+            format!("{value:.2}{unit}"),
+            format!("{:.2}-{:.2}", best(&per_round), worst(&per_round)),
+        );
+        let goal = row.goal.map_or(String::new(), |g| format!("<= {g}{unit}"));
+        let met = row
+            .goal
+            .map_or("", |g| if value <= g { "yes" } else { "no" });
         lines.push(format!(
             "| {} | {b:.3} | {:.0} % | {measured} | {range} | {} | {goal} | {met} |",
             row.name,

@@ -486,6 +486,30 @@ impl<B: StringBank> FourStrings<B> {
     /// finger lifts as after a bowed note. Returns the string, or `None` if no string can
     /// play the note or the strings cannot be plucked (then nothing sounds).
     pub fn pluck(&mut self, note: u8, pluck: Pluck) -> Option<usize> {
+        self.unbowed(note, |bank, index, vibrating_m| {
+            let width = pluck.width_m / vibrating_m;
+            // Past the middle of a short stopped string the hand plucks its middle.
+            let beta = (pluck.from_bridge_m / vibrating_m).clamp(MIN_NOTE_BETA, 0.5);
+            bank.pluck(index, pluck.displacement_m, beta, width)
+        })
+    }
+
+    /// Stops the string for `note` and strikes it at the bow point with the bow's stick
+    /// (col legno battuto): no bow hair lands, and a bow on that string lifts; the string
+    /// then rings as a plucked one does. Returns the string, or `None` if no string can
+    /// play the note or the strings cannot be struck (then nothing sounds).
+    pub fn strike(&mut self, note: u8, strike: Strike) -> Option<usize> {
+        self.unbowed(note, |bank, index, _| bank.strike(index, strike))
+    }
+
+    /// A note played without the bow (plucked or struck): stops the string for `note`
+    /// at its free pitch, lifts any bow from it and hands `excite` the bank, the string
+    /// and its vibrating length (m); the string, or `None` if nothing sounds.
+    fn unbowed(
+        &mut self,
+        note: u8,
+        excite: impl FnOnce(&mut B, usize, f64) -> bool,
+    ) -> Option<usize> {
         if !B::PLUCKABLE {
             return None;
         }
@@ -494,28 +518,7 @@ impl<B: StringBank> FourStrings<B> {
         let open = self.hands.open_notes[index];
         let vibrating_m =
             self.kind.string_length_m() * 2f64.powf(-(note.saturating_sub(open) as f64) / 12.0);
-        let width = pluck.width_m / vibrating_m;
-        // Past the middle of a short stopped string the hand plucks its middle.
-        let beta = (pluck.from_bridge_m / vibrating_m).clamp(MIN_NOTE_BETA, 0.5);
-        if !self.bank.pluck(index, pluck.displacement_m, beta, width) {
-            return None;
-        }
-        self.bank.wake(index);
-        self.hands.probed = index;
-        Some(index)
-    }
-
-    /// Stops the string for `note` and strikes it at the bow point with the bow's stick
-    /// (col legno battuto): no bow hair lands, and a bow on that string lifts; the string
-    /// then rings as a plucked one does. Returns the string, or `None` if no string can
-    /// play the note or the strings cannot be struck (then nothing sounds).
-    pub fn strike(&mut self, note: u8, strike: Strike) -> Option<usize> {
-        if !B::PLUCKABLE {
-            return None;
-        }
-        let index = self.stop_for(note, true)?;
-        self.hands.bows[index].bowed = false;
-        if !self.bank.strike(index, strike) {
+        if !excite(&mut self.bank, index, vibrating_m) {
             return None;
         }
         self.bank.wake(index);

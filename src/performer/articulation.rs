@@ -223,24 +223,25 @@ impl Performer {
 
     /// Plucks `note` with `velocity` on the waveguide strings of the setup's instrument.
     pub(super) fn pluck_note(&mut self, note: u8, velocity: f32) {
-        self.tail = None;
-        if self.instrument.kind() != self.setup.instrument {
-            self.instrument.set_kind(self.setup.instrument);
-        }
-        let string = self
-            .instrument
-            .pluck(note, pluck_for(self.setup.instrument, velocity));
+        let pluck = pluck_for(self.setup.instrument, velocity);
+        let string = self.unbowed_strings().pluck(note, pluck);
         self.took(note, string);
     }
 
     /// Strikes `note` with the bow's stick (col legno battuto) at velocity `velocity`.
     pub(super) fn strike_note(&mut self, note: u8, velocity: f32) {
+        let string = self.unbowed_strings().strike(note, strike_for(velocity));
+        self.took(note, string);
+    }
+
+    /// The waveguide strings of the setup's instrument, for a note played without the
+    /// bow (which plays them whatever the friction law).
+    fn unbowed_strings(&mut self) -> &mut crate::dsp::instrument::Instrument {
         self.tail = None;
         if self.instrument.kind() != self.setup.instrument {
             self.instrument.set_kind(self.setup.instrument);
         }
-        let string = self.instrument.strike(note, strike_for(velocity));
-        self.took(note, string);
+        &mut self.instrument
     }
 }
 
