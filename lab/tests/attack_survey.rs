@@ -116,3 +116,149 @@ fn guettler_diagram_survey() {
         println!("{row}");
     }
 }
+
+/// The smallest bowed string that has Guettler's attacks: two delay lines (cello D3 at
+/// 48 kHz, `Z0` 0.506 kg/s), a rigid end and a lossy one whose one-pole filter
+/// (`OnePoleLoss::for_string`, Q 500 at the fundamental and 250 at ten times it, as the
+/// plugin's D string) sits at the bridge (`loss_at_bridge`) or at the nut, the bow at beta
+/// 0.1 with the hyperbolic law; no torsion, hair, stiffness or fractional delay.
+struct MinimalString {
+    to_bridge: Vec<f64>,
+    from_bridge: Vec<f64>,
+    to_nut: Vec<f64>,
+    from_nut: Vec<f64>,
+    at_b: usize,
+    at_n: usize,
+    loss: colophony::dsp::filters::OnePoleLoss,
+    loss_at_bridge: bool,
+    friction: colophony::dsp::friction::HyperbolicFriction,
+}
+
+impl MinimalString {
+    fn new(f0: f64, beta: f64, loss_at_bridge: bool) -> Self {
+        let n_loop = (FS / f0).round() as usize;
+        let nb = (beta * n_loop as f64 / 2.0).round().max(1.0) as usize;
+        let nn = n_loop / 2 - nb;
+        Self {
+            to_bridge: vec![0.0; nb],
+            from_bridge: vec![0.0; nb],
+            to_nut: vec![0.0; nn],
+            from_nut: vec![0.0; nn],
+            at_b: 0,
+            at_n: 0,
+            loss: colophony::dsp::filters::OnePoleLoss::for_string(f0, FS, 500.0, 250.0, 1.0),
+            loss_at_bridge,
+            friction: Default::default(),
+        }
+    }
+
+    /// One sample with the bow at `velocity` (m/s) and `force` (N): the contact sample.
+    fn tick(&mut self, velocity: f64, force: f64) -> ContactSample {
+        use colophony::dsp::friction::{BowInput, FrictionContact, LoadLine};
+        const Z0: f64 = 0.506;
+        let (arriving_b, arriving_n) = (self.from_bridge[self.at_b], self.from_nut[self.at_n]);
+        let (at_bridge, at_nut) = (self.to_bridge[self.at_b], self.to_nut[self.at_n]);
+        let (reflected_b, reflected_n) = if self.loss_at_bridge {
+            (-self.loss.tick(at_bridge), -at_nut)
+        } else {
+            (-at_bridge, -self.loss.tick(at_nut))
+        };
+        let load = LoadLine {
+            free_velocity_m_per_s: arriving_b + arriving_n,
+            admittance_s_per_kg: 0.5 / Z0,
+        };
+        let f = self.friction.solve(
+            load,
+            BowInput {
+                velocity_m_per_s: velocity,
+                normal_force_n: force,
+            },
+        );
+        let dv = f * load.admittance_s_per_kg;
+        self.to_bridge[self.at_b] = arriving_n + dv;
+        self.to_nut[self.at_n] = arriving_b + dv;
+        self.from_bridge[self.at_b] = reflected_b;
+        self.from_nut[self.at_n] = reflected_n;
+        self.at_b = (self.at_b + 1) % self.to_bridge.len();
+        self.at_n = (self.at_n + 1) % self.to_nut.len();
+        let v = load.free_velocity_m_per_s + dv;
+        ContactSample {
+            string_velocity: v as f32,
+            relative_velocity: (v - velocity) as f32,
+            mu: (f / force) as f32,
+        }
+    }
+}
+
+/// The first slip onset that begins `run` consecutive spans of one period (within 3 %):
+/// when Helmholtz motion first appears, whether or not it lasts.
+fn first_helmholtz_run(probe: &[ContactSample], f0: f64, run: usize) -> Option<usize> {
+    let onsets = colophony::measure::regime::slip_onsets(probe);
+    let period = FS / f0;
+    let mut length = 0;
+    for (k, w) in onsets.windows(2).enumerate() {
+        if ((w[1] - w[0]) as f64 - period).abs() <= 0.03 * period {
+            length += 1;
+            if length == run {
+                return Some(onsets[k + 1 - run]);
+            }
+        } else {
+            length = 0;
+        }
+    }
+    None
+}
+
+/// Guettler's diagram on [`MinimalString`] (cello D3, beta 0.1; forces as fractions of
+/// Schelleng's `F_max` = 5.06 N, the bow from rest at constant acceleration to 0.1 m/s, 0:
+/// landing at speed), with the loss at the bridge and at the nut, and the plugin's cello at
+/// the same cells: ms from the bow's start to the first six periods of Helmholtz motion
+/// ([`first_helmholtz_run`]) and, in brackets, to Helmholtz motion that lasts to the end
+/// of 0.8 s ([`helmholtz_since`]). `cargo test --release -p colophony-lab --test
+/// attack_survey minimal -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn minimal_string_guettler_survey() {
+    use colophony::dsp::instrument::Instrument;
+    use colophony::measure::regime::helmholtz_since;
+    let f0 = midi_to_hz(50.0);
+    let accels = [0.0, 0.1, 0.2, 0.5, 1.0, 2.0, 5.0];
+    let fractions = [0.05, 0.1, 0.2, 0.3, 0.5, 0.7];
+    let n = (0.8 * FS) as usize;
+    let ms = |k: Option<usize>| k.map_or("never".to_string(), |k| format!("{:.0}", k as f64 / FS * 1e3));
+    for model in ["minimal, loss at the bridge", "minimal, loss at the nut", "the plugin's cello"] {
+        println!("{model}: rows F / F_max, columns acceleration (m/s^2); ms to six periods of Helmholtz motion (to lasting Helmholtz motion)");
+        for &frac in &fractions {
+            let force = frac * 5.06;
+            let mut row = format!("{frac:>5}");
+            for &a in &accels {
+                let bow_velocity = |i: usize| if a == 0.0 { 0.1 } else { (a * i as f64 / FS).min(0.1) };
+                let probe: Vec<ContactSample> = if model.starts_with("minimal") {
+                    let mut s = MinimalString::new(f0, 0.1, model.ends_with("bridge"));
+                    (0..n).map(|i| s.tick(bow_velocity(i), force)).collect()
+                } else {
+                    let mut cello = Instrument::new(InstrumentKind::Cello, FS);
+                    cello.set_friction_model(FrictionModel::Hyperbolic);
+                    cello.note_on(50);
+                    (0..n)
+                        .map(|i| {
+                            if i % 256 == 0 {
+                                cello.update_sleep();
+                            }
+                            let bow = BowControl {
+                                velocity_m_per_s: bow_velocity(i),
+                                force_n: force,
+                                position_beta: 0.1,
+                            };
+                            ContactSample::new(&cello.tick(bow), &bow)
+                        })
+                        .collect()
+                };
+                let first = ms(first_helmholtz_run(&probe, f0, 6));
+                let lasting = ms(helmholtz_since(&probe, FS as f32, f0 as f32));
+                row += &format!(" {:>13}", format!("{first} ({lasting})"));
+            }
+            println!("{row}");
+        }
+    }
+}
