@@ -225,14 +225,28 @@ fn minimal_string_guettler_survey() {
     let accels = [0.0, 0.1, 0.2, 0.5, 1.0, 2.0, 5.0];
     let fractions = [0.05, 0.1, 0.2, 0.3, 0.5, 0.7];
     let n = (0.8 * FS) as usize;
-    let ms = |k: Option<usize>| k.map_or("never".to_string(), |k| format!("{:.0}", k as f64 / FS * 1e3));
-    for model in ["minimal, loss at the bridge", "minimal, loss at the nut", "the plugin's cello"] {
+    let ms = |k: Option<usize>| {
+        k.map_or("never".to_string(), |k| {
+            format!("{:.0}", k as f64 / FS * 1e3)
+        })
+    };
+    for model in [
+        "minimal, loss at the bridge",
+        "minimal, loss at the nut",
+        "the plugin's cello",
+    ] {
         println!("{model}: rows F / F_max, columns acceleration (m/s^2); ms to six periods of Helmholtz motion (to lasting Helmholtz motion)");
         for &frac in &fractions {
             let force = frac * 5.06;
             let mut row = format!("{frac:>5}");
             for &a in &accels {
-                let bow_velocity = |i: usize| if a == 0.0 { 0.1 } else { (a * i as f64 / FS).min(0.1) };
+                let bow_velocity = |i: usize| {
+                    if a == 0.0 {
+                        0.1
+                    } else {
+                        (a * i as f64 / FS).min(0.1)
+                    }
+                };
                 let probe: Vec<ContactSample> = if model.starts_with("minimal") {
                     let mut s = MinimalString::new(f0, 0.1, model.ends_with("bridge"));
                     (0..n).map(|i| s.tick(bow_velocity(i), force)).collect()
