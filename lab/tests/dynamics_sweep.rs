@@ -1,0 +1,146 @@
+//! The dynamics through the performer, as the plugin plays them: every third semitone of
+//! each instrument's range (three octaves from the lowest open string), every model, the
+//! expression (CC11) at seven levels from 0 to 127 set before the note, velocity 100, the
+//! plugin's defaults (Dynamics Guard and String Weight on), 48 kHz, 1.6 s a note. Over
+//! 0.8-1.6 s: the output's RMS level, the bowed pitch (the strongest peak within 100 cents
+//! of the note) and the regime of the contact probe (the editor's classifier). Printed per
+//! instrument and model: the range in dB from CC11 0 to 127 (median and extremes over the
+//! notes), the notes whose level does not rise at every step, and how many (note, level)
+//! pairs play Helmholtz motion within 10 and within 5 cents, with the others listed. A
+//! survey of issue 44's requirements 2 and 6, printed, not asserted. `cargo test
+//! --release -p colophony-lab --test dynamics_sweep -- --ignored --nocapture` (about
+//! 3 min on two cores; `MODELS=hyperbolic,thermal` for some of the models).
+use colophony::analysis::{cents, peak_frequency_hz, rms};
+use colophony::dsp::friction::FrictionModel;
+use colophony::dsp::vocabulary::{midi_to_hz, BowControl, InstrumentKind};
+use colophony::measure::contact::ContactSample;
+use colophony::measure::regime::{classify_regime, Regime};
+use colophony::performer::{Performer, Setup};
+use rayon::prelude::*;
+
+const FS: f64 = 48_000.0;
+const LEVELS: [u8; 7] = [0, 21, 42, 64, 85, 106, 127];
+const SECONDS: f64 = 1.6;
+const FROM_S: f64 = 0.8;
+
+/// (level dB, cents, regime) of `note` on `kind` with `law` (`None`: the thermal model) at
+/// expression `cc11` (0-127).
+fn play(
+    kind: InstrumentKind,
+    law: Option<FrictionModel>,
+    note: u8,
+    cc11: u8,
+) -> (f64, f64, Option<Regime>) {
+    let setup = Setup {
+        instrument: kind,
+        point_law: law,
+        ..Setup::default()
+    };
+    let mut p = Performer::new(kind);
+    p.activate(&setup, FS).expect("activate");
+    p.set_controller(11, cc11 as f32 / 127.0);
+    p.note_on(note, 100.0 / 127.0);
+    let n = (SECONDS * FS) as usize;
+    let from = (FROM_S * FS) as usize;
+    let mut audio = Vec::with_capacity(n - from);
+    let mut probe = Vec::with_capacity(n - from);
+    let bow = BowControl::default();
+    for i in 0..n {
+        if i % 256 == 0 {
+            p.configure(&setup);
+        }
+        let frame = p.tick(bow);
+        if i >= from {
+            audio.push(frame.audio);
+            probe.push(ContactSample::new(&frame, &p.bow()));
+        }
+    }
+    let f0 = midi_to_hz(note as f64);
+    let level = 20.0 * rms(&audio).max(1e-12).log10();
+    let pitch = cents(peak_frequency_hz(&audio, FS, f0, 100.0), f0);
+    (level, pitch, classify_regime(&probe, FS as f32, f0 as f32))
+}
+
+#[test]
+#[ignore]
+fn dynamics_sweep_survey() {
+    let models: Vec<Option<FrictionModel>> = FrictionModel::ALL
+        .iter()
+        .map(|&m| Some(m))
+        .chain(std::iter::once(None))
+        .filter(|m| {
+            std::env::var("MODELS").map_or(true, |list| {
+                list.split(',')
+                    .any(|n| n == m.map_or("thermal", |l| l.name()))
+            })
+        })
+        .collect();
+    for kind in InstrumentKind::ALL {
+        let (low, high) = kind.note_range();
+        let notes: Vec<u8> = (low..=high.min(low + 36)).step_by(3).collect();
+        for &law in &models {
+            let name = law.map_or("thermal", |l| l.name());
+            let rows: Vec<(u8, Vec<(f64, f64, Option<Regime>)>)> = notes
+                .par_iter()
+                .map(|&note| {
+                    (
+                        note,
+                        LEVELS.iter().map(|&cc| play(kind, law, note, cc)).collect(),
+                    )
+                })
+                .collect();
+            let mut ranges: Vec<f64> = rows
+                .iter()
+                .map(|(_, r)| r[r.len() - 1].0 - r[0].0)
+                .collect();
+            ranges.sort_by(f64::total_cmp);
+            // The median level at each step, dB re CC11 127.
+            let steps: Vec<String> = (0..LEVELS.len())
+                .map(|k| {
+                    let mut d: Vec<f64> = rows
+                        .iter()
+                        .map(|(_, r)| r[k].0 - r[r.len() - 1].0)
+                        .collect();
+                    d.sort_by(f64::total_cmp);
+                    format!("{:.1}", d[d.len() / 2])
+                })
+                .collect();
+            let not_rising: Vec<u8> = rows
+                .iter()
+                .filter(|(_, r)| r.windows(2).any(|w| w[1].0 <= w[0].0))
+                .map(|(n, _)| *n)
+                .collect();
+            let pairs = rows.len() * LEVELS.len();
+            let helm = |tol: f64| {
+                rows.iter()
+                    .flat_map(|(_, r)| r.iter())
+                    .filter(|(_, c, g)| *g == Some(Regime::Helmholtz) && c.abs() <= tol)
+                    .count()
+            };
+            let mut off = String::new();
+            for (note, r) in &rows {
+                for (&cc, (_, c, g)) in LEVELS.iter().zip(r) {
+                    if !(*g == Some(Regime::Helmholtz) && c.abs() <= 5.0) {
+                        let regime = match g {
+                            Some(Regime::Helmholtz) => "H".to_string(),
+                            Some(Regime::MultipleSlips(n)) => format!("{n}x"),
+                            Some(Regime::Raucous) => "R".into(),
+                            Some(Regime::Sliding) => "S".into(),
+                            Some(Regime::Silent) | None => "0".into(),
+                        };
+                        off += &format!(" {note}@{cc}:{regime}{c:+.0}");
+                    }
+                }
+            }
+            println!(
+                "{kind:?} {name}: range {:.1} dB median ({:.1}-{:.1}), steps [{}] dB; not rising: {not_rising:?}; Helmholtz within 10 c {}/{pairs}, within 5 c {}/{pairs}; off (note@cc:regime cents):{off}",
+                ranges[ranges.len() / 2],
+                ranges[0],
+                ranges[ranges.len() - 1],
+                steps.join(" "),
+                helm(10.0),
+                helm(5.0),
+            );
+        }
+    }
+}
