@@ -33,7 +33,7 @@
 //! (docs/playing-space.md, "Tuned at the defaults").
 
 use crate::playing_space::{measure, Bowing, Cell, Model};
-use colophony::dsp::intonation::IntonationTable;
+use colophony::dsp::intonation::{IntonationTable, SOFT_EXPRESSIONS};
 use colophony::dsp::vocabulary::{InstrumentKind, MAX_STOP_SEMITONES, STRINGS};
 use rayon::prelude::*;
 use std::fmt::Write as _;
@@ -97,12 +97,14 @@ fn residual(cents: f64, helmholtz: bool) -> (f64, bool) {
 /// 0.9 s measured (above a hundred periods of the lowest note).
 pub const FIT_SECONDS: f64 = 1.2;
 
-/// One pass: bows every entry with `table` at the defaults and returns each entry's
-/// [`residual`].
+/// One pass: bows every entry with `table` at the defaults, at the dynamics'
+/// `expression` (1: full; below, the bow the Dynamics Guard plays there,
+/// [`Cell::at_expression`]), and returns each entry's [`residual`].
 fn residuals(
     entries: &[Entry],
     table: &'static IntonationTable,
     rate_hz: f64,
+    expression: f64,
     bar: &indicatif::ProgressBar,
 ) -> Result<Vec<(f64, bool)>, String> {
     entries
@@ -116,7 +118,8 @@ fn residuals(
                 rate_hz,
                 Bowing::Defaults,
                 FIT_SECONDS,
-            );
+            )
+            .at_expression(expression);
             cell.intonation = Some(table);
             let m = measure(&cell)?;
             bar.inc(1);
@@ -153,8 +156,97 @@ fn fill_gaps(values: &mut [f64]) {
     }
 }
 
-/// Runs `passes` passes at `rate_hz` for `models` and returns the table and a report.
+/// Runs `passes` passes at `rate_hz` for `models` and returns the table and a report;
+/// with `dynamics`, instead, as many for each of [`SOFT_EXPRESSIONS`], starting from the
+/// shipped table's full-expression corrections, which stay (the point laws only: paper
+/// B's thermal bow slides at the soft dynamics, docs/testing.md, "Dynamics").
 pub fn fit(
+    models: &[Model],
+    kinds: &[InstrumentKind],
+    rate_hz: f64,
+    passes: usize,
+    dynamics: bool,
+) -> Result<(IntonationTable, String), String> {
+    if !dynamics {
+        return fit_full(models, kinds, rate_hz, passes);
+    }
+    let mut table = colophony::dsp::intonation::shipped().clone();
+    let mut report = String::new();
+    {
+        let points: Vec<Model> = models
+            .iter()
+            .copied()
+            .filter(|m| matches!(m, Model::Point(_)))
+            .collect();
+        for level in 0..SOFT_EXPRESSIONS.len() {
+            let more = fit_soft(&mut table, &points, kinds, rate_hz, passes, level)?;
+            report += &more;
+        }
+    }
+    Ok((table, report))
+}
+
+/// A progress bar over `n` cells.
+fn progress(n: usize) -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::new(n as u64);
+    if let Ok(style) = indicatif::ProgressStyle::with_template(
+        "{elapsed_precise} [{bar:40}] {pos}/{len} cells, eta {eta}",
+    ) {
+        bar.set_style(style);
+    }
+    bar
+}
+
+/// The passes at soft expression `level` ([`SOFT_EXPRESSIONS`]) for `models`, starting
+/// from the full expression's corrections: each pass bows with the table so far and
+/// adds its residuals to the entries at that level.
+fn fit_soft(
+    table: &mut IntonationTable,
+    models: &[Model],
+    kinds: &[InstrumentKind],
+    rate_hz: f64,
+    passes: usize,
+    level: usize,
+) -> Result<String, String> {
+    let entries = entries(models, kinds);
+    let per_string = MAX_STOP_SEMITONES as usize + 1;
+    let expression = SOFT_EXPRESSIONS[level];
+    let mut report = String::new();
+    for e in &entries {
+        let row = e.model.row();
+        let full = table.get(row, e.kind, e.string, e.semitone);
+        table.set_soft(row, e.kind, e.string, e.semitone, level, full);
+    }
+    for pass in 0..passes.max(1) {
+        let current: &'static IntonationTable = Box::leak(Box::new(table.clone()));
+        let bar = progress(entries.len());
+        let measured = residuals(&entries, current, rate_hz, expression, &bar)?;
+        bar.finish_and_clear();
+        let helm: Vec<f64> = measured.iter().filter(|m| m.1).map(|m| m.0).collect();
+        let within = helm.iter().filter(|c| c.abs() <= 5.0).count();
+        let _ = writeln!(
+            report,
+            "expression {expression:.2}, pass {}: {} of {} notes in Helmholtz motion near their pitch, {within} of them within 5 cents",
+            pass + 1,
+            helm.len(),
+            entries.len(),
+        );
+        let measured: Vec<f64> = measured.iter().map(|m| m.0).collect();
+        for (es, ms) in entries.chunks(per_string).zip(measured.chunks(per_string)) {
+            let mut r: Vec<f64> = ms.to_vec();
+            fill_gaps(&mut r);
+            for (e, r) in es.iter().zip(r) {
+                let row = e.model.row();
+                let old = table.get_soft(row, e.kind, e.string, e.semitone, level);
+                table.set_soft(row, e.kind, e.string, e.semitone, level, old + r);
+            }
+        }
+    }
+    Ok(report)
+}
+
+/// The full expression's passes of [`fit`].
+fn fit_full(
     models: &[Model],
     kinds: &[InstrumentKind],
     rate_hz: f64,
@@ -167,13 +259,8 @@ pub fn fit(
     for pass in 0..passes.max(1) {
         // The engines hold the table by a static reference; one leak per pass, in a tool.
         let current: &'static IntonationTable = Box::leak(Box::new(table.clone()));
-        let bar = indicatif::ProgressBar::new(entries.len() as u64);
-        if let Ok(style) = indicatif::ProgressStyle::with_template(
-            "{elapsed_precise} [{bar:40}] {pos}/{len} cells, eta {eta}",
-        ) {
-            bar.set_style(style);
-        }
-        let measured = residuals(&entries, current, rate_hz, &bar)?;
+        let bar = progress(entries.len());
+        let measured = residuals(&entries, current, rate_hz, 1.0, &bar)?;
         bar.finish_and_clear();
         let _ = writeln!(
             report,
@@ -233,16 +320,25 @@ pub fn run(
     kinds: &[InstrumentKind],
     rate_hz: f64,
     passes: usize,
+    dynamics: bool,
 ) -> Result<String, String> {
-    let (table, report) = fit(models, kinds, rate_hz, passes)?;
-    // Models and instruments not fitted keep the shipped entries.
+    let (table, report) = fit(models, kinds, rate_hz, passes, dynamics)?;
+    // Models and instruments not fitted keep the shipped entries (and, without
+    // `dynamics`, their soft ones).
     let mut merged = colophony::dsp::intonation::shipped().clone();
     for &model in models {
         let row = model.row();
         for &kind in kinds {
             for string in 0..STRINGS {
                 for s in 0..=MAX_STOP_SEMITONES as usize {
-                    merged.set(row, kind, string, s, table.get(row, kind, string, s));
+                    if !dynamics {
+                        merged.set(row, kind, string, s, table.get(row, kind, string, s));
+                        continue;
+                    }
+                    for level in 0..SOFT_EXPRESSIONS.len() {
+                        let c = table.get_soft(row, kind, string, s, level);
+                        merged.set_soft(row, kind, string, s, level, c);
+                    }
                 }
             }
         }
@@ -252,7 +348,8 @@ pub fn run(
          # from its equal-tempered free-decay pitch so that it sounds in tune bowed at the defaults.\n\
          # Measured by `colophony bench intonation` at a host rate of {rate_hz} Hz (the point strings\n\
          # run at {internal} Hz inside, the violin's and viola's strings and the cello's A string at\n\
-         # twice that), {passes} passes.\n{}",
+         # twice that), {passes} passes. Rows with an expression below 1 hold the correction at that\n\
+         # dynamics level (the Dynamics Guard's bow there), for the point laws.\n{}",
         merged.to_csv(),
         internal = colophony::dsp::vocabulary::INTERNAL_RATE_HZ,
     );

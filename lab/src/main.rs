@@ -153,6 +153,10 @@ enum Command {
         /// intonation: measuring passes (default 2).
         #[arg(long)]
         passes: Option<usize>,
+        /// intonation: also fit the point laws' corrections at the soft dynamics (as many
+        /// passes again for each; the shipped table has them).
+        #[arg(long)]
+        dynamics: bool,
         /// peers: seconds each process renders (default 300).
         #[arg(long)]
         seconds: Option<f64>,
@@ -399,6 +403,7 @@ fn main() -> ExitCode {
             models,
             instruments,
             passes,
+            dynamics,
             seconds,
             attack,
         } => report(match what.as_str() {
@@ -430,7 +435,7 @@ fn main() -> ExitCode {
                 Some(file) => colophony_lab::playing_space::Plan::from_options(false, &rates, None, &models, &instruments)
                     .and_then(|plan| {
                         let rate = if rates.is_empty() { 48_000.0 } else { plan.rates_hz[0] };
-                        colophony_lab::intonation_fit::run(&file, &plan.models, &plan.kinds, rate, passes.unwrap_or(2))
+                        colophony_lab::intonation_fit::run(&file, &plan.models, &plan.kinds, rate, passes.unwrap_or(2), dynamics)
                     }),
                 None => Err("bench intonation needs --out FILE (the shipped one: assets/intonation.csv)".into()),
             },

@@ -48,11 +48,14 @@ use colophony::dsp::thermal::ThermalParams;
 use colophony::dsp::thermal_instrument::{
     ThermalInstrument, ThermalSettings, THERMAL_WEIGHT_REFERENCE_Z0,
 };
-use colophony::dsp::vocabulary::{midi_to_hz, BowControl, InstrumentKind, STRINGS};
+use colophony::dsp::vocabulary::{
+    midi_to_hz, BowControl, InstrumentKind, MAX_NOTE_BETA, MIN_NOTE_BETA, STRINGS,
+};
 use colophony::measure::contact::ContactSample;
 use colophony::measure::regime::{classify_regime, Regime};
 use colophony::measure::window::SchellengWindow;
 use colophony::performer::stroke::{Stroke, StrokeMode};
+use colophony::performer::{DYNAMICS_DRIFT_EXPONENT, DYNAMICS_RANGE_DB};
 use colophony::quality::{Quality, GOOD_NODES};
 use rayon::prelude::*;
 use std::fmt::Write as _;
@@ -162,6 +165,9 @@ pub struct Cell {
     pub thermal: ThermalParams,
     /// How the note begins (the map's default: [`Attack::Landing`]).
     pub attack: Attack,
+    /// The dynamics' expression the engine's intonation follows (1: full, as the map
+    /// bows; [`Cell::at_expression`] also plays the bow the Dynamics Guard plays there).
+    pub expression: f64,
 }
 
 /// How a cell's note begins.
@@ -284,6 +290,28 @@ impl Cell {
             integrator: BristleIntegrator::Trapezoid,
             attack: Attack::Landing,
             thermal: ThermalParams::default(),
+            expression: 1.0,
+        }
+    }
+
+    /// The cell at the dynamics' `expression` (0..=1) as the performer plays it with the
+    /// Dynamics Guard on: the bow's speed and force scaled by
+    /// `10^(-range (1 - e) / 20)` ([`DYNAMICS_RANGE_DB`]), the bow moved from the bridge
+    /// by that scale to the power `-`[`DYNAMICS_DRIFT_EXPONENT`], and the engine's
+    /// intonation told the expression.
+    pub fn at_expression(self, expression: f64) -> Self {
+        let e = expression.clamp(0.0, 1.0);
+        let scale = 10f64.powf(-DYNAMICS_RANGE_DB * (1.0 - e) / 20.0);
+        let beta = (self.bow.position_beta * scale.powf(-DYNAMICS_DRIFT_EXPONENT))
+            .clamp(MIN_NOTE_BETA, MAX_NOTE_BETA);
+        Self {
+            bow: BowControl {
+                velocity_m_per_s: self.bow.velocity_m_per_s * scale,
+                force_n: self.bow.force_n * scale,
+                position_beta: beta,
+            },
+            expression: e,
+            ..self
         }
     }
 
@@ -326,6 +354,7 @@ pub fn render_cell(cell: &Cell) -> Result<(Vec<f64>, Vec<ContactSample>), String
             engine.set_intonation(cell.intonation);
             engine.set_preferred_string(cell.string);
             engine.set_bristle_integrator(cell.integrator);
+            engine.set_dynamics(cell.expression);
             Ok(play(cell, &mut engine))
         }
         Model::Thermal => {
@@ -343,6 +372,7 @@ pub fn render_cell(cell: &Cell) -> Result<(Vec<f64>, Vec<ContactSample>), String
             )?;
             engine.set_intonation(cell.intonation);
             engine.set_preferred_string(cell.string);
+            engine.set_dynamics(cell.expression);
             Ok(play(cell, &mut engine))
         }
     }

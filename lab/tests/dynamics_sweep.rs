@@ -7,7 +7,7 @@
 //! instrument and model: the range in dB from CC11 0 to 127 (median and extremes over the
 //! notes), the notes whose level does not rise at every step, and how many (note, level)
 //! pairs play Helmholtz motion within 10 and within 5 cents, with the others listed. A
-//! survey of issue 44's requirements 2 and 6, printed, not asserted. `cargo test
+//! survey, printed, not asserted (docs/testing.md, "Dynamics"). `cargo test
 //! --release -p colophony-lab --test dynamics_sweep -- --ignored --nocapture` (about
 //! 3 min on two cores; `MODELS=hyperbolic,thermal` for some of the models).
 use colophony::analysis::{cents, peak_frequency_hz, rms};

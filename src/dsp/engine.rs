@@ -47,6 +47,9 @@ pub trait Engine {
     fn set_mute(&mut self, _on: bool) {}
     /// Pitch bend, semitones (engines without pitch ignore it).
     fn set_pitch_bend(&mut self, _semitones: f64) {}
+    /// The dynamics' expression the Dynamics Guard plays the bow at (0..=1; engines
+    /// without an intonation that follows it ignore it).
+    fn set_dynamics(&mut self, _expression: f64) {}
     /// String `string`'s note's own expression (engines without strings ignore it).
     fn set_note_expression(&mut self, _string: usize, _expression: NoteExpression) {}
     /// The string later notes go to (0 = lowest), `None` for the usual choice.
@@ -99,6 +102,9 @@ impl<B: StringBank> Engine for FourStrings<B> {
     }
     fn set_pitch_bend(&mut self, semitones: f64) {
         FourStrings::set_pitch_bend(self, semitones)
+    }
+    fn set_dynamics(&mut self, expression: f64) {
+        FourStrings::set_dynamics(self, expression)
     }
     fn set_mute(&mut self, on: bool) {
         FourStrings::set_mute(self, on)

@@ -58,6 +58,10 @@ impl BowEnvelope {
 /// rate, as many as make the same time ([`Fingering::glide_to`]), so a string at a high
 /// internal rate (paper B's at N_B 60: 542 kHz) is not retuned eleven times as often.
 pub const GLIDE_EVERY: u32 = 64;
+/// The smallest move of the dynamics' expression the performer retunes the strings for
+/// while the dynamics glide (the correction moves by a cent or two over it, and a move
+/// retunes a few times, not every sample); it retunes again where they come to rest.
+pub const DYNAMICS_INTONATION_STEP: f64 = 1.0 / 64.0;
 
 /// Notes, fingers and tuning of the four strings (see the module doc).
 #[derive(Debug, Clone)]
@@ -84,6 +88,8 @@ pub struct Fingering {
     intonation: Option<&'static IntonationTable>,
     /// The intonation table's row (the friction model).
     intonation_row: usize,
+    /// The dynamics' expression the intonation follows (1: full, the defaults).
+    dynamics: f64,
     /// Whether each string was plucked: it sounds its free pitch, which the table (made
     /// for the bowed sound) does not move.
     plucked: [bool; STRINGS],
@@ -107,6 +113,7 @@ impl Fingering {
             reference_semitones: 0.0,
             intonation: intonation_row.map(|_| intonation::shipped()),
             intonation_row: intonation_row.unwrap_or(0),
+            dynamics: 1.0,
             plucked: [false; STRINGS],
         }
     }
@@ -299,6 +306,20 @@ impl Fingering {
         self.intonation = table;
     }
 
+    /// The dynamics' expression the bow is played at (0..=1: the intonation table's
+    /// correction follows it, [`intonation::SOFT_EXPRESSIONS`]); returns whether it
+    /// changed, so the instrument retunes.
+    pub fn set_dynamics(&mut self, expression: f64) -> bool {
+        let e = if expression.is_finite() {
+            expression.clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        let changed = e != self.dynamics;
+        self.dynamics = e;
+        changed
+    }
+
     /// The intonation table's row in use (the friction model); returns whether it changed.
     pub fn set_intonation_row(&mut self, row: usize) -> bool {
         let changed = row != self.intonation_row;
@@ -329,6 +350,7 @@ impl Fingering {
             note,
             self.bend_semitones + self.glides[string] + self.expressions[string].bend_semitones,
             self.reference_semitones,
+            self.dynamics,
         )
     }
 }
@@ -336,6 +358,36 @@ impl Fingering {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_intonation_follows_the_dynamics_by_the_tables_soft_corrections() {
+        let kind = InstrumentKind::Cello;
+        let mut table = IntonationTable::zero();
+        // F#3 on the D string (4 semitones up): +2 cents at full expression, +14 at a third.
+        table.set(0, kind, 2, 4, 2.0);
+        table.set_soft(0, kind, 2, 4, 1, 14.0);
+        let mut f = Fingering::new(kind, Some(0));
+        f.set_intonation(Some(Box::leak(Box::new(table))));
+        let string = f.string_for_note_on(54).unwrap();
+        assert_eq!(string, 2);
+        f.start(string, 54);
+        let full = f.tuned_hz(string);
+        assert!(f.set_dynamics(1.0 / 3.0), "a new expression retunes");
+        let soft = f.tuned_hz(string);
+        // The string is stopped 12 cents lower so that the soft bow's sharper pitch lands
+        // on the note (1e-9: rounding).
+        let cents = 1200.0 * (soft / full).log2();
+        assert!((cents + 12.0).abs() < 1e-9, "{cents}");
+        assert!(
+            !f.set_dynamics(1.0 / 3.0),
+            "the same expression does not retune"
+        );
+        // Out of range and NaN are full expression or clamped, never a NaN pitch.
+        f.set_dynamics(f64::NAN);
+        assert_eq!(f.tuned_hz(string), full);
+        f.set_dynamics(-3.0);
+        assert!(f.tuned_hz(string).is_finite());
+    }
 
     /// A glide takes the time asked and retunes about every 1.3 ms at any tick rate: 64
     /// ticks at 48 kHz, 128 at 96 kHz, 1445 at paper B's 1.08 MHz ceiling.

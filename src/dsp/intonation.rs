@@ -17,7 +17,15 @@
 //! measured through the same engines the plugin plays by `colophony bench intonation`
 //! (`lab/src/intonation_fit.rs`), written to `assets/intonation.csv` and compiled in.
 //! Between semitones (pitch bend, vibrato) it is interpolated linearly. The change of
-//! pitch with force and bow position is left as the physics gives it.
+//! pitch with force and bow position is left as the physics gives it, but for the one a
+//! player meets on every note: the dynamics. With the Dynamics Guard on, the expression
+//! (CC11, CC2, pressure) scales the bow's speed and force and moves it from the bridge,
+//! and the bowed pitch moves with it (a slower bow's corners are rounder; up to tens of
+//! cents sharp on the Stribeck-type laws at mezzo piano). So the table also holds, for
+//! the point laws, the correction at the softer expressions [`SOFT_EXPRESSIONS`], fitted
+//! the same way with the bow the performer plays there; between them, and up to full
+//! expression, it is interpolated linearly, and an expression the table does not hold
+//! (paper B's thermal bow) takes the full expression's correction.
 //!
 //! ```
 //! use colophony::dsp::vocabulary::InstrumentKind;
@@ -36,6 +44,10 @@ use std::sync::OnceLock;
 
 /// Semitones per string in the table: 0 (open) ..= [`MAX_STOP_SEMITONES`].
 const SEMITONES: usize = MAX_STOP_SEMITONES as usize + 1;
+
+/// The expressions below full (1) the table holds corrections for: the dynamics at 0, a
+/// third and two thirds (CC11 0, 42 and 85).
+pub const SOFT_EXPRESSIONS: [f64; 3] = [0.0, 1.0 / 3.0, 2.0 / 3.0];
 
 /// A model the table holds corrections for: one of paper A's point laws on the waveguide
 /// strings ([`FrictionModel::ALL`], each by its `name()`), or paper B's thermal bow
@@ -91,9 +103,11 @@ impl TunedModel {
 }
 
 /// The free-decay pitch, Hz, that `string` of `kind` is stopped at to play MIDI `note`
-/// bent by `bend_semitones` under a reference `reference` semitones from A4 = 440 Hz:
-/// equal temperament moved by `table`'s correction for `row` at the bent note's place on
-/// the string (`None`: tuned by the free decay). Both string instruments tune by it.
+/// bent by `bend_semitones` under a reference `reference` semitones from A4 = 440 Hz, at
+/// the dynamics' `expression` (0..=1): equal temperament moved by `table`'s correction
+/// for `row` at the bent note's place on the string (`None`: tuned by the free decay).
+/// Both string instruments tune by it.
+#[allow(clippy::too_many_arguments)]
 pub fn tuned_hz(
     table: Option<&IntonationTable>,
     row: usize,
@@ -102,6 +116,7 @@ pub fn tuned_hz(
     note: u8,
     bend_semitones: f64,
     reference: f64,
+    expression: f64,
 ) -> f64 {
     let open = kind.open_notes()[string.min(STRINGS - 1)] as f64;
     // A bend slides the finger as far as the string reaches: down to a detuned open string,
@@ -111,27 +126,122 @@ pub fn tuned_hz(
     let top = open + MAX_STOP_SEMITONES as f64;
     let played = (note as f64 + bend_semitones).clamp(open - margin, top + margin);
     let correction = table.map_or(0.0, |t| {
-        t.correction_cents(row, kind, string, played - open)
+        t.correction_at(row, kind, string, played - open, expression)
     });
     super::vocabulary::midi_to_hz(played + reference - correction / 100.0)
 }
 
-/// Corrections for every model, instrument, string and semitone, cents.
-#[derive(Debug, Clone, PartialEq)]
+/// Corrections for every model, instrument, string and semitone, cents: at full
+/// expression, and at each of [`SOFT_EXPRESSIONS`] (NaN where not fitted).
+#[derive(Debug, Clone)]
 pub struct IntonationTable {
     cents: Vec<f64>,
+    soft: Vec<f64>,
+}
+
+/// Equal entries, an entry the table does not hold (NaN) equal to another it does not.
+impl PartialEq for IntonationTable {
+    fn eq(&self, other: &Self) -> bool {
+        let same = |a: &[f64], b: &[f64]| {
+            a.len() == b.len()
+                && a.iter()
+                    .zip(b)
+                    .all(|(x, y)| x == y || (x.is_nan() && y.is_nan()))
+        };
+        same(&self.cents, &other.cents) && same(&self.soft, &other.soft)
+    }
 }
 
 fn index(model: usize, kind: InstrumentKind, string: usize, semitone: usize) -> usize {
     ((model * InstrumentKind::COUNT + kind.index()) * STRINGS + string) * SEMITONES + semitone
 }
 
+/// The place of `expression` among [`SOFT_EXPRESSIONS`], if it is one of them.
+fn soft_level(expression: f64) -> Option<usize> {
+    SOFT_EXPRESSIONS
+        .iter()
+        .position(|&e| (e - expression).abs() < 1e-3)
+}
+
 impl IntonationTable {
-    /// A table of zeros: every string tuned by its free decay.
+    /// A table of zeros: every string tuned by its free decay, at every expression.
     pub fn zero() -> Self {
+        let n = TunedModel::COUNT * InstrumentKind::COUNT * STRINGS * SEMITONES;
         Self {
-            cents: vec![0.0; TunedModel::COUNT * InstrumentKind::COUNT * STRINGS * SEMITONES],
+            cents: vec![0.0; n],
+            soft: vec![f64::NAN; n * SOFT_EXPRESSIONS.len()],
         }
+    }
+
+    /// The correction of one entry at soft expression `level` (an index into
+    /// [`SOFT_EXPRESSIONS`]), cents; NaN where the table does not hold one.
+    pub fn get_soft(
+        &self,
+        model: usize,
+        kind: InstrumentKind,
+        string: usize,
+        semitone: usize,
+        level: usize,
+    ) -> f64 {
+        self.soft[index(model, kind, string, semitone) * SOFT_EXPRESSIONS.len() + level]
+    }
+
+    /// Sets one entry at soft expression `level` (clamped as [`IntonationTable::set`]; a
+    /// NaN clears it: the full expression's correction is taken there).
+    pub fn set_soft(
+        &mut self,
+        model: usize,
+        kind: InstrumentKind,
+        string: usize,
+        semitone: usize,
+        level: usize,
+        cents: f64,
+    ) {
+        let c = if cents.is_nan() {
+            f64::NAN
+        } else {
+            cents.clamp(-MAX_CORRECTION_CENTS, MAX_CORRECTION_CENTS)
+        };
+        self.soft[index(model, kind, string, semitone) * SOFT_EXPRESSIONS.len() + level] = c;
+    }
+
+    /// One entry at `expression` (0..=1): linear between [`SOFT_EXPRESSIONS`] and full,
+    /// a level the table does not hold taking the full expression's correction.
+    fn entry_at(
+        &self,
+        model: usize,
+        kind: InstrumentKind,
+        string: usize,
+        semitone: usize,
+        expression: f64,
+    ) -> f64 {
+        let full = self.get(model, kind, string, semitone);
+        if expression >= 1.0 {
+            return full;
+        }
+        let at = |level: usize| {
+            if level == SOFT_EXPRESSIONS.len() {
+                return full;
+            }
+            let c = self.get_soft(model, kind, string, semitone, level);
+            if c.is_nan() {
+                full
+            } else {
+                c
+            }
+        };
+        let e = expression.max(0.0);
+        let upper = SOFT_EXPRESSIONS
+            .iter()
+            .position(|&x| x > e)
+            .unwrap_or(SOFT_EXPRESSIONS.len());
+        if upper == 0 {
+            return at(0);
+        }
+        let lo = SOFT_EXPRESSIONS[upper - 1];
+        let hi = SOFT_EXPRESSIONS.get(upper).copied().unwrap_or(1.0);
+        let t = (e - lo) / (hi - lo);
+        at(upper - 1) + t * (at(upper) - at(upper - 1))
     }
 
     /// The correction of one table entry, cents.
@@ -166,14 +276,31 @@ impl IntonationTable {
         string: usize,
         semitones: f64,
     ) -> f64 {
-        if model >= TunedModel::COUNT || string >= STRINGS || !semitones.is_finite() {
+        self.correction_at(model, kind, string, semitones, 1.0)
+    }
+
+    /// [`IntonationTable::correction_cents`] at the dynamics' `expression` (0..=1; see
+    /// [`SOFT_EXPRESSIONS`]).
+    pub fn correction_at(
+        &self,
+        model: usize,
+        kind: InstrumentKind,
+        string: usize,
+        semitones: f64,
+        expression: f64,
+    ) -> f64 {
+        if model >= TunedModel::COUNT
+            || string >= STRINGS
+            || !semitones.is_finite()
+            || !expression.is_finite()
+        {
             return 0.0;
         }
         let s = semitones.clamp(0.0, (SEMITONES - 1) as f64);
         let lo = (s.floor() as usize).min(SEMITONES - 2);
         let t = s - lo as f64;
-        let a = self.get(model, kind, string, lo);
-        let b = self.get(model, kind, string, lo + 1);
+        let a = self.entry_at(model, kind, string, lo, expression);
+        let b = self.entry_at(model, kind, string, lo + 1, expression);
         a + t * (b - a)
     }
 
@@ -185,41 +312,73 @@ impl IntonationTable {
             .lines()
             .filter(|l| !l.trim_start().starts_with('#') && !l.trim().is_empty());
         let header = lines.next().ok_or("empty intonation table")?;
-        if header.trim() != "model,instrument,string,semitone,cents" {
-            return Err(format!("unexpected intonation header '{header}'"));
-        }
+        // Without the expression column every entry is at full expression.
+        let columns = match header.trim() {
+            "model,instrument,string,semitone,cents" => 5,
+            "model,instrument,string,semitone,expression,cents" => 6,
+            _ => return Err(format!("unexpected intonation header '{header}'")),
+        };
         for (n, line) in lines.enumerate() {
             let f: Vec<&str> = line.split(',').map(str::trim).collect();
             let bad = || format!("intonation table line {}: '{line}'", n + 2);
-            if f.len() != 5 {
+            if f.len() != columns {
                 return Err(bad());
             }
             let model = TunedModel::from_name(f[0]).ok_or_else(bad)?.row();
             let kind = InstrumentKind::from_name(f[1]).ok_or_else(bad)?;
             let string: usize = f[2].parse().map_err(|_| bad())?;
             let semitone: usize = f[3].parse().map_err(|_| bad())?;
-            let cents: f64 = f[4].parse().map_err(|_| bad())?;
+            let expression: f64 = if columns == 6 {
+                f[4].parse().map_err(|_| bad())?
+            } else {
+                1.0
+            };
+            let cents: f64 = f[columns - 1].parse().map_err(|_| bad())?;
             if string >= STRINGS || semitone >= SEMITONES || !cents.is_finite() {
                 return Err(bad());
             }
-            table.set(model, kind, string, semitone, cents);
+            if (expression - 1.0).abs() < 1e-3 {
+                table.set(model, kind, string, semitone, cents);
+            } else {
+                let level = soft_level(expression).ok_or_else(bad)?;
+                table.set_soft(model, kind, string, semitone, level, cents);
+            }
         }
         Ok(table)
     }
 
-    /// The table as CSV (header `model,instrument,string,semitone,cents`).
+    /// The table as CSV (header `model,instrument,string,semitone,expression,cents`):
+    /// every entry at full expression (1), then those it holds at soft expressions.
     pub fn to_csv(&self) -> String {
-        let mut s = String::from("model,instrument,string,semitone,cents\n");
+        let mut s = String::from("model,instrument,string,semitone,expression,cents\n");
         for model in TunedModel::all() {
             let (m, name) = (model.row(), model.name());
             for kind in InstrumentKind::ALL {
                 for string in 0..STRINGS {
                     for semitone in 0..SEMITONES {
                         s.push_str(&format!(
-                            "{name},{},{string},{semitone},{:.2}\n",
+                            "{name},{},{string},{semitone},1,{:.2}\n",
                             kind.name(),
                             self.get(m, kind, string, semitone)
                         ));
+                    }
+                }
+            }
+        }
+        for (level, expression) in SOFT_EXPRESSIONS.iter().enumerate() {
+            for model in TunedModel::all() {
+                let (m, name) = (model.row(), model.name());
+                for kind in InstrumentKind::ALL {
+                    for string in 0..STRINGS {
+                        for semitone in 0..SEMITONES {
+                            let c = self.get_soft(m, kind, string, semitone, level);
+                            if c.is_finite() {
+                                s.push_str(&format!(
+                                    "{name},{},{string},{semitone},{expression:.4},{c:.2}\n",
+                                    kind.name(),
+                                ));
+                            }
+                        }
                     }
                 }
             }
@@ -271,7 +430,33 @@ mod tests {
         let mut t = IntonationTable::zero();
         t.set(2, InstrumentKind::Viola, 3, 17, -4.25);
         t.set(4, InstrumentKind::Cello, 0, 0, 12.5);
+        t.set_soft(0, InstrumentKind::Cello, 2, 4, 1, 7.75);
         assert_eq!(IntonationTable::parse(&t.to_csv()).unwrap(), t);
+        // The table without the expression column is read at full expression.
+        let old = "model,instrument,string,semitone,cents\nstatic,violin,1,3,2.5\n";
+        let read = IntonationTable::parse(old).unwrap();
+        assert_eq!(read.get(1, InstrumentKind::Violin, 1, 3), 2.5);
+        assert!(read.get_soft(1, InstrumentKind::Violin, 1, 3, 0).is_nan());
+    }
+
+    #[test]
+    fn corrections_interpolate_across_the_dynamics_and_fall_back_to_full_expression() {
+        let mut t = IntonationTable::zero();
+        let k = InstrumentKind::Cello;
+        t.set(0, k, 2, 4, 2.0);
+        t.set_soft(0, k, 2, 4, 0, 20.0);
+        t.set_soft(0, k, 2, 4, 1, 14.0);
+        // Level 2 (two thirds) is not held: the full expression's 2 cents stand there.
+        assert_eq!(t.correction_at(0, k, 2, 4.0, 1.0), 2.0);
+        assert_eq!(t.correction_at(0, k, 2, 4.0, 0.0), 20.0);
+        assert_eq!(t.correction_at(0, k, 2, 4.0, 1.0 / 3.0), 14.0);
+        // Halfway from 0 to a third, and from a third to two thirds.
+        assert!((t.correction_at(0, k, 2, 4.0, 1.0 / 6.0) - 17.0).abs() < 1e-9);
+        assert!((t.correction_at(0, k, 2, 4.0, 0.5) - 8.0).abs() < 1e-9);
+        // A model with no soft entries keeps its full correction at every expression.
+        t.set(4, k, 2, 4, -3.0);
+        assert_eq!(t.correction_at(4, k, 2, 4.0, 0.2), -3.0);
+        assert_eq!(t.correction_at(0, k, 2, 4.0, f64::NAN), 0.0);
     }
 
     #[test]
@@ -295,6 +480,8 @@ mod tests {
             "model,instrument,string,semitone,cents\nhyperbolic,cello,9,0,1\n",
             "model,instrument,string,semitone,cents\nhyperbolic,lute,0,0,1\n",
             "model,instrument,string,semitone,cents\nhyperbolic,cello,0,0,NaN\n",
+            "model,instrument,string,semitone,expression,cents\nhyperbolic,cello,0,0,0.5,1\n",
+            "model,instrument,string,semitone,expression,cents\nhyperbolic,cello,0,0,1\n",
         ] {
             assert!(IntonationTable::parse(bad).is_err(), "{bad:?}");
         }

@@ -637,6 +637,15 @@ impl<B: StringBank> FourStrings<B> {
         }
     }
 
+    /// The dynamics' expression the bow is played at (0..=1, with the Dynamics Guard's
+    /// bow): the intonation follows it ([`super::intonation::SOFT_EXPRESSIONS`]);
+    /// sounding notes retune when it has moved far enough.
+    pub fn set_dynamics(&mut self, expression: f64) {
+        if self.hands.fingering.set_dynamics(expression) {
+            self.retune();
+        }
+    }
+
     /// Gives string `index` its note's own expression (sanitized; see
     /// [`NoteExpression`]); a changed bend retunes it at once (a bend the string cannot
     /// follow lifts its bow). A new note on the string starts neutral again.

@@ -4,6 +4,7 @@
 
 use super::midi::RPN_NULL;
 use super::*;
+use crate::dsp::fingering::DYNAMICS_INTONATION_STEP;
 
 /// The dynamics' range: expression 0 (CC11, CC2 or channel pressure at 0) plays the bow
 /// this many dB below expression 1 (the default, and the parameters' own bow). The
@@ -88,6 +89,8 @@ pub(super) struct Gesture {
     /// Samples since the last note landed.
     pub(super) since_note: u64,
     pub(super) countdown: u32,
+    /// The expression the engines' intonation was last told ([`Performer::shape`]).
+    pub(super) intonation_expression: f64,
 }
 
 impl Gesture {
@@ -113,6 +116,7 @@ impl Gesture {
             seed: 0x9e37_79b9_7f4a_7c15,
             since_note: 0,
             countdown: 0,
+            intonation_expression: 1.0,
         }
     }
 
@@ -224,6 +228,24 @@ impl Performer {
             && self.direct.is_idle()
             && self.stroke.is_settled();
         self.steady = steady.then_some((g.bow_scale * speed, force_scale, away));
+        // The intonation follows the guard's bow (the table is fitted with it); without
+        // the guard it stays at full expression's.
+        let scale = self.gesture.bow_scale;
+        let expression = if self.setup.dynamics_guard && scale < 1.0 {
+            (1.0 + 20.0 * scale.log10() / DYNAMICS_RANGE_DB).max(0.0)
+        } else {
+            1.0
+        };
+        // Every [`DYNAMICS_INTONATION_STEP`] of a move, and where it comes to rest.
+        let sent = self.gesture.intonation_expression;
+        let settled = self.gesture.bow_scale == self.gesture.target;
+        if (expression - sent).abs() >= DYNAMICS_INTONATION_STEP || (settled && expression != sent)
+        {
+            self.gesture.intonation_expression = expression;
+            for engine in self.engines() {
+                engine.set_dynamics(expression);
+            }
+        }
         out
     }
 
@@ -287,9 +309,14 @@ mod tests {
     /// Bows cello D3 at the defaults with the expression at `e` from the start; returns
     /// the RMS over 1.5..2 s and the regime of its last 8 periods on the probe.
     fn bowed_at(e: f32) -> (f64, Option<Regime>) {
+        bowed_note_at(50, e)
+    }
+
+    /// [`bowed_at`] for `note` on the cello.
+    fn bowed_note_at(note: u8, e: f32) -> (f64, Option<Regime>) {
         let mut p = cello();
         p.set_controller(11, e);
-        p.note_on(50, 0.8);
+        p.note_on(note, 0.8);
         let bow = BowControl::default();
         let n = (2.0 * FS) as usize;
         let mut audio = Vec::with_capacity(n);
@@ -304,7 +331,7 @@ mod tests {
         }
         let tail = &audio[(1.5 * FS) as usize..];
         let rms = (tail.iter().map(|x| x * x).sum::<f64>() / tail.len() as f64).sqrt();
-        let f0 = midi_to_hz(50.0);
+        let f0 = midi_to_hz(note as f64);
         let window = (8.0 * FS / f0) as usize;
         (
             rms,
@@ -389,15 +416,34 @@ mod tests {
 
     #[test]
     fn dynamics_raise_the_level_monotonically_and_keep_helmholtz_motion() {
-        let mut last = 0.0;
-        for e in [0.25, 0.5, 0.75, 1.0] {
-            let (rms, regime) = bowed_at(e);
-            println!("expression {e}: RMS {rms:.5}, {regime:?}");
-            assert!(rms > last, "expression {e}: RMS {rms} not above {last}");
-            // Velocity and force scale together, so the bow keeps its place in the window.
-            assert_eq!(regime, Some(Regime::Helmholtz), "expression {e}");
-            last = rms;
+        // The cello's D string, D3 to A3, at four levels: velocity and force scale
+        // together, so the bow keeps its place in the window. Which limit cycle an attack
+        // falls into is chaotic (a note's neighbour, or the same note a few cents
+        // retuned, can settle in double slips for seconds: docs/playing-space.md), so the
+        // test asks what the dynamics sweep measures across the range, most pairs in
+        // Helmholtz motion (there, 78-89 of 91 for this law), not every one.
+        let mut helmholtz = 0;
+        let mut pairs = 0;
+        for note in 50..=57u8 {
+            let mut last = 0.0;
+            for e in [0.25, 0.5, 0.75, 1.0] {
+                let (rms, regime) = bowed_note_at(note, e);
+                println!("note {note}, expression {e}: RMS {rms:.5}, {regime:?}");
+                assert!(
+                    rms > last,
+                    "note {note}, expression {e}: RMS {rms} not above {last}"
+                );
+                last = rms;
+                pairs += 1;
+                helmholtz += usize::from(regime == Some(Regime::Helmholtz));
+            }
         }
+        // At least seven in eight: the sweep's share for this law, less a pair for the
+        // smaller sample.
+        assert!(
+            8 * helmholtz >= 7 * pairs,
+            "{helmholtz} of {pairs} in Helmholtz motion"
+        );
         // The amplitude follows the bow velocity (Raman): expression 0.5 plays half the
         // range below full, within 3 dB (a slower bow rounds the corners more: the
         // output falls by about nine tenths of the bow's fall).
@@ -406,6 +452,45 @@ mod tests {
             (ratio_db + DYNAMICS_RANGE_DB / 2.0).abs() < 3.0,
             "{ratio_db:.1} dB"
         );
+    }
+
+    #[test]
+    fn with_the_guard_the_intonation_follows_the_dynamics_and_without_it_stays_at_full() {
+        use crate::dsp::intonation::{shipped, TunedModel};
+        // F#3 on the cello's D string, 4 semitones up, hyperbolic law.
+        let (note, string, semitones) = (54u8, 2usize, 4.0);
+        let row = TunedModel::Point(FrictionModel::Hyperbolic).row();
+        let table = shipped();
+        for guard in [true, false] {
+            let setup = Setup {
+                dynamics_guard: guard,
+                ..Setup::default()
+            };
+            let mut p = cello_with(&setup);
+            p.set_controller(11, 1.0 / 3.0);
+            p.note_on(note, 0.8);
+            let bow = BowControl::default();
+            for _ in 0..FS as usize {
+                p.tick(bow);
+            }
+            let expression = if guard { 1.0 / 3.0 } else { 1.0 };
+            let moved =
+                table.correction_at(row, InstrumentKind::Cello, string, semitones, expression)
+                    - table.correction_cents(row, InstrumentKind::Cello, string, semitones);
+            let played = p.strings().string(string).fundamental_hz();
+            let mut full = cello_with(&setup);
+            full.note_on(note, 0.8);
+            full.tick(bow);
+            let at_full = full.strings().string(string).fundamental_hz();
+            // The string is stopped lower by the table's extra correction at a third of
+            // the range (the dynamics rest there after 1 s; 0.01 cents: the smoothing's
+            // last step, which lands within 1e-9 of the target scale).
+            let cents = 1200.0 * (played / at_full).log2();
+            assert!(
+                (cents + moved).abs() < 0.01,
+                "guard {guard}: {cents} against {moved}"
+            );
+        }
     }
 
     /// Plays D3 for 3 s with the mod wheel up under `setup`, after `controllers`; returns
