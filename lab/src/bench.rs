@@ -573,7 +573,7 @@ struct PeerRow {
 /// libstk-dev: `scripts/install-peers.sh` installs it), this binary's `render` with the
 /// hyperbolic string (the default) and with the elasto-plastic string at the plugin's
 /// tolerance (the good preset's) and at the reference's, and paper B's cello and a quartet
-/// of thermal instruments. User + system CPU of each process, [`PEER_ROUNDS`] rounds with
+/// of thermal instruments. User + system CPU of each process, `PEER_ROUNDS` rounds with
 /// the rows interleaved in each, so load on a shared machine hits them alike; the best,
 /// the spread (worst over best) and, against STK, the ratio of the bests and its range
 /// over the rounds. Where valgrind is installed, instructions per output sample beside

@@ -226,7 +226,7 @@ pub fn serafin_modal(out: &Path) -> Result<String, String> {
 }
 
 /// Paper B, Figure 6: cello open C, v_b 0.15 m/s, beta 0.07, 300 N/m, 60 nodes over 1 cm,
-/// two periods from [`SETTLE_S`] on.
+/// two periods from [`crate::playing_space::SETTLE_S`] on.
 pub fn maestre_fig6(out: &Path) -> Result<String, String> {
     const SETTLE_S: f64 = 1.5;
     use colophony::dsp::thermal::{

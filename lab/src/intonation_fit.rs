@@ -8,7 +8,7 @@
 //! defaults (0.1 m/s, 1 N on the knob times the string's weight, beta 0.1: `F_max / 2` of
 //! the point laws' window on every string), [`FIT_SECONDS`] long, and measures it after
 //! the 0.3 s settling time as the playing-space map measures. An entry's residual is, in
-//! this order of trust ([`residual`]):
+//! this order of trust (`residual`):
 //! 1. the bowed pitch where the note is in Helmholtz motion by the map's full criterion
 //!    (one slip a period, slip fraction within 15 % of beta, sticking at the bow
 //!    velocity) and within [`TRUSTED_CENTS`];

@@ -5,7 +5,7 @@
 //! - [`midi_file`]: a standard MIDI file through the plugin's performer
 //!   (`colophony render --midi`);
 //! - [`figures`], [`playing_space::figure`]: the papers' figures and the maps, as PNG;
-//! - [`bench`], [`precision`], [`playing_space`], [`intonation_fit`]: real-time ratios, the
+//! - [`bench`](mod@bench), [`precision`], [`playing_space`], [`intonation_fit`]: real-time ratios, the
 //!   work-precision benchmark, the playing-space map and the intonation table;
 //! - [`admittance_fit`]: fitting a passive modal bridge to measured admittance;
 //! - [`timbre`]: the played notes' long-term spectrum against a real instrument's.
