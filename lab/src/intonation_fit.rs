@@ -209,7 +209,6 @@ fn fit_soft(
     level: usize,
 ) -> Result<String, String> {
     let entries = entries(models, kinds);
-    let per_string = MAX_STOP_SEMITONES as usize + 1;
     let expression = SOFT_EXPRESSIONS[level];
     let mut report = String::new();
     for e in &entries {
@@ -231,18 +230,35 @@ fn fit_soft(
             helm.len(),
             entries.len(),
         );
-        let measured: Vec<f64> = measured.iter().map(|m| m.0).collect();
-        for (es, ms) in entries.chunks(per_string).zip(measured.chunks(per_string)) {
-            let mut r: Vec<f64> = ms.to_vec();
-            fill_gaps(&mut r);
-            for (e, r) in es.iter().zip(r) {
-                let row = e.model.row();
-                let old = table.get_soft(row, e.kind, e.string, e.semitone, level);
-                table.set_soft(row, e.kind, e.string, e.semitone, level, old + r);
+        fold(table, &entries, &measured, Some(level));
+    }
+    Ok(report)
+}
+
+/// Adds one pass's residuals `measured` (one per entry, [`residual`]) to `table`'s
+/// entries, string by string, gaps filled from their neighbours ([`fill_gaps`]): at
+/// full expression (`level` `None`) or at soft expression `level`.
+fn fold(
+    table: &mut IntonationTable,
+    entries: &[Entry],
+    measured: &[(f64, bool)],
+    level: Option<usize>,
+) {
+    let per_string = MAX_STOP_SEMITONES as usize + 1;
+    for (es, ms) in entries.chunks(per_string).zip(measured.chunks(per_string)) {
+        let mut r: Vec<f64> = ms.iter().map(|m| m.0).collect();
+        fill_gaps(&mut r);
+        for (e, r) in es.iter().zip(r) {
+            let (row, k, string, s) = (e.model.row(), e.kind, e.string, e.semitone);
+            match level {
+                None => table.set(row, k, string, s, table.get(row, k, string, s) + r),
+                Some(l) => {
+                    let old = table.get_soft(row, k, string, s, l);
+                    table.set_soft(row, k, string, s, l, old + r);
+                }
             }
         }
     }
-    Ok(report)
 }
 
 /// The full expression's passes of [`fit`].
@@ -255,7 +271,6 @@ fn fit_full(
     let entries = entries(models, kinds);
     let mut table = IntonationTable::zero();
     let mut report = String::new();
-    let per_string = MAX_STOP_SEMITONES as usize + 1;
     for pass in 0..passes.max(1) {
         // The engines hold the table by a static reference; one leak per pass, in a tool.
         let current: &'static IntonationTable = Box::leak(Box::new(table.clone()));
@@ -295,18 +310,7 @@ fn fit_full(
                 other
             );
         }
-        let measured: Vec<f64> = measured.iter().map(|m| m.0).collect();
-        // Fold the residuals in, string by string.
-        for chunk in entries.chunks(per_string).zip(measured.chunks(per_string)) {
-            let (es, ms) = chunk;
-            let mut r: Vec<f64> = ms.to_vec();
-            fill_gaps(&mut r);
-            for (e, r) in es.iter().zip(r) {
-                let row = e.model.row();
-                let old = table.get(row, e.kind, e.string, e.semitone);
-                table.set(row, e.kind, e.string, e.semitone, old + r);
-            }
-        }
+        fold(&mut table, &entries, &measured, None);
     }
     Ok((table, report))
 }

@@ -89,8 +89,10 @@ pub(super) struct Gesture {
     /// Samples since the last note landed.
     pub(super) since_note: u64,
     pub(super) countdown: u32,
-    /// The expression the engines' intonation was last told ([`Performer::shape`]).
+    /// The expression the engines' intonation was last told, and the guard's bow scale
+    /// last looked at for it ([`Performer::shape`]).
     pub(super) intonation_expression: f64,
+    pub(super) intonation_scale: f64,
 }
 
 impl Gesture {
@@ -117,6 +119,7 @@ impl Gesture {
             since_note: 0,
             countdown: 0,
             intonation_expression: 1.0,
+            intonation_scale: 1.0,
         }
     }
 
@@ -229,14 +232,29 @@ impl Performer {
             && self.stroke.is_settled();
         self.steady = steady.then_some((g.bow_scale * speed, force_scale, away));
         // The intonation follows the guard's bow (the table is fitted with it); without
-        // the guard it stays at full expression's.
-        let scale = self.gesture.bow_scale;
-        let expression = if self.setup.dynamics_guard && scale < 1.0 {
+        // the guard it stays at full expression's. Looked at only when that bow's scale
+        // changes (a vibrato runs this path every sample with the dynamics at rest).
+        let scale = if self.setup.dynamics_guard {
+            self.gesture.bow_scale
+        } else {
+            1.0
+        };
+        if scale != self.gesture.intonation_scale {
+            self.gesture.intonation_scale = scale;
+            self.follow_dynamics(scale);
+        }
+        out
+    }
+
+    /// Tells the engines the expression the guard's bow `scale` plays (0..=1, so their
+    /// intonation follows it): every [`DYNAMICS_INTONATION_STEP`] of a move, and where the
+    /// dynamics come to rest.
+    fn follow_dynamics(&mut self, scale: f64) {
+        let expression = if scale < 1.0 {
             (1.0 + 20.0 * scale.log10() / DYNAMICS_RANGE_DB).max(0.0)
         } else {
             1.0
         };
-        // Every [`DYNAMICS_INTONATION_STEP`] of a move, and where it comes to rest.
         let sent = self.gesture.intonation_expression;
         let settled = self.gesture.bow_scale == self.gesture.target;
         if (expression - sent).abs() >= DYNAMICS_INTONATION_STEP || (settled && expression != sent)
@@ -246,7 +264,6 @@ impl Performer {
                 engine.set_dynamics(expression);
             }
         }
-        out
     }
 
     /// One sample of the vibrato: its clock runs while the mod wheel is up (so the onset
