@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Writes the articulation demos' MIDI files into assets/demos/midi/ (standard MIDI files,
 format 0, 480 ticks a beat, 60 bpm), each switching articulation by keyswitch (C0 arco,
-C#0 pizzicato, D0 tremolo, D#0 spiccato, E0 col legno):
+C#0 pizzicato, D0 tremolo, D#0 spiccato, E0 col legno, F0 sautillé):
 
 - pachelbel-ground-keyswitch.mid: J. Pachelbel's canon in D, the ground bass (public
   domain) on the double bass, played twice: pizzicato, then arco;
@@ -9,7 +9,9 @@ C#0 pizzicato, D0 tremolo, D#0 spiccato, E0 col legno):
 - violin-spiccato-keyswitch.mid: a violin scale in sixteenths, spiccato, then the same
   notes arco (keyswitch C0);
 - viola-col-legno-keyswitch.mid: a viola ostinato in eighths struck col legno, growing
-  louder, then its last bar arco (keyswitch C0)."""
+  louder, then its last bar arco (keyswitch C0);
+- violin-sautille-keyswitch.mid: a violin figure of broken chords, twelve separate notes
+  a second (a stroke each, the sautillé's default rate), then its first bar arco."""
 import struct
 import sys
 from pathlib import Path
@@ -73,3 +75,9 @@ for i, note in enumerate(OSTINATO):
 events += keyswitch(t + TPB // 2, 12)
 part, _ = notes(t + TPB, OSTINATO[-8:], 0.5, 0.95, 100)
 write(out / "viola-col-legno-keyswitch.mid", events + part)
+FIGURE = [67, 71, 74, 79, 74, 71] * 2 + [67, 72, 76, 79, 76, 72] * 2 + [66, 69, 74, 78, 74, 69] * 2 + [67, 71, 74, 79, 83, 79]
+events, t = keyswitch(0, 17), 20
+part, t = notes(t, FIGURE, 1 / 12, 0.8, 100)
+events += part + keyswitch(t + TPB // 2, 12)
+part, _ = notes(t + TPB, FIGURE[:12], 1 / 12, 0.8, 100)
+write(out / "violin-sautille-keyswitch.mid", events + part)

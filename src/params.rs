@@ -134,6 +134,9 @@ pub enum ArticulationChoice {
     #[id = "col-legno"]
     #[name = "Col legno"]
     ColLegno,
+    #[id = "sautille"]
+    #[name = "Sautillé"]
+    Sautille,
 }
 
 /// What sets the tremolo's strokes ([`crate::performer::articulation::TremoloSync`]).
@@ -168,6 +171,7 @@ impl From<ArticulationChoice> for crate::performer::Articulation {
             ArticulationChoice::Tremolo => Self::Tremolo,
             ArticulationChoice::Spiccato => Self::Spiccato,
             ArticulationChoice::ColLegno => Self::ColLegno,
+            ArticulationChoice::Sautille => Self::Sautille,
         }
     }
 }

@@ -1,4 +1,4 @@
-//! The regime the strings play in tremolo and spiccato, through the performer as the
+//! The regime the strings play in tremolo, spiccato and sautillé, through the performer as the
 //! plugin plays them at the defaults: each instrument over two octaves from its lowest
 //! string (every fourth semitone), the hyperbolic and the static law, velocity 0.8; the
 //! editor's regime classifier on the contact probe. A survey, printed, not asserted:
@@ -8,6 +8,8 @@
 //!   40-95 % of its length (after the bow's turn, which takes its first 30 %).
 //! - **Spiccato**: separate notes of 0.25 s; each contact of the bouncing bow that lasts
 //!   at least five periods, classified over its second half.
+//! - **Sautillé** (12 strokes a second): separate notes a stroke long, each contact as in
+//!   spiccato.
 //!
 //! `cargo test --release -p colophony-lab --test articulation_regime -- --ignored --nocapture`;
 //! the counts are in docs/articulations.md.
@@ -48,6 +50,28 @@ fn probe(setup: &Setup, note: u8, seconds: f64, every_s: Option<f64>) -> Vec<Con
     out
 }
 
+/// The regime of each contact in `samples` (the bow touching the string) that lasts at
+/// least five periods of `f0` (`period` samples), classified over its second half.
+fn contacts(samples: &[ContactSample], period: f64, f0: f64) -> Vec<Option<Regime>> {
+    let mut out = Vec::new();
+    let mut start = None;
+    for (i, s) in samples.iter().enumerate() {
+        let touching = s.mu.abs() > 1e-3;
+        match (touching, start) {
+            (true, None) => start = Some(i),
+            (false, Some(a)) => {
+                if (i - a) as f64 >= 5.0 * period {
+                    let half = a + (i - a) / 2;
+                    out.push(classify_regime(&samples[half..i], FS as f32, f0 as f32));
+                }
+                start = None;
+            }
+            _ => {}
+        }
+    }
+    out
+}
+
 /// Counts of Helmholtz motion among `regimes`, and the others by name.
 fn tally(regimes: &[Option<Regime>]) -> (usize, usize, String) {
     let helm = regimes
@@ -67,7 +91,7 @@ fn tremolo_and_spiccato_regime_survey() {
     for kind in InstrumentKind::ALL {
         for law in [FrictionModel::Hyperbolic, FrictionModel::Stribeck] {
             let (low, _) = kind.note_range();
-            let (mut trem, mut spicc) = (Vec::new(), Vec::new());
+            let (mut trem, mut spicc, mut saut) = (Vec::new(), Vec::new(), Vec::new());
             for note in (low..=low + 24).step_by(4) {
                 let f0 = midi_to_hz(note as f64);
                 let period = FS / f0;
@@ -91,25 +115,13 @@ fn tremolo_and_spiccato_regime_survey() {
                     ..tremolo
                 };
                 let samples = probe(&spiccato, note, 2.0, Some(0.25));
-                let mut start = None;
-                for (i, s) in samples.iter().enumerate() {
-                    let touching = s.mu.abs() > 1e-3;
-                    match (touching, start) {
-                        (true, None) => start = Some(i),
-                        (false, Some(a)) => {
-                            if (i - a) as f64 >= 5.0 * period {
-                                let half = a + (i - a) / 2;
-                                spicc.push(classify_regime(
-                                    &samples[half..i],
-                                    FS as f32,
-                                    f0 as f32,
-                                ));
-                            }
-                            start = None;
-                        }
-                        _ => {}
-                    }
-                }
+                spicc.extend(contacts(&samples, period, f0));
+                let sautille = Setup {
+                    articulation: Articulation::Sautille,
+                    ..tremolo
+                };
+                let samples = probe(&sautille, note, 2.0, Some(stroke / FS));
+                saut.extend(contacts(&samples, period, f0));
             }
             let (h, n, others) = tally(&trem);
             println!(
@@ -117,6 +129,8 @@ fn tremolo_and_spiccato_regime_survey() {
             );
             let (h, n, others) = tally(&spicc);
             println!("{kind:?} {law:?} spiccato: {h} of {n} contacts in Helmholtz motion; others {others}");
+            let (h, n, others) = tally(&saut);
+            println!("{kind:?} {law:?} sautille: {h} of {n} contacts in Helmholtz motion; others {others}");
         }
     }
 }

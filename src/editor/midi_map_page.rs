@@ -61,6 +61,9 @@ impl MidiMapPage {
              Curve bends the way between (0 straight). CC 6, 38, 100 and 101 set the \
              pitch-bend range (RPN 0) and MPE member channels play their own notes.",
         );
+        // Narrower sliders than egui's default keep a row inside the editor's default
+        // width (880) with room for the page's scroll bar.
+        ui.spacing_mut().slider_width = 80.0;
         egui::Grid::new("midi-map")
             .striped(true)
             .num_columns(7)

@@ -220,7 +220,8 @@ impl EditorUi {
         }
         ui.separator();
         if self.show_midi_map {
-            egui::ScrollArea::vertical().show(ui, |ui| {
+            // Both ways: a narrow window still reaches every row's last column.
+            egui::ScrollArea::both().show(ui, |ui| {
                 self.midi_map
                     .show(ui, &params.midi_map, &params.last_controller)
             });

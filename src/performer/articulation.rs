@@ -4,7 +4,7 @@
 //!
 //! **Keyswitches.** The twelve keys of one octave below the instrument's range
 //! ([`Setup::keyswitch_octave`], C0 by default) choose the articulation and play nothing:
-//! C arco, C# pizzicato, D tremolo, D# spiccato, E col legno. A key of that octave the instrument can play (the double bass's
+//! C arco, C# pizzicato, D tremolo, D# spiccato, E col legno, F sautillé. A key of that octave the instrument can play (the double bass's
 //! E1 with the keyswitches on C1) stays a note.
 //!
 //! **The pluck.** The finger pulls the string aside at [`PLUCK_FROM_BRIDGE`] of the open
@@ -38,6 +38,10 @@ pub enum Articulation {
     Spiccato,
     /// Struck with the bow's stick (col legno battuto).
     ColLegno,
+    /// Fast strokes with the bow bouncing by itself, the hand driving the bounce once a
+    /// stroke ([`crate::performer::stroke::Stroke::set_sautille`]); the strokes come at
+    /// the tremolo's rate ([`Setup::tremolo_rate_hz`] or [`TremoloSync`]).
+    Sautille,
 }
 
 /// What sets the tremolo's strokes: its rate, or notes of the host's tempo.
@@ -76,12 +80,13 @@ pub fn tremolo_stroke_s(rate_hz: f64, sync: TremoloSync, tempo_bpm: Option<f64>)
 
 impl Articulation {
     /// In the order of their keyswitches (from C of the keyswitch octave).
-    pub const ALL: [Articulation; 5] = [
+    pub const ALL: [Articulation; 6] = [
         Articulation::Arco,
         Articulation::Pizzicato,
         Articulation::Tremolo,
         Articulation::Spiccato,
         Articulation::ColLegno,
+        Articulation::Sautille,
     ];
 
     /// The name a score uses.
@@ -92,6 +97,7 @@ impl Articulation {
             Articulation::Tremolo => "trem.",
             Articulation::Spiccato => "spicc.",
             Articulation::ColLegno => "col legno",
+            Articulation::Sautille => "saut.",
         }
     }
 }
@@ -171,17 +177,33 @@ impl Performer {
         self.follow_tremolo();
     }
 
-    /// The bow under held notes starts, follows or stops the tremolo the articulation,
-    /// rate and tempo ask for.
+    /// The bow under held notes starts, follows or stops the tremolo or sautillé the
+    /// articulation, rate and tempo ask for.
     pub(super) fn follow_tremolo(&mut self) {
         if self.held.iter().any(|&h| h) {
             self.stroke.set_tremolo(self.tremolo_stroke());
+            let velocity = self.stroke.velocity();
+            self.stroke
+                .set_sautille(self.sautille_stroke().map(|s| (s, velocity)));
         }
     }
 
-    /// The tremolo's stroke length now, s, or `None` when the articulation is not tremolo.
+    /// The sautillé's stroke length now, s, or `None` when the articulation is not
+    /// sautillé.
+    pub(super) fn sautille_stroke(&self) -> Option<f64> {
+        (self.articulation() == Articulation::Sautille)
+            .then(|| self.tremolo_stroke())
+            .flatten()
+    }
+
+    /// The tremolo's (or sautillé's) stroke length now, s, or `None` when the
+    /// articulation is neither.
     pub(super) fn tremolo_stroke(&self) -> Option<f64> {
-        (self.articulation() == Articulation::Tremolo).then(|| {
+        matches!(
+            self.articulation(),
+            Articulation::Tremolo | Articulation::Sautille
+        )
+        .then(|| {
             tremolo_stroke_s(
                 self.setup.tremolo_rate_hz,
                 self.setup.tremolo_sync,
@@ -494,6 +516,101 @@ mod tests {
         assert!(peaks[1] > 1.2 * peaks[0], "peaks {peaks:?}");
     }
 
+    /// Sautillé: the hand drives the bow's bounce once a stroke. At velocity 1 the hair
+    /// leaves the string once a stroke (24 flights in 2 s at 12 strokes a second, 16 at 8
+    /// and 40 at 20: within one, the count's ends), each flight holding the bow's turn
+    /// (where its speed crosses zero); at velocity 0.4 the hair stays on and only its force
+    /// swings, by `SAUTILLE_LIFT x 0.4` of the mean each way (within 5 %: the push is set
+    /// from the linear motion, the contact is not quite linear at its edges); over whole
+    /// strokes the mean force is the pull's (the hand's push averages to nothing:
+    /// momentum), within 1 % (measured within 0.2 %; 2 s is a whole number of strokes at
+    /// these rates).
+    #[test]
+    fn sautille_bounces_the_bow_once_a_stroke_at_its_rate() {
+        for rate in [8.0, 12.0, 20.0] {
+            for velocity in [1.0f32, 0.4] {
+                let setup = Setup {
+                    articulation: Articulation::Sautille,
+                    tremolo_rate_hz: rate,
+                    ..Setup::default()
+                };
+                let mut p = cello_with(&setup);
+                p.note_on(50, velocity);
+                play(&mut p, 0.5);
+                let asked = BowControl::default();
+                let (force, speed): (Vec<f64>, Vec<f64>) = (0..96_000)
+                    .map(|_| {
+                        p.tick(asked);
+                        (p.bow().force_n, p.bow().velocity_m_per_s)
+                    })
+                    .unzip();
+                let mean = force.iter().sum::<f64>() / force.len() as f64;
+                let expected = asked.force_n * stroke::SPICCATO_PULL_N / stroke::BOUNCE_REFERENCE_N;
+                eprintln!(
+                    "rate {rate} velocity {velocity}: mean force {:.4} of {expected:.4} N",
+                    mean
+                );
+                assert!(
+                    (mean / expected - 1.0).abs() < 0.01,
+                    "rate {rate} velocity {velocity}: mean {mean} N against {expected}"
+                );
+                let turns: Vec<usize> = speed
+                    .windows(2)
+                    .enumerate()
+                    .filter(|(_, w)| (w[0] > 0.0) != (w[1] > 0.0))
+                    .map(|(i, _)| i)
+                    .collect();
+                if velocity < 0.5 {
+                    let lo = force.iter().copied().fold(f64::MAX, f64::min);
+                    let hi = force.iter().copied().fold(0.0, f64::max);
+                    eprintln!("  stays on: {lo:.4}..{hi:.4} N");
+                    assert!(lo > 0.0, "rate {rate}: the hair stays on ({lo} N)");
+                    let swing = 0.5 * (hi - lo) / mean;
+                    let designed = stroke::SAUTILLE_LIFT * stroke::velocity_step(velocity);
+                    assert!(
+                        (swing / designed - 1.0).abs() < 0.05,
+                        "rate {rate}: swing {swing:.3} of the mean against {designed:.3}"
+                    );
+                    continue;
+                }
+                let mut flights = Vec::new();
+                let mut start = None;
+                for (i, &f) in force.iter().enumerate() {
+                    match (f == 0.0, start) {
+                        (true, None) => start = Some(i),
+                        (false, Some(s)) => {
+                            flights.push((s, i));
+                            start = None;
+                        }
+                        _ => {}
+                    }
+                }
+                let expected_flights = (2.0 * rate) as usize;
+                let share = flights.iter().map(|(a, b)| b - a).sum::<usize>() as f64 / 96_000.0;
+                eprintln!(
+                    "  {} flights ({:.0} % of the time), {} turns",
+                    flights.len(),
+                    100.0 * share,
+                    turns.len()
+                );
+                assert!(
+                    flights.len().abs_diff(expected_flights) <= 1,
+                    "rate {rate}: {} flights in 2 s",
+                    flights.len()
+                );
+                let held = turns
+                    .iter()
+                    .filter(|&&t| flights.iter().any(|&(a, b)| a <= t && t <= b))
+                    .count();
+                assert!(
+                    held + 1 >= turns.len(),
+                    "rate {rate}: {held} of {} turns in the air",
+                    turns.len()
+                );
+            }
+        }
+    }
+
     /// Con sordino takes level out of the bridge hill and leaves the body's low modes:
     /// on the violin's A4 and D5 at the defaults, the harmonics' power between 2 and 4 kHz
     /// (the bridge hill, where SHARC's muted violin loses 6-11 dB against its open one:
@@ -763,7 +880,8 @@ mod tests {
             assert_eq!(keyswitch(14, 0, kind), Some(Articulation::Tremolo));
             assert_eq!(keyswitch(15, 0, kind), Some(Articulation::Spiccato));
             assert_eq!(keyswitch(16, 0, kind), Some(Articulation::ColLegno));
-            assert_eq!(keyswitch(17, 0, kind), None, "no sixth articulation");
+            assert_eq!(keyswitch(17, 0, kind), Some(Articulation::Sautille));
+            assert_eq!(keyswitch(18, 0, kind), None, "no seventh articulation");
             assert_eq!(keyswitch(0, -1, kind), Some(Articulation::Arco));
             assert_eq!(keyswitch(25, 1, kind), Some(Articulation::Pizzicato));
             for note in kind.open_notes()[0]..128 {

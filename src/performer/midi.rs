@@ -135,11 +135,16 @@ impl Performer {
                 self.direct.set_controller(direct::CC_BOW_POSITION, x);
             }
             Target::Portamento => self.gesture.portamento_pedal = (x * 127.0).round() >= 64.0,
-            Target::Pizzicato | Target::Tremolo | Target::Spiccato | Target::ColLegno => {
+            Target::Pizzicato
+            | Target::Tremolo
+            | Target::Spiccato
+            | Target::ColLegno
+            | Target::Sautille => {
                 let on = match target {
                     Target::Pizzicato => Articulation::Pizzicato,
                     Target::Tremolo => Articulation::Tremolo,
                     Target::Spiccato => Articulation::Spiccato,
+                    Target::Sautille => Articulation::Sautille,
                     _ => Articulation::ColLegno,
                 };
                 let down = (x * 127.0).round() >= 64.0;

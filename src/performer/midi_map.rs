@@ -44,6 +44,8 @@ pub const SPICCATO_CC: u8 = 104;
 pub const CON_SORDINO_CC: u8 = 105;
 /// The controller that switches col legno in the default map (undefined in MIDI too).
 pub const COL_LEGNO_CC: u8 = 106;
+/// The controller that switches sautillé in the default map (undefined in MIDI too).
+pub const SAUTILLE_CC: u8 = 107;
 
 /// Most mappings a map holds.
 pub const MAX_MAPPINGS: usize = 16;
@@ -80,11 +82,13 @@ pub enum Target {
     ConSordino,
     /// Col legno (battuto) while the value is 0.5 or more, arco below it.
     ColLegno,
+    /// Sautillé while the value is 0.5 or more, arco below it.
+    Sautille,
 }
 
 impl Target {
     /// In the order saved maps index them: new targets go at the end.
-    pub const ALL: [Target; 13] = [
+    pub const ALL: [Target; 14] = [
         Target::Dynamics,
         Target::VibratoDepth,
         Target::VibratoRate,
@@ -98,6 +102,7 @@ impl Target {
         Target::Spiccato,
         Target::ConSordino,
         Target::ColLegno,
+        Target::Sautille,
     ];
 
     /// The name the editor shows.
@@ -116,6 +121,7 @@ impl Target {
             Target::Spiccato => "Spiccato",
             Target::ConSordino => "Con sordino (mute)",
             Target::ColLegno => "Col legno",
+            Target::Sautille => "Sautillé",
         }
     }
 
@@ -216,6 +222,7 @@ impl Default for MidiMap {
             Mapping::new(SPICCATO_CC, Target::Spiccato),
             Mapping::new(CON_SORDINO_CC, Target::ConSordino),
             Mapping::new(COL_LEGNO_CC, Target::ColLegno),
+            Mapping::new(SAUTILLE_CC, Target::Sautille),
         ] {
             map.add(m);
         }

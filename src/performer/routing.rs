@@ -52,10 +52,12 @@ impl Performer {
         if separate && self.held[note as usize & 127] {
             self.stroke
                 .start(self.setup.bow_strokes, stroke::velocity_step(velocity));
+            let velocity = stroke::velocity_step(velocity);
             self.stroke.set_tremolo(self.tremolo_stroke());
             let spiccato = self.articulation() == Articulation::Spiccato;
+            self.stroke.set_spiccato(spiccato, velocity);
             self.stroke
-                .set_spiccato(spiccato, stroke::velocity_step(velocity));
+                .set_sautille(self.sautille_stroke().map(|s| (s, velocity)));
         }
     }
 

@@ -108,6 +108,12 @@ pub struct Stroke {
     /// Spiccato: the bow bouncing on the string, its force over [`BOUNCE_REFERENCE_N`]
     /// multiplying the asked force.
     bounce: Option<BouncingBow>,
+    /// Sautillé: the hand's push on the bouncing bow at its peak, N (0: not driven), once
+    /// a stroke, and the bounce frequency it was set up for.
+    drive_n: f64,
+    drive_hz: f64,
+    /// The velocity (0..=1) the last stroke started with.
+    velocity: f64,
 }
 
 /// The bouncing bow's pull toward the string, N: half a violin bow's 60 g weight at the
@@ -117,6 +123,14 @@ pub const SPICCATO_PULL_N: f64 = 0.3;
 pub const SPICCATO_DROP_M: f64 = 0.015;
 /// The bouncing bow's force that plays the asked bow force, N.
 pub const BOUNCE_REFERENCE_N: f64 = 1.0;
+
+/// The bounce frequencies a sautillé can use, Hz: where along the bow Askenfelt and
+/// Guettler measured a violin bow bouncing (8-20 Hz, [`crate::dsp::bounce`]).
+pub const SAUTILLE_BOUNCE_HZ: std::ops::RangeInclusive<f64> = 8.0..=20.0;
+/// At velocity 1 the hand's push would swing the hair's force this many times the pull
+/// each way, if the hair stayed on the string (a choice: it leaves the string for part of
+/// each stroke from velocity 0.67 up).
+pub const SAUTILLE_LIFT: f64 = 1.5;
 
 /// A tremolo reversal takes this share of a stroke: the bow slows, stops and speeds up
 /// the other way over it, and travels at the asked speed for the rest.
@@ -140,6 +154,9 @@ impl Stroke {
             tremolo_left: 0,
             tremolo_step: 0.0,
             bounce: None,
+            drive_n: 0.0,
+            drive_hz: 0.0,
+            velocity: 0.8,
         }
     }
 
@@ -148,7 +165,15 @@ impl Stroke {
     /// note, so the note lands on time), and it bounces
     /// ([`crate::dsp::bounce`]) until the next stroke; `false`: the bow stays on.
     pub fn set_spiccato(&mut self, spiccato: bool, velocity: f64) {
-        self.bounce = spiccato.then(|| {
+        if !spiccato {
+            // A driven bounce (sautillé) is [`Stroke::set_sautille`]'s to end.
+            if self.drive_n == 0.0 {
+                self.bounce = None;
+            }
+            return;
+        }
+        self.drive_n = 0.0;
+        self.bounce = Some({
             let mut bow = BouncingBow::new(
                 BounceParams::default(),
                 SPICCATO_PULL_N,
@@ -158,6 +183,50 @@ impl Stroke {
             bow.land_from(SPICCATO_DROP_M * v * v);
             bow
         });
+    }
+
+    /// Sautillé (`Some((stroke_s, velocity))`): the bow reverses every `stroke_s` seconds,
+    /// as in tremolo, and the hand drives its bounce once a stroke ([`BouncingBow::driven`]):
+    /// it bounces at `1 / stroke_s` (held within [`SAUTILLE_BOUNCE_HZ`], the bow's measured
+    /// range), highest at each turn and pressing hardest mid-stroke. The velocity (0..=1)
+    /// sets the push: at 1 the hair's force would swing [`SAUTILLE_LIFT`] times the pull
+    /// each way if the hair stayed on, so it leaves the string for part of each stroke;
+    /// below `1 / SAUTILLE_LIFT` the hair stays on and only its force swings. `None` ends
+    /// it (and the tremolo).
+    pub fn set_sautille(&mut self, sautille: Option<(f64, f64)>) {
+        let Some((stroke_s, velocity)) = sautille.filter(|(s, _)| s.is_finite() && *s > 0.0) else {
+            if self.drive_n != 0.0 {
+                self.drive_n = 0.0;
+                self.bounce = None;
+                self.set_tremolo(None);
+            }
+            return;
+        };
+        self.set_tremolo(Some(stroke_s));
+        let hz = (1.0 / stroke_s).clamp(*SAUTILLE_BOUNCE_HZ.start(), *SAUTILLE_BOUNCE_HZ.end());
+        let params = BounceParams {
+            bounce_hz: hz,
+            ..BounceParams::default()
+        };
+        // The hair's force per newton of push in the linear (never leaving) motion:
+        // |k + i c w| |H|.
+        let (m, k) = (params.mass_kg, params.stiffness_n_per_m());
+        let c = 2.0 * params.damping_ratio() * (k * m).sqrt();
+        let w = 2.0 * std::f64::consts::PI / stroke_s;
+        let gain = k.hypot(c * w) / (k - m * w * w).hypot(c * w);
+        let push = velocity.clamp(0.0, 1.0) * SAUTILLE_LIFT * SPICCATO_PULL_N / gain;
+        if self.drive_n == 0.0 || self.drive_hz != hz || self.bounce.is_none() {
+            self.bounce = Some(BouncingBow::driven(
+                params,
+                SPICCATO_PULL_N,
+                push,
+                1.0 / stroke_s,
+                self.sample_rate_hz,
+            ));
+            self.drive_hz = hz;
+        }
+        // A push of 0 is no drive: keep a hair's breadth of one so the bow stays driven.
+        self.drive_n = push.max(1e-9);
     }
 
     /// Tremolo: the bow reverses every `stroke_s` seconds (each reversal through
@@ -194,12 +263,18 @@ impl Stroke {
         self.started = true;
         self.tremolo_left = self.tremolo_samples;
         let v = velocity.clamp(0.0, 1.0);
+        self.velocity = v;
         let attack_s = ATTACK_SLOWEST_S * (ATTACK_FASTEST_S / ATTACK_SLOWEST_S).powf(v);
         self.step = 1.0 / (attack_s * self.sample_rate_hz).max(1.0);
         self.speed = 0.0;
         let mezzo = 64.0 / 127.0;
         self.accent = ACCENT_MAX * ((v - mezzo) / (1.0 - mezzo)).max(0.0);
         self.onset = (ONSET_OCTAVES_PER_VELOCITY * (v - mezzo)).min(0.0).exp2() - 1.0;
+    }
+
+    /// The velocity (0..=1) the last stroke started with.
+    pub fn velocity(&self) -> f64 {
+        self.velocity
     }
 
     /// The bow direction of the stroke in progress (+1 down, -1 up).
@@ -216,7 +291,17 @@ impl Stroke {
         }
         let (speed, mut force) = self.tick_ramp();
         if let Some(bow) = &mut self.bounce {
-            force *= bow.tick() / BOUNCE_REFERENCE_N;
+            let contact = if self.drive_n != 0.0 {
+                // The stroke's phase, 0 where the bow's speed crosses zero in its turn (half
+                // way through the reversal), where the bow is highest.
+                let phase = 1.0
+                    - self.tremolo_left as f64 / self.tremolo_samples.max(1) as f64
+                    - 0.5 * TREMOLO_REVERSAL_SHARE;
+                bow.tick_pushed(self.drive_n * (std::f64::consts::TAU * phase).sin())
+            } else {
+                bow.tick()
+            };
+            force *= contact / BOUNCE_REFERENCE_N;
         }
         if self.onset == 0.0 {
             return (speed, force);
