@@ -137,6 +137,9 @@ pub enum ArticulationChoice {
     #[id = "sautille"]
     #[name = "Sautillé"]
     Sautille,
+    #[id = "harmonics"]
+    #[name = "Harmonics"]
+    Harmonics,
 }
 
 /// What sets the tremolo's strokes ([`crate::performer::articulation::TremoloSync`]).
@@ -172,6 +175,7 @@ impl From<ArticulationChoice> for crate::performer::Articulation {
             ArticulationChoice::Spiccato => Self::Spiccato,
             ArticulationChoice::ColLegno => Self::ColLegno,
             ArticulationChoice::Sautille => Self::Sautille,
+            ArticulationChoice::Harmonics => Self::Harmonics,
         }
     }
 }

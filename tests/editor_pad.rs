@@ -701,6 +701,9 @@ fn the_midi_map_page_learns_a_controller_and_edits_the_shared_map() {
     );
     {
         let mut h = harness(&mut f.editor);
+        // Under the rows: the page scrolls to it, as a player would.
+        h.get_by_label(ADD_MAPPING_LABEL).scroll_to_me();
+        h.run();
         h.get_by_label(ADD_MAPPING_LABEL).click();
         h.run();
     }
@@ -710,6 +713,9 @@ fn the_midi_map_page_learns_a_controller_and_edits_the_shared_map() {
     );
     {
         let mut h = harness(&mut f.editor);
+        // Under the rows: the page scrolls to it, as a player would.
+        h.get_by_label(DEFAULT_MAP_LABEL).scroll_to_me();
+        h.run();
         h.get_by_label(DEFAULT_MAP_LABEL).click();
         h.run();
     }

@@ -93,6 +93,9 @@ pub struct Fingering {
     /// Whether each string was plucked: it sounds its free pitch, which the table (made
     /// for the bowed sound) does not move.
     plucked: [bool; STRINGS],
+    /// The partial each string's note sounds: 1 (its fundamental), or more for a harmonic
+    /// (the string stopped that many times under the note, a finger touching it).
+    partials: [u8; STRINGS],
 }
 
 impl Fingering {
@@ -115,6 +118,7 @@ impl Fingering {
             intonation_row: intonation_row.unwrap_or(0),
             dynamics: 1.0,
             plucked: [false; STRINGS],
+            partials: [1; STRINGS],
         }
     }
 
@@ -149,6 +153,33 @@ impl Fingering {
         if let Some(p) = self.plucked.get_mut(string) {
             *p = plucked;
         }
+    }
+
+    /// `string`'s note sounds its `partial` (a harmonic; 1: its fundamental), until set
+    /// again.
+    pub fn set_partial(&mut self, string: usize, partial: u8) {
+        if let Some(p) = self.partials.get_mut(string) {
+            *p = partial.max(1);
+        }
+    }
+
+    /// The partial `string`'s note sounds (1 unless a harmonic).
+    pub fn partial(&self, string: usize) -> u8 {
+        self.partials[string.min(STRINGS - 1)]
+    }
+
+    /// The note `string` is stopped at: its note, or for a harmonic the note its
+    /// partial sounds over.
+    pub fn stopped_note(&self, string: usize) -> Option<u8> {
+        let partial = self.partial(string);
+        self.notes[string.min(STRINGS - 1)]
+            .map(|n| n.saturating_sub(crate::dsp::vocabulary::partial_semitones(partial)))
+    }
+
+    /// How `note` is played as a harmonic on these strings, the player's preferred string
+    /// first ([`InstrumentKind::harmonic_for`]).
+    pub fn harmonic_for(&self, note: u8) -> Option<crate::dsp::vocabulary::HarmonicFingering> {
+        self.kind.harmonic_for(note, self.preferred_string)
     }
 
     /// A new note on `string`: neutral expression, no glide.
@@ -339,6 +370,10 @@ impl Fingering {
 
     /// As [`Fingering::tuned_hz`] for `note` on `string`.
     pub fn tuned_hz_for(&self, string: usize, note: u8) -> f64 {
+        let s = string.min(STRINGS - 1);
+        if self.partials[s] > 1 {
+            return self.harmonic_hz(s, note);
+        }
         let table = self
             .intonation
             .filter(|_| !self.plucked[string.min(STRINGS - 1)]);
@@ -352,6 +387,18 @@ impl Fingering {
             self.reference_semitones,
             self.dynamics,
         )
+    }
+
+    /// A harmonic `note` on string `s`: the pitch its string is stopped at, the note's
+    /// (with its bends) over its partial. The intonation table does not move it: a touched
+    /// string bowed at its partial does not sound where a stopped string bowed at that
+    /// pitch does, so the stopped notes' corrections do not carry over
+    /// (docs/articulations.md#harmonics).
+    fn harmonic_hz(&self, s: usize, note: u8) -> f64 {
+        let played =
+            note as f64 + self.bend_semitones + self.glides[s] + self.expressions[s].bend_semitones;
+        crate::dsp::vocabulary::midi_to_hz(played + self.reference_semitones)
+            / self.partials[s] as f64
     }
 }
 

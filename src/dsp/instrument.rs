@@ -34,7 +34,7 @@ use super::halfband::HalfbandDecimator;
 use super::intonation;
 use super::resample::Resampler;
 pub use super::strings::FourStrings;
-use super::strings::{StringBank, StringBow};
+use super::strings::{StringBank, StringBow, HARMONIC_FINGER_RESISTANCE_Z0};
 use super::waveguide::WaveguideString;
 
 use super::vocabulary::*;
@@ -163,6 +163,14 @@ impl StringBank for WaveguideBank {
     }
 
     const PLUCKABLE: bool = true;
+
+    const TOUCHABLE: bool = true;
+
+    fn touch(&mut self, i: usize, partial: Option<u32>) {
+        let string = &mut self.voices[i].string;
+        let r = HARMONIC_FINGER_RESISTANCE_Z0 * string.spec().z0_kg_per_s;
+        string.set_touch(partial.map(|n| (n, r)));
+    }
 
     fn set_mute(&mut self, on: bool) {
         if on != self.muted {

@@ -311,6 +311,38 @@ impl InstrumentKind {
         self.string_for_note(note)
     }
 
+    /// How `note` is played as a harmonic: a natural harmonic (an open string's partial in
+    /// [`NATURAL_HARMONICS`], the lowest partial first, on the highest string that has
+    /// it, or the `preferred` string's if it has one), or else an artificial one (the
+    /// note two octaves down stopped, on the string [`Self::string_for_note_on`] gives it,
+    /// touched a fourth above: its 4th partial). `None` if neither plays it.
+    pub fn harmonic_for(self, note: u8, preferred: Option<usize>) -> Option<HarmonicFingering> {
+        let open = self.open_notes();
+        let strings = || {
+            (0..STRINGS)
+                .rev()
+                .filter(move |s| preferred.is_none_or(|p| p == *s))
+        };
+        for partial in NATURAL_HARMONICS {
+            for string in strings() {
+                if open[string] as u16 + partial_semitones(partial) as u16 == note as u16 {
+                    return Some(HarmonicFingering {
+                        string,
+                        stopped: open[string],
+                        partial,
+                    });
+                }
+            }
+        }
+        let stopped = note.checked_sub(partial_semitones(ARTIFICIAL_HARMONIC))?;
+        let string = self.string_for_note_on(stopped, preferred)?;
+        Some(HarmonicFingering {
+            string,
+            stopped,
+            partial: ARTIFICIAL_HARMONIC,
+        })
+    }
+
     /// Playable notes, inclusive.
     pub fn note_range(self) -> (u8, u8) {
         let open = self.open_notes();
@@ -352,6 +384,29 @@ impl Default for BowControl {
             position_beta: 0.1,
         }
     }
+}
+
+/// The partials a natural harmonic is played on: those within 2 cents of equal
+/// temperament (the 5th and 7th sit 14 and 31 cents flat of it, so a note there is played
+/// as an artificial harmonic instead), in the order they are tried.
+pub const NATURAL_HARMONICS: [u8; 5] = [2, 3, 4, 6, 8];
+/// The artificial harmonic's partial: the stopped note's 4th, touched a fourth above the
+/// stopping finger, two octaves above the stopped note.
+pub const ARTIFICIAL_HARMONIC: u8 = 4;
+
+/// How a harmonic is fingered: the string, the note it is stopped at (its open note for
+/// a natural harmonic), and the partial a light finger at its node nearest the bridge
+/// leaves sounding.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct HarmonicFingering {
+    pub string: usize,
+    pub stopped: u8,
+    pub partial: u8,
+}
+
+/// Semitones from a fundamental up to its partial `n` in equal temperament, rounded.
+pub fn partial_semitones(n: u8) -> u8 {
+    (12.0 * (n.max(1) as f64).log2()).round() as u8
 }
 
 /// A finger's pluck (pizzicato): the string pulled aside at one point and let go from rest.

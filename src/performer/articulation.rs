@@ -4,7 +4,7 @@
 //!
 //! **Keyswitches.** The twelve keys of one octave below the instrument's range
 //! ([`Setup::keyswitch_octave`], C0 by default) choose the articulation and play nothing:
-//! C arco, C# pizzicato, D tremolo, D# spiccato, E col legno, F sautillé. A key of that octave the instrument can play (the double bass's
+//! C arco, C# pizzicato, D tremolo, D# spiccato, E col legno, F sautillé, F# harmonics. A key of that octave the instrument can play (the double bass's
 //! E1 with the keyswitches on C1) stays a note.
 //!
 //! **The pluck.** The finger pulls the string aside at [`PLUCK_FROM_BRIDGE`] of the open
@@ -42,6 +42,10 @@ pub enum Articulation {
     /// stroke ([`crate::performer::stroke::Stroke::set_sautille`]); the strokes come at
     /// the tremolo's rate ([`Setup::tremolo_rate_hz`] or [`TremoloSync`]).
     Sautille,
+    /// Bowed with a light finger at a node: natural harmonics on the open strings' 2nd,
+    /// 3rd, 4th, 6th and 8th partials, artificial ones (a stopped note touched a fourth
+    /// above) for the other notes ([`crate::dsp::strings::FourStrings::harmonic`]).
+    Harmonics,
 }
 
 /// What sets the tremolo's strokes: its rate, or notes of the host's tempo.
@@ -80,13 +84,14 @@ pub fn tremolo_stroke_s(rate_hz: f64, sync: TremoloSync, tempo_bpm: Option<f64>)
 
 impl Articulation {
     /// In the order of their keyswitches (from C of the keyswitch octave).
-    pub const ALL: [Articulation; 6] = [
+    pub const ALL: [Articulation; 7] = [
         Articulation::Arco,
         Articulation::Pizzicato,
         Articulation::Tremolo,
         Articulation::Spiccato,
         Articulation::ColLegno,
         Articulation::Sautille,
+        Articulation::Harmonics,
     ];
 
     /// The name a score uses.
@@ -98,6 +103,7 @@ impl Articulation {
             Articulation::Spiccato => "spicc.",
             Articulation::ColLegno => "col legno",
             Articulation::Sautille => "saut.",
+            Articulation::Harmonics => "harm.",
         }
     }
 }
@@ -273,6 +279,16 @@ mod tests {
     use crate::analysis::{cents, partial_amplitude, peak_frequency_hz, rms};
     use crate::dsp::friction::FrictionModel;
     use crate::performer::testing::*;
+
+    /// `seconds` of `note` at velocity 0.8 on a performer set up as `setup`, with the
+    /// default bow.
+    fn note_played(setup: &Setup, note: u8, seconds: f64) -> Vec<f64> {
+        let mut p = Performer::new(setup.instrument);
+        p.activate(setup, FS).unwrap();
+        p.configure(setup);
+        p.note_on(note, 0.8);
+        play(&mut p, seconds)
+    }
 
     /// `seconds` of `p`'s output with the default bow.
     fn play(p: &mut Performer, seconds: f64) -> Vec<f64> {
@@ -611,6 +627,82 @@ mod tests {
         }
     }
 
+    /// Bowed harmonics speak near their written pitch: the natural harmonics (2nd, 3rd,
+    /// 4th, 6th and 8th partials) of every open string and artificial ones every fifth
+    /// semitone from two octaves above the lowest string up, on every instrument, bowed
+    /// at the defaults (velocity 0.8), each note once. Every one speaks (over -40 dBFS
+    /// in the last second; measured -28 dBFS at the quietest); at least 90 % sit within
+    /// 10 cents (measured 68 of 72, the other four in no steady regime) and at least half
+    /// within the 5 cents a player hears as in tune (measured 42 of 72). The 5 cents the
+    /// articulation asks of every note is not met (docs/articulations.md#harmonics): these
+    /// floors hold what is measured against getting worse.
+    #[test]
+    fn bowed_harmonics_speak_near_their_written_pitch_on_every_instrument() {
+        use crate::dsp::vocabulary::{midi_to_hz, partial_semitones, NATURAL_HARMONICS};
+        let (mut count, mut within_5, mut within_10) = (0, 0, 0);
+        for kind in InstrumentKind::ALL {
+            let open = kind.open_notes();
+            let natural = open
+                .iter()
+                .flat_map(|&o| NATURAL_HARMONICS.map(|n| o + partial_semitones(n)));
+            let artificial = (open[0] + 24..=open[3] + 31).step_by(5);
+            let notes: std::collections::BTreeSet<u8> = natural.chain(artificial).collect();
+            for note in notes {
+                let setup = Setup {
+                    instrument: kind,
+                    articulation: Articulation::Harmonics,
+                    ..Setup::default()
+                };
+                let out = note_played(&setup, note, 1.5);
+                let tail = &out[24_000..];
+                let f = midi_to_hz(note as f64);
+                let off = cents(peak_frequency_hz(tail, FS, f, 60.0), f);
+                let level = 20.0 * rms(tail).log10();
+                eprintln!("harmonic: {kind:?} note {note}: {off:+.2} cents, {level:.1} dBFS");
+                assert!(
+                    level > -40.0,
+                    "{kind:?} {note} does not speak: {level:.1} dBFS"
+                );
+                count += 1;
+                within_5 += (off.abs() < 5.0) as usize;
+                within_10 += (off.abs() < 10.0) as usize;
+            }
+        }
+        eprintln!("{within_5} of {count} within 5 cents, {within_10} within 10");
+        assert!(
+            within_10 * 100 >= 90 * count,
+            "{within_10} of {count} within 10 cents"
+        );
+        assert!(
+            within_5 * 2 >= count,
+            "{within_5} of {count} within 5 cents"
+        );
+    }
+
+    /// A harmonic comes from the keyswitch F# of the keyswitch octave and from CC108, and
+    /// plays its string touched: the cello's D4 (its D string's 2nd partial, a natural
+    /// harmonic) sounds its pitch without its octave below (the touched string's 1st
+    /// partial more than 30 dB under the 2nd), where the same key bowed arco sounds the
+    /// stopped note whose fundamental it is.
+    #[test]
+    fn the_keyswitch_and_its_controller_choose_harmonics_that_touch_the_string() {
+        let mut p = cello_with(&Setup::default());
+        p.note_on(18, 1.0);
+        assert_eq!(p.articulation(), Articulation::Harmonics);
+        p.set_controller(108, 0.0);
+        assert_eq!(p.articulation(), Articulation::Arco);
+        p.set_controller(108, 1.0);
+        assert_eq!(p.articulation(), Articulation::Harmonics);
+        p.note_on(62, 0.8);
+        let out = play(&mut p, 1.5);
+        let tail = &out[24_000..];
+        let f = crate::dsp::vocabulary::midi_to_hz(62.0);
+        let below = partial_amplitude(tail, FS, 0.5 * f);
+        let at = partial_amplitude(tail, FS, f);
+        let db = 20.0 * (below / at).log10();
+        assert!(db < -30.0, "the octave below at {db:+.1} dB");
+    }
+
     /// Con sordino takes level out of the bridge hill and leaves the body's low modes:
     /// on the violin's A4 and D5 at the defaults, the harmonics' power between 2 and 4 kHz
     /// (the bridge hill, where SHARC's muted violin loses 6-11 dB against its open one:
@@ -757,11 +849,7 @@ mod tests {
                 con_sordino: mute,
                 ..Setup::default()
             };
-            let mut p = Performer::new(kind);
-            p.activate(&setup, FS).unwrap();
-            p.configure(&setup);
-            p.note_on(note, 0.8);
-            let out = play(&mut p, 1.5);
+            let out = note_played(&setup, note, 1.5);
             let steady = &out[48_000..];
             let f0 = peak_frequency_hz(steady, FS, midi_to_hz(note as f64), 50.0);
             results.push((
@@ -881,7 +969,8 @@ mod tests {
             assert_eq!(keyswitch(15, 0, kind), Some(Articulation::Spiccato));
             assert_eq!(keyswitch(16, 0, kind), Some(Articulation::ColLegno));
             assert_eq!(keyswitch(17, 0, kind), Some(Articulation::Sautille));
-            assert_eq!(keyswitch(18, 0, kind), None, "no seventh articulation");
+            assert_eq!(keyswitch(18, 0, kind), Some(Articulation::Harmonics));
+            assert_eq!(keyswitch(19, 0, kind), None, "no eighth articulation");
             assert_eq!(keyswitch(0, -1, kind), Some(Articulation::Arco));
             assert_eq!(keyswitch(25, 1, kind), Some(Articulation::Pizzicato));
             for note in kind.open_notes()[0]..128 {

@@ -139,12 +139,14 @@ impl Performer {
             | Target::Tremolo
             | Target::Spiccato
             | Target::ColLegno
-            | Target::Sautille => {
+            | Target::Sautille
+            | Target::Harmonics => {
                 let on = match target {
                     Target::Pizzicato => Articulation::Pizzicato,
                     Target::Tremolo => Articulation::Tremolo,
                     Target::Spiccato => Articulation::Spiccato,
                     Target::Sautille => Articulation::Sautille,
+                    Target::Harmonics => Articulation::Harmonics,
                     _ => Articulation::ColLegno,
                 };
                 let down = (x * 127.0).round() >= 64.0;

@@ -46,9 +46,11 @@ pub const CON_SORDINO_CC: u8 = 105;
 pub const COL_LEGNO_CC: u8 = 106;
 /// The controller that switches sautillé in the default map (undefined in MIDI too).
 pub const SAUTILLE_CC: u8 = 107;
+/// The controller that switches harmonics in the default map (undefined in MIDI too).
+pub const HARMONICS_CC: u8 = 108;
 
 /// Most mappings a map holds.
-pub const MAX_MAPPINGS: usize = 16;
+pub const MAX_MAPPINGS: usize = 24;
 
 /// What a controller moves.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -84,11 +86,13 @@ pub enum Target {
     ColLegno,
     /// Sautillé while the value is 0.5 or more, arco below it.
     Sautille,
+    /// Harmonics while the value is 0.5 or more, arco below it.
+    Harmonics,
 }
 
 impl Target {
     /// In the order saved maps index them: new targets go at the end.
-    pub const ALL: [Target; 14] = [
+    pub const ALL: [Target; 15] = [
         Target::Dynamics,
         Target::VibratoDepth,
         Target::VibratoRate,
@@ -103,6 +107,7 @@ impl Target {
         Target::ConSordino,
         Target::ColLegno,
         Target::Sautille,
+        Target::Harmonics,
     ];
 
     /// The name the editor shows.
@@ -122,6 +127,7 @@ impl Target {
             Target::ConSordino => "Con sordino (mute)",
             Target::ColLegno => "Col legno",
             Target::Sautille => "Sautillé",
+            Target::Harmonics => "Harmonics",
         }
     }
 
@@ -223,6 +229,7 @@ impl Default for MidiMap {
             Mapping::new(CON_SORDINO_CC, Target::ConSordino),
             Mapping::new(COL_LEGNO_CC, Target::ColLegno),
             Mapping::new(SAUTILLE_CC, Target::Sautille),
+            Mapping::new(HARMONICS_CC, Target::Harmonics),
         ] {
             map.add(m);
         }

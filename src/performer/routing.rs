@@ -72,6 +72,9 @@ impl Performer {
             // Notes the instrument cannot play are ignored.
             Source::Strings => {
                 let landed = match glide {
+                    _ if self.articulation() == Articulation::Harmonics => {
+                        self.instrument.harmonic(note)
+                    }
                     Some(seconds) => self.instrument.note_on_gliding(note, seconds),
                     None => self.instrument.note_on(note),
                 };
