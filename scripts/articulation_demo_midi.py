@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Writes the articulation demos' MIDI files into assets/demos/midi/ (standard MIDI files,
 format 0, 480 ticks a beat, 60 bpm), each switching articulation by keyswitch (C0 arco,
-C#0 pizzicato, D0 tremolo, D#0 spiccato, E0 col legno, F0 sautillé):
+C#0 pizzicato, D0 tremolo, D#0 spiccato, E0 col legno, F0 sautillé, F#0 harmonics):
 
 - pachelbel-ground-keyswitch.mid: J. Pachelbel's canon in D, the ground bass (public
   domain) on the double bass, played twice: pizzicato, then arco;
@@ -11,7 +11,9 @@ C#0 pizzicato, D0 tremolo, D#0 spiccato, E0 col legno, F0 sautillé):
 - viola-col-legno-keyswitch.mid: a viola ostinato in eighths struck col legno, growing
   louder, then its last bar arco (keyswitch C0);
 - violin-sautille-keyswitch.mid: a violin figure of broken chords, twelve separate notes
-  a second (a stroke each, the sautillé's default rate), then its first bar arco."""
+  a second (a stroke each, the sautillé's default rate), then its first bar arco;
+- violin-harmonics-keyswitch.mid: a slow violin line in harmonics (natural ones on the
+  open strings, artificial ones between), then the same line arco an octave lower."""
 import struct
 import sys
 from pathlib import Path
@@ -81,3 +83,9 @@ part, t = notes(t, FIGURE, 1 / 12, 0.8, 100)
 events += part + keyswitch(t + TPB // 2, 12)
 part, _ = notes(t + TPB, FIGURE[:12], 1 / 12, 0.8, 100)
 write(out / "violin-sautille-keyswitch.mid", events + part)
+LINE = [88, 95, 100, 93, 86, 81, 84, 88, 79, 86, 91]
+events, t = keyswitch(0, 18), 20
+part, t = notes(t, LINE, 1, 0.95, 90)
+events += part + keyswitch(t + TPB // 2, 12)
+part, _ = notes(t + TPB, [n - 12 for n in LINE], 1, 0.95, 90)
+write(out / "violin-harmonics-keyswitch.mid", events + part)

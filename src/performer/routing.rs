@@ -72,9 +72,12 @@ impl Performer {
             // Notes the instrument cannot play are ignored.
             Source::Strings => {
                 let landed = match glide {
-                    _ if self.articulation() == Articulation::Harmonics => {
-                        self.instrument.harmonic(note)
-                    }
+                    // A note no harmonic plays (under two octaves above the lowest
+                    // string, and no open string's partial) is played stopped.
+                    _ if self.articulation() == Articulation::Harmonics => self
+                        .instrument
+                        .harmonic(note)
+                        .or_else(|| self.instrument.note_on(note)),
                     Some(seconds) => self.instrument.note_on_gliding(note, seconds),
                     None => self.instrument.note_on(note),
                 };
