@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Writes the articulation demos' MIDI files into assets/demos/midi/ (standard MIDI files,
 format 0, 480 ticks a beat, 60 bpm), each switching articulation by keyswitch (C0 arco,
-C#0 pizzicato, D0 tremolo, D#0 spiccato, E0 col legno, F0 sautillé, F#0 harmonics):
+C#0 pizzicato, D0 tremolo, D#0 spiccato, E0 col legno, F0 sautillé, F#0 harmonics, G0 col legno tratto):
 
 - pachelbel-ground-keyswitch.mid: J. Pachelbel's canon in D, the ground bass (public
   domain) on the double bass, played twice: pizzicato, then arco;
@@ -13,7 +13,9 @@ C#0 pizzicato, D0 tremolo, D#0 spiccato, E0 col legno, F0 sautillé, F#0 harmoni
 - violin-sautille-keyswitch.mid: a violin figure of broken chords, twelve separate notes
   a second (a stroke each, the sautillé's default rate), then its first bar arco;
 - violin-harmonics-keyswitch.mid: a slow violin line in harmonics (natural ones on the
-  open strings, artificial ones between), then the same line arco an octave lower."""
+  open strings, artificial ones between), then the same line arco an octave lower;
+- cello-col-legno-tratto-keyswitch.mid: a cello line in half notes drawn with the stick
+  (col legno tratto), then the same line with the hair (keyswitch C0)."""
 import struct
 import sys
 from pathlib import Path
@@ -89,3 +91,9 @@ part, t = notes(t, LINE, 1, 0.95, 90)
 events += part + keyswitch(t + TPB // 2, 12)
 part, _ = notes(t + TPB, [n - 12 for n in LINE], 1, 0.95, 90)
 write(out / "violin-harmonics-keyswitch.mid", events + part)
+TRATTO = [50, 53, 57, 55, 53, 52, 50]
+events, t = keyswitch(0, 19), 20
+part, t = notes(t, TRATTO, 2, 0.97, 96)
+events += part + keyswitch(t + TPB // 2, 12)
+part, _ = notes(t + TPB, TRATTO, 2, 0.97, 96)
+write(out / "cello-col-legno-tratto-keyswitch.mid", events + part)

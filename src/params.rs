@@ -140,6 +140,9 @@ pub enum ArticulationChoice {
     #[id = "harmonics"]
     #[name = "Harmonics"]
     Harmonics,
+    #[id = "col-legno-tratto"]
+    #[name = "Col legno tratto"]
+    ColLegnoTratto,
 }
 
 /// What sets the tremolo's strokes ([`crate::performer::articulation::TremoloSync`]).
@@ -176,6 +179,7 @@ impl From<ArticulationChoice> for crate::performer::Articulation {
             ArticulationChoice::ColLegno => Self::ColLegno,
             ArticulationChoice::Sautille => Self::Sautille,
             ArticulationChoice::Harmonics => Self::Harmonics,
+            ArticulationChoice::ColLegnoTratto => Self::ColLegnoTratto,
         }
     }
 }

@@ -29,7 +29,7 @@
 
 use super::body::{BodyMode, BodyModes, MAX_BODY_MODES};
 use super::friction::bristle::{BristleParams, SolverStats};
-use super::friction::{AnyFriction, BowInput, FrictionContact, FrictionModel};
+use super::friction::{AnyFriction, BowInput, FrictionContact, FrictionModel, HyperbolicFriction};
 use super::halfband::HalfbandDecimator;
 use super::intonation;
 use super::resample::Resampler;
@@ -91,7 +91,21 @@ pub struct WaveguideBank {
     /// `body_fade_left` samples as the new one fades in (`MUTE_FADE_S`).
     body_before: BodyModes,
     body_fade_left: u32,
+    /// The friction law the strings play with the hair ([`Instrument::set_friction_model`])
+    /// and whether the hair yields ([`Instrument::set_bow_hair`]), kept while the stick
+    /// plays instead ([`Instrument::set_stick_contact`]).
+    law: FrictionModel,
+    hair: bool,
+    stick: bool,
 }
+
+/// The bow's stick drawn across the string (col legno tratto): varnished, unrosined wood
+/// on the string, the hyperbolic law with these coefficients. Choices, not measurements
+/// (none of a stick on a string was found): the stick's static friction well under the
+/// rosined hair's 0.4, and a small fall to sliding, where rosin's falls to half.
+pub const STICK_MU_S: f64 = 0.15;
+/// The stick's sliding friction ([`STICK_MU_S`]).
+pub const STICK_MU_D: f64 = 0.12;
 
 /// The four waveguide strings of a violin, viola, cello or double bass with a shared bow, note
 /// handling and a generic body (see the module doc): [`FourStrings`] over
@@ -478,6 +492,9 @@ impl Instrument {
             skipping: true,
             body_asleep: true,
             muted: false,
+            law: FrictionModel::Hyperbolic,
+            hair: true,
+            stick: false,
             slow: false,
             body_before: BodyModes::new(&kind.body_modes(), 1.0, sample_rate_hz),
             body_fade_left: 0,
@@ -552,8 +569,11 @@ impl Instrument {
 
     /// Switches every string's friction law, handing over force and stick state (no click).
     pub fn set_friction_model(&mut self, model: FrictionModel) {
-        for voice in &mut self.bank.voices {
-            voice.contact.set_model(model);
+        self.bank.law = model;
+        if !self.bank.stick {
+            for voice in &mut self.bank.voices {
+                voice.contact.set_model(model);
+            }
         }
         if self
             .hands
@@ -575,8 +595,39 @@ impl Instrument {
     /// Lets the bow hair yield (the default) or ties the contact rigidly to the bow
     /// ([`WaveguideString::set_bow_hair`]).
     pub fn set_bow_hair(&mut self, enabled: bool) {
+        self.bank.hair = enabled;
+        if !self.bank.stick {
+            for voice in &mut self.bank.voices {
+                voice.string.set_bow_hair(enabled);
+            }
+        }
+    }
+
+    /// The bow's stick plays the strings instead of its hair (`true`, col legno tratto):
+    /// the hyperbolic law with the wood's [`STICK_MU_S`] and [`STICK_MU_D`], and no hair
+    /// to yield (the stick is stiff); `false` gives the strings back their law and hair.
+    /// The stick state and force are handed over as in a change of law. Real-time safe.
+    pub fn set_stick_contact(&mut self, stick: bool) {
+        if stick == self.bank.stick {
+            return;
+        }
+        self.bank.stick = stick;
+        let (law, hair) = (self.bank.law, self.bank.hair);
+        let rosin = HyperbolicFriction::default();
         for voice in &mut self.bank.voices {
-            voice.string.set_bow_hair(enabled);
+            if stick {
+                voice
+                    .contact
+                    .set_hyperbolic_coefficients(STICK_MU_S, STICK_MU_D, rosin.v0_m_per_s);
+                voice.contact.set_model(FrictionModel::Hyperbolic);
+                voice.string.set_bow_hair(false);
+            } else {
+                voice
+                    .contact
+                    .set_hyperbolic_coefficients(rosin.mu_s, rosin.mu_d, rosin.v0_m_per_s);
+                voice.contact.set_model(law);
+                voice.string.set_bow_hair(hair);
+            }
         }
     }
 
@@ -587,6 +638,12 @@ impl Instrument {
             let rate = bank.sample_rate_hz * bank.oversample[i] as f64;
             let model = voice.contact.model();
             voice.contact = AnyFriction::new(model, params, rate)?;
+            if bank.stick {
+                let v0 = HyperbolicFriction::default().v0_m_per_s;
+                voice
+                    .contact
+                    .set_hyperbolic_coefficients(STICK_MU_S, STICK_MU_D, v0);
+            }
         }
         Ok(())
     }

@@ -140,13 +140,15 @@ impl Performer {
             | Target::Spiccato
             | Target::ColLegno
             | Target::Sautille
-            | Target::Harmonics => {
+            | Target::Harmonics
+            | Target::ColLegnoTratto => {
                 let on = match target {
                     Target::Pizzicato => Articulation::Pizzicato,
                     Target::Tremolo => Articulation::Tremolo,
                     Target::Spiccato => Articulation::Spiccato,
                     Target::Sautille => Articulation::Sautille,
                     Target::Harmonics => Articulation::Harmonics,
+                    Target::ColLegnoTratto => Articulation::ColLegnoTratto,
                     _ => Articulation::ColLegno,
                 };
                 let down = (x * 127.0).round() >= 64.0;

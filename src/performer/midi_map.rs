@@ -48,6 +48,9 @@ pub const COL_LEGNO_CC: u8 = 106;
 pub const SAUTILLE_CC: u8 = 107;
 /// The controller that switches harmonics in the default map (undefined in MIDI too).
 pub const HARMONICS_CC: u8 = 108;
+/// The controller that switches col legno tratto in the default map (undefined in MIDI
+/// too).
+pub const COL_LEGNO_TRATTO_CC: u8 = 109;
 
 /// Most mappings a map holds.
 pub const MAX_MAPPINGS: usize = 24;
@@ -88,11 +91,13 @@ pub enum Target {
     Sautille,
     /// Harmonics while the value is 0.5 or more, arco below it.
     Harmonics,
+    /// Col legno tratto while the value is 0.5 or more, arco below it.
+    ColLegnoTratto,
 }
 
 impl Target {
     /// In the order saved maps index them: new targets go at the end.
-    pub const ALL: [Target; 15] = [
+    pub const ALL: [Target; 16] = [
         Target::Dynamics,
         Target::VibratoDepth,
         Target::VibratoRate,
@@ -108,6 +113,7 @@ impl Target {
         Target::ColLegno,
         Target::Sautille,
         Target::Harmonics,
+        Target::ColLegnoTratto,
     ];
 
     /// The name the editor shows.
@@ -128,6 +134,7 @@ impl Target {
             Target::ColLegno => "Col legno",
             Target::Sautille => "Sautillé",
             Target::Harmonics => "Harmonics",
+            Target::ColLegnoTratto => "Col legno tratto",
         }
     }
 
@@ -230,6 +237,7 @@ impl Default for MidiMap {
             Mapping::new(COL_LEGNO_CC, Target::ColLegno),
             Mapping::new(SAUTILLE_CC, Target::Sautille),
             Mapping::new(HARMONICS_CC, Target::Harmonics),
+            Mapping::new(COL_LEGNO_TRATTO_CC, Target::ColLegnoTratto),
         ] {
             map.add(m);
         }

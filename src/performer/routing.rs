@@ -71,6 +71,8 @@ impl Performer {
         match self.source {
             // Notes the instrument cannot play are ignored.
             Source::Strings => {
+                self.instrument
+                    .set_stick_contact(self.articulation() == Articulation::ColLegnoTratto);
                 let landed = match glide {
                     // A note no harmonic plays (under two octaves above the lowest
                     // string, and no open string's partial) is played stopped.

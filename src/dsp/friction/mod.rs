@@ -304,6 +304,17 @@ impl AnyFriction {
     }
 }
 
+impl AnyFriction {
+    /// The hyperbolic law's coefficients (the static and sliding friction and the
+    /// velocity of the fall between them), used while the model is
+    /// [`FrictionModel::Hyperbolic`].
+    pub fn set_hyperbolic_coefficients(&mut self, mu_s: f64, mu_d: f64, v0_m_per_s: f64) {
+        self.hyperbolic.mu_s = mu_s;
+        self.hyperbolic.mu_d = mu_d;
+        self.hyperbolic.v0_m_per_s = v0_m_per_s;
+    }
+}
+
 impl FrictionContact for AnyFriction {
     #[inline(always)]
     fn solve(&mut self, load: LoadLine, bow: BowInput) -> f64 {
