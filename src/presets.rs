@@ -106,6 +106,14 @@ const FACTORY: &[(&str, &str)] = &[
         include_str!("../assets/presets/double-bass-pizzicato.json"),
     ),
     (
+        "violin-harmonics",
+        include_str!("../assets/presets/violin-harmonics.json"),
+    ),
+    (
+        "cello-col-legno-tratto",
+        include_str!("../assets/presets/cello-col-legno-tratto.json"),
+    ),
+    (
         "thermal-cello",
         include_str!("../assets/presets/thermal-cello.json"),
     ),
