@@ -87,7 +87,7 @@ fn tally(regimes: &[Option<Regime>]) -> (usize, usize, String) {
 
 #[test]
 #[ignore]
-fn tremolo_and_spiccato_regime_survey() {
+fn tremolo_spiccato_and_sautille_regime_survey() {
     for kind in InstrumentKind::ALL {
         for law in [FrictionModel::Hyperbolic, FrictionModel::Stribeck] {
             let (low, _) = kind.note_range();

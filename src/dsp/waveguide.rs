@@ -155,7 +155,8 @@ pub struct WaveguideString {
 struct Touch {
     /// The partial it leaves sounding (0: no finger).
     partial: u32,
-    resistance_kg_per_s: f64,
+    /// Its place on the delay lines, samples from the bridge, and the share of the
+    /// string's velocity it takes out there.
     index: usize,
     share: f64,
     /// The bridge's fractional delay (0.5 to 1.5 samples) ...
@@ -164,8 +165,6 @@ struct Touch {
     /// in `held`.
     unit: bool,
     held: f64,
-    /// The bridge's whole delay at the partial, samples (0: no finger).
-    delay: f64,
 }
 
 /// The string's torsional motion as the bow feels it: a high-pass admittance in parallel
@@ -564,7 +563,6 @@ impl WaveguideString {
         match touch {
             Some((partial, r)) if partial >= 2 && r.is_finite() && r > 0.0 => {
                 self.touch.partial = partial;
-                self.touch.resistance_kg_per_s = r;
                 self.touch.share = r / (r + 2.0 * self.spec.z0_kg_per_s);
             }
             _ if self.touch.partial == 0 => return,
@@ -594,7 +592,6 @@ impl WaveguideString {
         touch.index = k as usize;
         touch.unit = delay >= 1.5;
         touch.fraction.a = Allpass1::coefficient_for_delay(delay - touch.unit as u8 as f64, w);
-        touch.delay = delay;
         Some(delay)
     }
 
