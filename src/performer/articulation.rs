@@ -709,6 +709,31 @@ mod tests {
         assert!(db < -30.0, "the octave below at {db:+.1} dB");
     }
 
+    /// Released, a natural harmonic rings on as an open string does
+    /// (lab/tests/note_release.rs): the cello's D4 as its D string's 2nd partial (nothing
+    /// stops the string) loses less than 6 dB at its pitch from 0.1-0.2 s to 0.3-0.4 s
+    /// after the key is let go (a T60 above 2 s, the string's own losses; measured 2.9 dB).
+    #[test]
+    fn a_released_natural_harmonic_rings_on() {
+        let setup = Setup {
+            articulation: Articulation::Harmonics,
+            preferred_string: Some(1),
+            ..Setup::default()
+        };
+        let mut p = cello_with(&setup);
+        p.note_on(62, 0.8);
+        let mut out = play(&mut p, 1.0);
+        p.note_off(62);
+        out.extend(play(&mut p, 0.5));
+        let f = crate::dsp::vocabulary::midi_to_hz(62.0);
+        let level = |from: f64, to: f64| {
+            let a = partial_amplitude(&out[(from * FS) as usize..(to * FS) as usize], FS, f);
+            20.0 * a.max(1e-15).log10()
+        };
+        let lost = level(1.1, 1.2) - level(1.3, 1.4);
+        assert!(lost < 6.0, "the natural harmonic: {lost:.1} dB down");
+    }
+
     /// Col legno tratto draws the stick across the string: through the performer at the
     /// defaults, on notes of every instrument, the largest friction force the stick
     /// exerts, over the hair's on the same note, is the stick's static friction over the
