@@ -374,19 +374,23 @@ impl Fingering {
         if self.partials[s] > 1 {
             return self.harmonic_hz(s, note);
         }
-        let table = self
-            .intonation
-            .filter(|_| !self.plucked[string.min(STRINGS - 1)]);
+        let table = self.intonation.filter(|_| !self.plucked[s]);
         intonation::tuned_hz(
             table,
             self.intonation_row,
             self.kind,
             string,
             note,
-            self.bend_semitones + self.glides[string] + self.expressions[string].bend_semitones,
+            self.bends_semitones(string),
             self.reference_semitones,
             self.dynamics,
         )
+    }
+
+    /// Every bend on `string`'s note, semitones: the pitch bend, its glide and its own
+    /// expression's bend.
+    fn bends_semitones(&self, string: usize) -> f64 {
+        self.bend_semitones + self.glides[string] + self.expressions[string].bend_semitones
     }
 
     /// A harmonic `note` on string `s`: the pitch its string is stopped at, the note's
@@ -395,8 +399,7 @@ impl Fingering {
     /// pitch does, so the stopped notes' corrections do not carry over
     /// (docs/articulations.md#harmonics).
     fn harmonic_hz(&self, s: usize, note: u8) -> f64 {
-        let played =
-            note as f64 + self.bend_semitones + self.glides[s] + self.expressions[s].bend_semitones;
+        let played = note as f64 + self.bends_semitones(s);
         crate::dsp::vocabulary::midi_to_hz(played + self.reference_semitones)
             / self.partials[s] as f64
     }

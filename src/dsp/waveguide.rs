@@ -167,6 +167,14 @@ struct Touch {
     held: f64,
 }
 
+impl Touch {
+    /// The bridge's delay at `w` rad/sample: its fraction's phase delay and the held
+    /// sample.
+    fn bridge_delay_at(&self, w: f64) -> f64 {
+        Allpass1::phase_delay(self.fraction.a, w) + self.unit as u8 as f64
+    }
+}
+
 /// The string's torsional motion as the bow feels it: a high-pass admittance in parallel
 /// with the transverse one, `Y_t(s) = s / (s + w_c) / (2 Z_t)`. The bow drives the string's
 /// surface, which moves with the transverse velocity plus the torsional one. Above `w_c`
@@ -544,7 +552,7 @@ impl WaveguideString {
         let bridge = if self.touch.partial == 0 {
             0.0
         } else {
-            Allpass1::phase_delay(self.touch.fraction.a, w) + self.touch.unit as u8 as f64
+            self.touch.bridge_delay_at(w)
         };
         2.0 * self.m as f64
             + Allpass1::phase_delay(self.fraction.a, w)
@@ -571,11 +579,6 @@ impl WaveguideString {
         if self.fundamental_hz > 0.0 {
             self.bend_to(self.fundamental_hz);
         }
-    }
-
-    /// The partial a touching finger leaves sounding (0: none).
-    pub fn touched_partial(&self) -> u32 {
-        self.touch.partial
     }
 
     /// Places the touching finger for a partial of `period` samples (`w` its angular
