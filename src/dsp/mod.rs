@@ -21,6 +21,7 @@ pub mod halfband;
 pub mod instrument;
 pub mod intonation;
 pub mod modal;
+pub mod radiation;
 pub mod resample;
 pub mod rubbed;
 pub mod strings;

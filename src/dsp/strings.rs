@@ -35,6 +35,7 @@
 use super::filters::flush_tiny;
 use super::fingering::{BowEnvelope, Fingering};
 use super::intonation::IntonationTable;
+use super::radiation::Radiation;
 use super::resample::Resampler;
 use super::vocabulary::{
     BowControl, Frame, InstrumentKind, NoteExpression, Pluck, Strike, BOW_RAMP_S, MAX_NOTE_BETA,
@@ -188,6 +189,8 @@ pub struct FourStrings<B: StringBank> {
     pending: Option<B::Settings>,
     fade: f64,
     fade_step: f64,
+    /// The sound leaving the body at the host rate ([`Radiation`]).
+    radiation: Radiation,
 }
 
 /// The player's hands on the four strings: the notes and fingers, and the bow on each
@@ -441,6 +444,7 @@ impl<B: StringBank> FourStrings<B> {
             pending: None,
             fade: 1.0,
             fade_step: 1.0 / (RECONFIGURE_FADE_S * host_rate_hz).max(1.0),
+            radiation: Radiation::new(kind.a0_hz(), host_rate_hz),
         }
     }
 
@@ -488,6 +492,7 @@ impl<B: StringBank> FourStrings<B> {
             std::array::from_fn(|i| kind.string_weight_for(i, B::WEIGHT_REFERENCE_Z0));
         self.hands.open_notes = kind.open_notes();
         self.hands.free = [false; STRINGS];
+        self.radiation = Radiation::new(kind.a0_hz(), self.host_rate_hz);
         self.press_every_finger();
     }
 
@@ -809,16 +814,19 @@ impl<B: StringBank> FourStrings<B> {
             return;
         }
         if self.bank.sleep(&self.lifted()) {
-            // What the resampler still holds is below -200 dB: asleep is silence.
+            // What the resampler and the radiation still hold is below -200 dB: asleep
+            // is silence.
             if let Some(r) = &mut self.resampler {
                 r.reset();
             }
+            self.radiation.reset();
         }
     }
 
     /// Silences every string and forgets every note.
     pub fn reset(&mut self) {
         self.bank.reset();
+        self.radiation.reset();
         self.hands.bows = [BowEnvelope::default(); STRINGS];
         self.hands.expressive = [false; STRINGS];
         self.hands.fingering.clear();
@@ -935,6 +943,7 @@ impl<B: StringBank> FourStrings<B> {
     /// The host sample `audio` with the probe, or silence (and a reset) if it is not finite.
     #[inline(always)]
     fn finish(&mut self, audio: f64) -> Frame {
+        let audio = self.radiation.tick(audio);
         if !audio.is_finite() {
             // Cannot happen with finite inputs; if it ever does, recover to silence rather
             // than emit garbage.

@@ -245,6 +245,12 @@ impl InstrumentKind {
         })
     }
 
+    /// The body's air resonance A0, Hz: its first mode, where its radiation turns on
+    /// ([`super::radiation`]).
+    pub fn a0_hz(self) -> f64 {
+        self.body_modes()[0].freq_hz
+    }
+
     /// What the bow force is multiplied by on string `index` when the strings are weighted
     /// ([`super::strings::FourStrings::set_string_weighting`]): the string's impedance over
     /// [`WEIGHT_REFERENCE_Z0`]. Schelleng's limits are both proportional to `Z0` (with the

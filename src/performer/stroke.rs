@@ -66,9 +66,9 @@ pub const ACCENT_MAX: f64 = 0.5;
 /// Decay time of the landing accent, s.
 pub const ACCENT_S: f64 = 0.04;
 /// The gentle start's depth: a note of velocity `v` (0..=1) below 64/127 sets out at
-/// `2^(ONSET_OCTAVES_PER_VELOCITY (v - 64/127))` of the asked bow speed and force: x0.25
-/// (-12.1 dB) at velocity 0, x0.48 (-6.4 dB) at 30, x1 from 64 up.
-pub const ONSET_OCTAVES_PER_VELOCITY: f64 = 4.0;
+/// `2^(ONSET_OCTAVES_PER_VELOCITY (v - 64/127))` of the asked bow speed and force: x0.12
+/// (-18.2 dB) at velocity 0, x0.33 (-9.7 dB) at 30, x1 from 64 up.
+pub const ONSET_OCTAVES_PER_VELOCITY: f64 = 6.0;
 /// Time constant of the gentle start's rise to the asked bow, s.
 pub const ONSET_RISE_S: f64 = 0.2;
 

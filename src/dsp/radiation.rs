@@ -1,0 +1,132 @@
+//! Where the sound leaves the instrument: its radiation below the body's lowest resonance.
+//!
+//! A violin-family body is a box with holes: below its air resonance A0 (the Helmholtz
+//! resonance of the cavity through the f-holes) the air in the holes moves against the
+//! plates and their volume velocities cancel, as in a vented loudspeaker box below its
+//! port tuning, where the radiated pressure falls as the fourth power of frequency (24 dB
+//! an octave: Thiele's vented-box alignments, a fourth-order high-pass at the tuning). The
+//! bodies' modes ([`super::body`], paper B's bridge) give the bridge's motion; this stage
+//! turns it into what a microphone in front of the instrument hears: a fourth-order
+//! Butterworth high-pass at the instrument's A0 (its body's first mode), so that the
+//! lowest string's fundamentals, below A0, come out as weak as a real instrument's.
+//!
+//! ```
+//! use colophony::dsp::radiation::Radiation;
+//! let mut r = Radiation::new(275.0, 48_000.0);
+//! // Far below A0 almost nothing passes once the onset has rung out: (50 / 275)^4.
+//! let out: Vec<f64> = (0..48_000)
+//!     .map(|i| r.tick((2.0 * std::f64::consts::PI * 50.0 * i as f64 / 48e3).sin()))
+//!     .collect();
+//! let low = out[24_000..].iter().fold(0.0f64, |m, x| m.max(x.abs()));
+//! assert!(low < 0.002);
+//! ```
+
+use std::f64::consts::PI;
+
+/// One transposed direct-form II biquad.
+#[derive(Debug, Clone, Copy, Default)]
+struct Biquad {
+    b: [f64; 3],
+    a: [f64; 2],
+    s: [f64; 2],
+}
+
+impl Biquad {
+    /// A second-order high-pass at `f_hz` with quality `q` (bilinear, pre-warped).
+    fn high_pass(f_hz: f64, q: f64, fs: f64) -> Self {
+        let w = 2.0 * PI * (f_hz / fs).min(0.45);
+        let (sin, cos) = w.sin_cos();
+        let alpha = sin / (2.0 * q);
+        let a0 = 1.0 + alpha;
+        Self {
+            b: [
+                (1.0 + cos) / 2.0 / a0,
+                -(1.0 + cos) / a0,
+                (1.0 + cos) / 2.0 / a0,
+            ],
+            a: [-2.0 * cos / a0, (1.0 - alpha) / a0],
+            s: [0.0; 2],
+        }
+    }
+
+    #[inline]
+    fn tick(&mut self, x: f64) -> f64 {
+        let y = self.b[0] * x + self.s[0];
+        self.s[0] = self.b[1] * x - self.a[0] * y + self.s[1];
+        self.s[1] = self.b[2] * x - self.a[1] * y;
+        y
+    }
+}
+
+/// The radiation stage (see the module doc).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Radiation {
+    sections: [Biquad; 2],
+}
+
+/// The quality factors of a fourth-order Butterworth filter's two sections.
+const BUTTERWORTH_Q: [f64; 2] = [0.541_196_100_146_197, 1.306_562_964_876_376_7];
+
+impl Radiation {
+    /// The radiation of a body whose air resonance is `a0_hz`, at `sample_rate_hz`.
+    pub fn new(a0_hz: f64, sample_rate_hz: f64) -> Self {
+        Self {
+            sections: BUTTERWORTH_Q.map(|q| Biquad::high_pass(a0_hz, q, sample_rate_hz)),
+        }
+    }
+
+    #[inline]
+    pub fn tick(&mut self, x: f64) -> f64 {
+        let y = self.sections[0].tick(x);
+        super::filters::flush_tiny(self.sections[1].tick(y))
+    }
+
+    pub fn reset(&mut self) {
+        for s in &mut self.sections {
+            s.s = [0.0; 2];
+        }
+    }
+
+    /// The magnitude response at `f_hz`.
+    pub fn gain(a0_hz: f64, f_hz: f64) -> f64 {
+        1.0 / (1.0 + (a0_hz / f_hz).powi(8)).sqrt()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The stage is a fourth-order high-pass at A0 at every rate: -3 dB at A0, -24 dB an
+    /// octave below and -48 dB two octaves below, unity three octaves above. Tolerance
+    /// 0.5 dB: the bilinear transform matches the analogue filter exactly only at A0.
+    #[test]
+    fn the_radiation_falls_24_db_an_octave_below_a0_and_passes_above() {
+        for fs in [8_000.0, 44_100.0, 48_000.0, 192_000.0] {
+            for a0 in [63.0, 115.0, 275.0] {
+                for (f, expected_db) in [
+                    (a0, -3.01),
+                    (a0 / 2.0, -24.1),
+                    (a0 / 4.0, -48.2),
+                    (a0 * 8.0, 0.0),
+                ] {
+                    if f > 0.4 * fs {
+                        continue;
+                    }
+                    let mut r = Radiation::new(a0, fs);
+                    let n = (fs * (4.0 + 40.0 / f)) as usize;
+                    let y: Vec<f64> = (0..n)
+                        .map(|i| r.tick((2.0 * PI * f * i as f64 / fs).sin()))
+                        .collect();
+                    let tail = &y[n / 2..];
+                    let peak = tail.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                    let db = 20.0 * peak.log10();
+                    assert!(
+                        (db - expected_db).abs() < 0.5,
+                        "fs {fs}, A0 {a0}, {f} Hz: {db:.2} dB"
+                    );
+                }
+            }
+        }
+    }
+}
