@@ -125,7 +125,8 @@ enum Command {
     /// the bowing window (see its options); `intonation --out FILE` measures the bowed
     /// intonation table; `timbre --out DIR [--models ..] [--rates ..] [--instruments ..]`
     /// compares each instrument's played notes with a real player's, band by band (default
-    /// the hyperbolic law at 48 kHz).
+    /// the hyperbolic law at 48 kHz; STK's Bowed on the same notes where libstk-dev is
+    /// installed).
     Bench {
         what: String,
         /// Output directory (precision).

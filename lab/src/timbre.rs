@@ -104,32 +104,74 @@ pub fn played(kind: InstrumentKind, model: TunedModel, rate_hz: f64, note: u8) -
         ..Setup::default()
     };
     let mut performer = Performer::new(kind);
+    if performer.activate(&setup, rate_hz).is_err() {
+        return NoteSpectrum {
+            note,
+            fundamental_hz: midi_to_hz(note as f64),
+            amplitudes: Vec::new(),
+        };
+    }
+    performer.configure(&setup);
+    performer.note_on(note, VELOCITY);
+    let bow = BowControl::default();
+    let n = (NOTE_S * rate_hz) as usize;
+    let out: Vec<f64> = (0..n).map(|_| performer.tick(bow).audio).collect();
+    measured(&out, rate_hz, note)
+}
+
+/// The harmonics of `note` in `out` (a render of [`NOTE_S`] at `rate_hz`), read from its
+/// steady part: the fundamental is the strongest peak within a semitone of the note's.
+pub fn measured(out: &[f64], rate_hz: f64, note: u8) -> NoteSpectrum {
     let mut amplitudes = Vec::new();
-    let mut fundamental_hz = midi_to_hz(note as f64);
-    if performer.activate(&setup, rate_hz).is_ok() {
-        performer.configure(&setup);
-        performer.note_on(note, VELOCITY);
-        let bow = BowControl::default();
-        let n = (NOTE_S * rate_hz) as usize;
-        let out: Vec<f64> = (0..n).map(|_| performer.tick(bow).audio).collect();
-        let steady = &out[(STEADY_FROM_S * rate_hz) as usize..];
-        fundamental_hz = peak_frequency_hz(steady, rate_hz, fundamental_hz, 100.0);
-        let top = MAX_HARMONIC_HZ.min(0.45 * rate_hz);
-        let mut h = 1;
-        while h as f64 * fundamental_hz <= top {
-            amplitudes.push(partial_amplitude(
-                steady,
-                rate_hz,
-                h as f64 * fundamental_hz,
-            ));
-            h += 1;
-        }
+    let from = ((STEADY_FROM_S * rate_hz) as usize).min(out.len());
+    let steady = &out[from..];
+    let fundamental_hz = peak_frequency_hz(steady, rate_hz, midi_to_hz(note as f64), 100.0);
+    let top = MAX_HARMONIC_HZ.min(0.45 * rate_hz);
+    let mut h = 1;
+    while h as f64 * fundamental_hz <= top {
+        amplitudes.push(partial_amplitude(
+            steady,
+            rate_hz,
+            h as f64 * fundamental_hz,
+        ));
+        h += 1;
     }
     NoteSpectrum {
         note,
         fundamental_hz,
         amplitudes,
     }
+}
+
+/// The lowest frequency STK's `Bowed` is built for in the timbre bench, Hz (its
+/// constructor's `lowestFrequency` in `assets/peers/stk_bowed.cpp`): lower notes are left
+/// out of its row.
+pub const STK_LOWEST_HZ: f64 = 50.0;
+
+/// `note` played by STK's `stk::Bowed` at its own defaults (the driver `stk`, built by
+/// [`crate::precision::peers::build_stk`]) for [`NOTE_S`] at `rate_hz`, measured as
+/// [`measured`]; `None` if the driver fails.
+pub fn played_by_stk(stk: &Path, dir: &Path, rate_hz: f64, note: u8) -> Option<NoteSpectrum> {
+    let raw = dir.join(format!("stk-{note}.f32"));
+    let status = std::process::Command::new(stk)
+        .arg(format!("{NOTE_S}"))
+        .arg(format!("{rate_hz}"))
+        .arg(format!("{}", midi_to_hz(note as f64)))
+        .arg(&raw)
+        .arg("1")
+        .stdout(std::process::Stdio::null())
+        .status()
+        .ok()?;
+    if !status.success() {
+        return None;
+    }
+    let bytes = std::fs::read(&raw).ok()?;
+    let _ = std::fs::remove_file(&raw);
+    let out: Vec<f64> = bytes
+        .chunks_exact(4)
+        .map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]]) as f64)
+        .collect();
+    Some(measured(&out, rate_hz, note))
 }
 
 /// The index of the base-10 third-octave band holding `hz` (centre `10^(k/10)`).
@@ -190,7 +232,8 @@ pub fn profile(n: &NoteSpectrum) -> Vec<f64> {
 #[derive(Debug, Clone)]
 pub struct Score {
     pub kind: InstrumentKind,
-    pub model: TunedModel,
+    /// The model's name, or the peer's.
+    pub model: &'static str,
     pub rate_hz: f64,
     pub notes: Vec<u8>,
     /// Band indices, the model's and the reference's curves, dB.
@@ -212,6 +255,19 @@ pub fn score(kind: InstrumentKind, model: TunedModel, rate_hz: f64) -> Score {
         .par_iter()
         .map(|&n| played(kind, model, rate_hz, n))
         .collect();
+    scored(kind, model.name(), rate_hz, played_notes)
+}
+
+/// Scores `played_notes` of `kind` (named `model`, at `rate_hz`) against the reference's
+/// same notes.
+pub fn scored(
+    kind: InstrumentKind,
+    model: &'static str,
+    rate_hz: f64,
+    played_notes: Vec<NoteSpectrum>,
+) -> Score {
+    let reference_notes = reference(kind);
+    let notes: Vec<u8> = played_notes.iter().map(|n| n.note).collect();
     let refs: Vec<&NoteSpectrum> = notes
         .iter()
         .filter_map(|n| reference_notes.iter().find(|r| r.note == *n))
@@ -268,6 +324,34 @@ pub fn run(
             }
         }
     }
+    // STK's `Bowed` on the same notes at the first rate, where g++ and libstk-dev are
+    // installed: its one string and body for every instrument.
+    match crate::precision::peers::build_stk(out) {
+        Ok(stk) => {
+            let rate = rates[0];
+            for &kind in kinds {
+                let reference_notes = reference(kind);
+                let notes: Vec<u8> = notes(kind, &reference_notes)
+                    .into_iter()
+                    .filter(|&n| midi_to_hz(n as f64) >= STK_LOWEST_HZ)
+                    .collect();
+                let played: Option<Vec<NoteSpectrum>> = notes
+                    .par_iter()
+                    .map(|&n| played_by_stk(&stk, out, rate, n))
+                    .collect();
+                match played {
+                    Some(played) => scores.push(scored(kind, "stk-bowed", rate, played)),
+                    None => eprintln!("STK's Bowed failed on {}: its row is left out", kind.name()),
+                }
+            }
+            for name in ["stk_bowed", "stk_bowed.cpp"] {
+                let _ = std::fs::remove_file(out.join(name));
+            }
+        }
+        Err(e) => eprintln!(
+            "STK's Bowed is not compared ({e}; scripts/install-peers.sh or apt-get install libstk-dev g++)"
+        ),
+    }
     let mut bands_csv =
         String::from("instrument,model,rate_hz,band_hz,reference_db,played_db,difference_db\n");
     let mut summary_csv =
@@ -281,13 +365,13 @@ pub fn run(
                 bands_csv,
                 "{},{},{},{:.0},{r:.2},{p:.2},{:.2}",
                 s.kind.name(),
-                s.model.name(),
+                s.model,
                 s.rate_hz,
                 centre_hz(*b),
                 p - r
             );
         }
-        let (kind, model, rate, notes) = (s.kind.name(), s.model.name(), s.rate_hz, s.notes.len());
+        let (kind, model, rate, notes) = (s.kind.name(), s.model, s.rate_hz, s.notes.len());
         let (rms, worst, profile) = (s.rms_db, s.worst_db, s.profile_db);
         let _ = writeln!(
             summary_csv,
@@ -313,14 +397,16 @@ pub fn run(
     write("summary.csv", &summary_csv)?;
     let first: Vec<&Score> = scores
         .iter()
-        .filter(|s| s.model == models[0] && s.rate_hz == rates[0])
+        .filter(|s| s.model == models[0].name() && s.rate_hz == rates[0])
         .collect();
-    figure(&out.join("timbre.png"), &first)?;
+    let peers: Vec<&Score> = scores.iter().filter(|s| s.model == "stk-bowed").collect();
+    figure(&out.join("timbre.png"), &first, &peers)?;
     Ok(table)
 }
 
-/// One panel per instrument: the model's long-term spectrum against the reference's.
-fn figure(out: &Path, scores: &[&Score]) -> Result<(), String> {
+/// One panel per instrument: the model's long-term spectrum against the reference's, and
+/// STK's where `peers` holds the instrument.
+fn figure(out: &Path, scores: &[&Score], peers: &[&Score]) -> Result<(), String> {
     use plotters::prelude::*;
     crate::figures::fonts();
     let err = |e: &dyn std::fmt::Display| e.to_string();
@@ -339,7 +425,7 @@ fn figure(out: &Path, scores: &[&Score]) -> Result<(), String> {
                 format!(
                     "{} ({}): RMS {:.1} dB, profile {:.1} dB",
                     s.kind.name(),
-                    s.model.name(),
+                    s.model,
                     s.rms_db,
                     s.profile_db
                 ),
@@ -371,6 +457,16 @@ fn figure(out: &Path, scores: &[&Score]) -> Result<(), String> {
             .map_err(|e| err(&e))?
             .label("Colophony")
             .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], RED.stroke_width(2)));
+        if let Some(peer) = peers.iter().find(|p| p.kind == s.kind) {
+            let colour = BLUE.mix(0.6);
+            chart
+                .draw_series(LineSeries::new(pts(&peer.played), colour.stroke_width(1)))
+                .map_err(|e| err(&e))?
+                .label(format!("STK Bowed: RMS {:.1} dB", peer.rms_db))
+                .legend(move |(x, y)| {
+                    PathElement::new([(x, y), (x + 16, y)], colour.stroke_width(1))
+                });
+        }
         chart
             .configure_series_labels()
             .background_style(WHITE.mix(0.8))
