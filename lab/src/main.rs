@@ -640,7 +640,7 @@ fn play_note(
     release: Option<f64>,
     out: &std::path::Path,
 ) -> Result<(f64, f32), String> {
-    use colophony_lab::midi_file::{render_events, MidiEvent, Timed};
+    use colophony_lab::midi_file::{one_note, render_events};
     if !(seconds.is_finite() && seconds > 0.0 && seconds <= 3600.0) {
         return Err(format!("--seconds must be within 0..=3600, got {seconds}"));
     }
@@ -654,18 +654,7 @@ fn play_note(
     }
     let at = |t: f64| (t * how.sample_rate_hz).round() as u64;
     let lift = release.unwrap_or(seconds).clamp(0.0, seconds);
-    let events = [
-        Timed {
-            sample: 0,
-            channel: 0,
-            event: MidiEvent::NoteOn(note, 100),
-        },
-        Timed {
-            sample: at(lift),
-            channel: 0,
-            event: MidiEvent::NoteOff(note),
-        },
-    ];
+    let events = one_note(note, 100, at(lift));
     let frames = at(seconds) as usize;
     render_events(&events, how, Some(frames), out)
 }

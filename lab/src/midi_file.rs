@@ -39,6 +39,23 @@ pub struct Timed {
     pub event: MidiEvent,
 }
 
+/// One note on channel 0: `note` at `velocity` from sample 0, released at sample
+/// `release`.
+pub fn one_note(note: u8, velocity: u8, release: u64) -> [Timed; 2] {
+    [
+        Timed {
+            sample: 0,
+            channel: 0,
+            event: MidiEvent::NoteOn(note, velocity),
+        },
+        Timed {
+            sample: release,
+            channel: 0,
+            event: MidiEvent::NoteOff(note),
+        },
+    ]
+}
+
 /// The longest ring-out rendered after the last event, s.
 pub const MAX_TAIL_S: f64 = 10.0;
 /// The ring-out ends once the output has stayed below this for [`QUIET_S`] (-100 dBFS:

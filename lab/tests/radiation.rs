@@ -8,24 +8,13 @@
 use colophony::analysis::rms;
 use colophony::dsp::friction::FrictionModel;
 use colophony::dsp::vocabulary::InstrumentKind;
-use colophony_lab::midi_file::{perform, MidiEvent, Performance, Timed};
+use colophony_lab::midi_file::{one_note, perform, Performance};
 
 const FS: f64 = 48_000.0;
 
 /// `note` held 1.5 s at velocity 100 through the performer at the plugin's defaults.
 fn held(kind: InstrumentKind, law: Option<FrictionModel>, note: u8) -> Vec<f64> {
-    let events = [
-        Timed {
-            sample: 0,
-            channel: 0,
-            event: MidiEvent::NoteOn(note, 100),
-        },
-        Timed {
-            sample: (1.5 * FS) as u64,
-            channel: 0,
-            event: MidiEvent::NoteOff(note),
-        },
-    ];
+    let events = one_note(note, 100, (1.5 * FS) as u64);
     let how = Performance::plugin_defaults(kind, law, FS);
     perform(&events, &how, |_, _| {})
         .expect("the note plays")
