@@ -492,7 +492,7 @@ impl<B: StringBank> FourStrings<B> {
             std::array::from_fn(|i| kind.string_weight_for(i, B::WEIGHT_REFERENCE_Z0));
         self.hands.open_notes = kind.open_notes();
         self.hands.free = [false; STRINGS];
-        self.radiation = Radiation::new(kind.a0_hz(), self.host_rate_hz);
+        self.radiation.retune(kind.a0_hz(), self.host_rate_hz);
         self.press_every_finger();
     }
 
