@@ -106,6 +106,10 @@ const FACTORY: &[(&str, &str)] = &[
         include_str!("../assets/presets/double-bass-pizzicato.json"),
     ),
     (
+        "violin-sautille",
+        include_str!("../assets/presets/violin-sautille.json"),
+    ),
+    (
         "violin-harmonics",
         include_str!("../assets/presets/violin-harmonics.json"),
     ),
