@@ -8,7 +8,8 @@
 //! CC2 and channel pressure set the dynamics, CC1 the vibrato depth. The bow's own
 //! velocity, force and position are the constants given.
 
-use colophony::dsp::vocabulary::{BowControl, Frame};
+use colophony::dsp::friction::FrictionModel;
+use colophony::dsp::vocabulary::{BowControl, Frame, InstrumentKind};
 use colophony::measure::contact::ContactSample;
 use colophony::performer::{Event, Performer, Setup, Status};
 use midly::{MetaMessage, MidiMessage, Smf, Timing, TrackEventKind};
@@ -54,6 +55,27 @@ pub fn one_note(note: u8, velocity: u8, release: u64) -> [Timed; 2] {
             event: MidiEvent::NoteOff(note),
         },
     ]
+}
+
+/// `note` at `velocity` played alone through the performer at the plugin's defaults
+/// ([`Performance::plugin_defaults`] with `law`, `None` for paper B's thermal model) and
+/// released after `held_s`: the audio of those `held_s` seconds.
+pub fn one_note_audio(
+    kind: InstrumentKind,
+    law: Option<FrictionModel>,
+    note: u8,
+    velocity: u8,
+    held_s: f64,
+    sample_rate_hz: f64,
+) -> Vec<f64> {
+    let held = (held_s * sample_rate_hz) as u64;
+    let how = Performance::plugin_defaults(kind, law, sample_rate_hz);
+    perform(&one_note(note, velocity, held), &how, |_, _| {})
+        .expect("one note plays")
+        .into_iter()
+        .map(f64::from)
+        .take(held as usize)
+        .collect()
 }
 
 /// The longest ring-out rendered after the last event, s.

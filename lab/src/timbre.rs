@@ -255,18 +255,18 @@ pub fn score(kind: InstrumentKind, model: TunedModel, rate_hz: f64) -> Score {
         .par_iter()
         .map(|&n| played(kind, model, rate_hz, n))
         .collect();
-    scored(kind, model.name(), rate_hz, played_notes)
+    scored(kind, model.name(), rate_hz, played_notes, &reference_notes)
 }
 
-/// Scores `played_notes` of `kind` (named `model`, at `rate_hz`) against the reference's
-/// same notes.
+/// Scores `played_notes` of `kind` (named `model`, at `rate_hz`) against the same notes of
+/// `reference_notes` (the reference's, [`reference`]).
 pub fn scored(
     kind: InstrumentKind,
     model: &'static str,
     rate_hz: f64,
     played_notes: Vec<NoteSpectrum>,
+    reference_notes: &[NoteSpectrum],
 ) -> Score {
-    let reference_notes = reference(kind);
     let notes: Vec<u8> = played_notes.iter().map(|n| n.note).collect();
     let refs: Vec<&NoteSpectrum> = notes
         .iter()
@@ -340,7 +340,9 @@ pub fn run(
                     .map(|&n| played_by_stk(&stk, out, rate, n))
                     .collect();
                 match played {
-                    Some(played) => scores.push(scored(kind, "stk-bowed", rate, played)),
+                    Some(played) => {
+                        scores.push(scored(kind, "stk-bowed", rate, played, &reference_notes))
+                    }
                     None => eprintln!("STK's Bowed failed on {}: its row is left out", kind.name()),
                 }
             }

@@ -6,7 +6,7 @@
 use colophony::analysis::{cents, partial_amplitude, peak_frequency_hz, rms};
 use colophony::dsp::friction::FrictionModel;
 use colophony::dsp::vocabulary::InstrumentKind;
-use colophony_lab::midi_file::{one_note, perform, Performance};
+use colophony_lab::midi_file::one_note_audio;
 
 const FS: f64 = 48_000.0;
 
@@ -23,14 +23,7 @@ fn pitch_window_s(note: u8) -> (f64, f64) {
 
 /// One separate note at `velocity` (1..=127), held [`HELD_S`]: the audio.
 fn play(kind: InstrumentKind, law: Option<FrictionModel>, note: u8, velocity: u8) -> Vec<f64> {
-    let events = one_note(note, velocity, (HELD_S * FS) as u64);
-    let how = Performance::plugin_defaults(kind, law, FS);
-    perform(&events, &how, |_, _| {})
-        .expect("the note plays")
-        .into_iter()
-        .map(f64::from)
-        .take((HELD_S * FS) as usize)
-        .collect()
+    one_note_audio(kind, law, note, velocity, HELD_S, FS)
 }
 
 /// The peak level, dB: the largest RMS over 10 ms windows (hop 2.5 ms), the level a

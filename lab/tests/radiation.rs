@@ -8,21 +8,9 @@
 use colophony::analysis::rms;
 use colophony::dsp::friction::FrictionModel;
 use colophony::dsp::vocabulary::InstrumentKind;
-use colophony_lab::midi_file::{one_note, perform, Performance};
+use colophony_lab::midi_file::one_note_audio;
 
 const FS: f64 = 48_000.0;
-
-/// `note` held 1.5 s at velocity 100 through the performer at the plugin's defaults.
-fn held(kind: InstrumentKind, law: Option<FrictionModel>, note: u8) -> Vec<f64> {
-    let events = one_note(note, 100, (1.5 * FS) as u64);
-    let how = Performance::plugin_defaults(kind, law, FS);
-    perform(&events, &how, |_, _| {})
-        .expect("the note plays")
-        .into_iter()
-        .map(f64::from)
-        .take((1.5 * FS) as usize)
-        .collect()
-}
 
 #[test]
 fn a_held_stroke_sounds_without_the_bows_steady_push() {
@@ -38,7 +26,8 @@ fn a_held_stroke_sounds_without_the_bows_steady_push() {
         let open = kind.open_notes();
         for note in [open[0], open[1] + 5, open[3] + 7] {
             for law in laws {
-                let out = held(kind, law, note);
+                // `note` held 1.5 s at velocity 100.
+                let out = one_note_audio(kind, law, note, 100, 1.5, FS);
                 // The stroke's steady part: from 0.5 s (the attack and the radiation's
                 // onset over) to the release. 0.5 s holds at least 20 periods of the
                 // lowest note (E1, 41 Hz), so a sounding part's own mean over it is

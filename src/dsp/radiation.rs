@@ -96,11 +96,6 @@ impl Radiation {
             s.s = [0.0; 2];
         }
     }
-
-    /// The magnitude response at `f_hz`.
-    pub fn gain(a0_hz: f64, f_hz: f64) -> f64 {
-        1.0 / (1.0 + (a0_hz / f_hz).powi(8)).sqrt()
-    }
 }
 
 #[cfg(test)]
