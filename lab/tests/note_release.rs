@@ -61,15 +61,17 @@ const LAWS: [Option<FrictionModel>; 5] = [
 ];
 
 /// Cases known to miss the criterion, with the law: the cello's F3 after Bb2 with the
-/// point laws. The released Bb2 falls 16-17 dB in its first 50 ms, but the new F3 is still
+/// point laws. The released Bb2 falls 14-15 dB in its first 50 ms, but the new F3 is still
 /// 8-10 dB under its own steady level there (it speaks slowly: docs/testing.md), so the
-/// Bb2 is only 6.4-9.2 dB under it (measured at 48 kHz). The test fails if one of them
-/// comes to pass, so the list is kept true.
-const KNOWN_SLOW_NEXT: [(InstrumentKind, u8, &str); 4] = [
+/// Bb2 is only 5.2-7.0 dB under it; and the viola's Bb3 after D#3 with paper B's thermal
+/// bow, 11.7 dB (measured at 48 kHz). The test fails if one of them comes to pass, so the
+/// list is kept true.
+const KNOWN_SLOW_NEXT: [(InstrumentKind, u8, &str); 5] = [
     (InstrumentKind::Cello, 46, "hyperbolic"),
     (InstrumentKind::Cello, 46, "static"),
     (InstrumentKind::Cello, 46, "lugre"),
     (InstrumentKind::Cello, 46, "elasto-plastic"),
+    (InstrumentKind::Viola, 51, "thermal"),
 ];
 
 #[test]
