@@ -39,7 +39,7 @@ fn a_held_stroke_sounds_without_the_bows_steady_push() {
                 let share = mean.abs() / level;
                 worst = worst.max(share);
                 // 2 %: a percent for the window's partial period, a percent of margin
-                // (measured 0.51 % at most); without the radiation stage the violin's
+                // (measured 0.48 % at most); without the radiation stage the violin's
                 // open G alone had a mean of 87 % of its output's RMS.
                 assert!(
                     share < 0.02,
