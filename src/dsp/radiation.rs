@@ -6,7 +6,7 @@
 //! port tuning. The vented-box theory (Thiele) gives a pressure that falls as the fourth
 //! power of frequency there (24 dB an octave); the measured fall is steeper: Bissinger's
 //! radiation per unit of bridge velocity of a violin (2002, fig. 1) falls by about 20 dB
-//! from its A0 peak to 220 Hz, 45-65 dB an octave, and the four recorded instruments of
+//! from its A0 peak to 220 Hz, 45-50 dB an octave, and the four recorded instruments of
 //! the timbre benchmark (docs/timbre.md) give their lowest string's fundamentals, below
 //! A0, 14-19 dB under what a fourth-order fall leaves. The bodies' modes
 //! ([`super::body`], paper B's bridge) give the bridge's motion; this stage turns it into
