@@ -66,6 +66,92 @@ pub fn muted_bridge_mode(mode: BridgeMode, scale: f64) -> BridgeMode {
 
 pub use super::vocabulary::BodyMode;
 
+/// How long a body takes to move to a mute's modes and back, s: the old body fades out
+/// as the new fades in, so the switch does not click (a player takes longer to slide a
+/// mute on).
+pub const MUTE_FADE_S: f64 = 0.05;
+
+/// The modes `kind`'s body plays, and how many: `custom` (a fitted bridge's passive
+/// reduction, [`body_from_bridge`]; at most [`MAX_BODY_MODES`] are kept) or the generic
+/// ones, each loaded by a mute ([`muted`]) when `with_mute`.
+pub fn body_modes_for(
+    kind: super::vocabulary::InstrumentKind,
+    custom: Option<&[BodyMode]>,
+    with_mute: bool,
+) -> ([BodyMode; MAX_BODY_MODES], usize) {
+    let mut modes = [BodyMode {
+        freq_hz: 0.0,
+        q: 1.0,
+        gain: 0.0,
+    }; MAX_BODY_MODES];
+    let generic = kind.body_modes();
+    let chosen = custom.unwrap_or(&generic);
+    let n = chosen.len().min(MAX_BODY_MODES);
+    modes[..n].copy_from_slice(&chosen[..n]);
+    if with_mute {
+        let scale = kind.spec().body_scale;
+        for mode in &mut modes[..n] {
+            *mode = muted(*mode, scale);
+        }
+    }
+    (modes, n)
+}
+
+/// A body that moves to new modes without a click: the new modes start from the old
+/// ones' ringing state ([`BodyModes::retune`]) and the old body rings on as it fades out
+/// over [`MUTE_FADE_S`] (linearly: the new from 0 to 1, the old from 1 to 0).
+#[derive(Debug, Clone)]
+pub struct FadingBody {
+    /// The body now playing (without the fading one).
+    pub playing: BodyModes,
+    before: BodyModes,
+    fade_left: u32,
+    fade_total: f64,
+}
+
+impl FadingBody {
+    pub fn new(body: BodyModes, sample_rate_hz: f64) -> Self {
+        Self {
+            before: body.clone(),
+            playing: body,
+            fade_left: 0,
+            fade_total: (MUTE_FADE_S * sample_rate_hz).max(1.0),
+        }
+    }
+
+    /// Moves to `body`'s modes, fading out the present ones over [`MUTE_FADE_S`].
+    pub fn fade_to(&mut self, body: &BodyModes, sample_rate_hz: f64) {
+        self.before = self.playing.clone();
+        self.playing.retune(body);
+        self.fade_left = (MUTE_FADE_S * sample_rate_hz).round() as u32;
+        self.fade_total = (MUTE_FADE_S * sample_rate_hz).max(1.0);
+    }
+
+    /// Whether the old modes are still fading out.
+    pub fn is_fading(&self) -> bool {
+        self.fade_left > 0
+    }
+
+    /// One sample of the bridge force `x` through the body, and the fading one while it
+    /// fades.
+    #[inline]
+    pub fn tick(&mut self, x: f64) -> f64 {
+        if self.fade_left > 0 {
+            let new = 1.0 - self.fade_left as f64 / self.fade_total;
+            self.fade_left -= 1;
+            new * self.playing.tick(x) + (1.0 - new) * self.before.tick(x)
+        } else {
+            self.playing.tick(x)
+        }
+    }
+
+    /// Silences the body and ends a fade.
+    pub fn reset(&mut self) {
+        self.playing.reset();
+        self.fade_left = 0;
+    }
+}
+
 /// The modes as parallel band-pass biquads ([`Bandpass`]'s transposed direct form II),
 /// stored lane by lane so that one sample's update of every mode is a few vector
 /// operations. Unused lanes hold zero coefficients and stay at zero.

@@ -27,7 +27,8 @@
 //! assert!(peak > 0.01 && peak < 1.0);
 //! ```
 
-use super::body::{BodyMode, BodyModes, MAX_BODY_MODES};
+pub use super::body::MUTE_FADE_S;
+use super::body::{body_modes_for, BodyMode, BodyModes, FadingBody, MAX_BODY_MODES};
 use super::friction::bristle::{BristleParams, SolverStats};
 use super::friction::{AnyFriction, BowInput, FrictionContact, FrictionModel, HyperbolicFriction};
 use super::halfband::HalfbandDecimator;
@@ -64,7 +65,8 @@ pub struct WaveguideBank {
     /// [`Instrument::native`]).
     sample_rate_hz: f64,
     voices: [StringVoice; STRINGS],
-    body: BodyModes,
+    /// The body, fading to a mute's modes and back ([`FadingBody`]).
+    body: FadingBody,
     /// Each instrument's body in place of the generic one ([`Instrument::set_body`]):
     /// modes and their count, per [`InstrumentKind::ALL`] index.
     custom_bodies: [Option<([BodyMode; MAX_BODY_MODES], usize)>; InstrumentKind::COUNT],
@@ -87,10 +89,6 @@ pub struct WaveguideBank {
     /// A stick is striking a string (col legno), or the body is moving to a mute's modes:
     /// [`WaveguideBank::sample_slow`].
     slow: bool,
-    /// The body before the mute went on or came off, faded out over the next
-    /// `body_fade_left` samples as the new one fades in (`MUTE_FADE_S`).
-    body_before: BodyModes,
-    body_fade_left: u32,
     /// The friction law the strings play with the hair ([`Instrument::set_friction_model`])
     /// and whether the hair yields ([`Instrument::set_bow_hair`]), kept while the stick
     /// plays instead ([`Instrument::set_stick_contact`]).
@@ -120,28 +118,10 @@ impl WaveguideBank {
 
     /// The body `kind` plays: its custom one if set, else the generic one.
     fn body_of(&self, kind: InstrumentKind) -> BodyModes {
-        let mut modes = [BodyMode {
-            freq_hz: 0.0,
-            q: 1.0,
-            gain: 0.0,
-        }; MAX_BODY_MODES];
-        let n = match &self.custom_bodies[kind.index()] {
-            Some((custom, n)) => {
-                modes[..*n].copy_from_slice(&custom[..*n]);
-                *n
-            }
-            None => {
-                let generic = kind.body_modes();
-                modes[..generic.len()].copy_from_slice(&generic);
-                generic.len()
-            }
-        };
-        if self.muted {
-            let scale = kind.spec().body_scale;
-            for mode in &mut modes[..n] {
-                *mode = super::body::muted(*mode, scale);
-            }
-        }
+        let custom = self.custom_bodies[kind.index()]
+            .as_ref()
+            .map(|(modes, n)| &modes[..*n]);
+        let (modes, n) = body_modes_for(kind, custom, self.muted);
         BodyModes::new(&modes[..n], 1.0, self.sample_rate_hz)
     }
 }
@@ -189,12 +169,8 @@ impl StringBank for WaveguideBank {
     fn set_mute(&mut self, on: bool) {
         if on != self.muted {
             self.muted = on;
-            // The new modes start from the old ones' ringing state; the old body rings on
-            // as it fades out.
-            self.body_before = self.body.clone();
             let body = self.body_of(self.kind);
-            self.body.retune(&body);
-            self.body_fade_left = (MUTE_FADE_S * self.sample_rate_hz).round() as u32;
+            self.body.fade_to(&body, self.sample_rate_hz);
             self.slow = true;
         }
     }
@@ -251,9 +227,10 @@ impl StringBank for WaveguideBank {
     fn sleep(&mut self, lifted: &[bool; STRINGS]) -> bool {
         // The body sleeps too once no string is awake and its modes have rung out
         // (state below 1e-12 N: output below -200 dB of a bowed note).
-        self.body_asleep = self.voices.iter().all(|v| !v.awake) && self.body.is_quiet(BODY_QUIET_N);
+        self.body_asleep =
+            self.voices.iter().all(|v| !v.awake) && self.body.playing.is_quiet(BODY_QUIET_N);
         if self.body_asleep {
-            self.body.reset();
+            self.body.playing.reset();
             self.decimator.reset();
         }
         for (voice, &lifted) in self.voices.iter_mut().zip(lifted) {
@@ -273,7 +250,7 @@ impl StringBank for WaveguideBank {
         let body_s = if self.body_asleep {
             0.0
         } else {
-            self.body.samples_below(BODY_QUIET_N) / self.sample_rate_hz
+            self.body.playing.samples_below(BODY_QUIET_N) / self.sample_rate_hz
         };
         let mut longest = 0.0f64;
         for (voice, &lifted) in self.voices.iter().zip(lifted) {
@@ -311,7 +288,6 @@ impl StringBank for WaveguideBank {
             voice.awake = false;
         }
         self.body.reset();
-        self.body_fade_left = 0;
         self.decimator.reset();
         self.probe = (0.0, 0.0);
     }
@@ -332,7 +308,7 @@ impl WaveguideBank {
     #[inline(never)]
     fn sample_slow(&mut self, probed: usize, bow_of: impl FnMut(usize) -> StringBow) -> f64 {
         let out = self.sample_as::<true>(probed, bow_of);
-        self.slow = self.body_fade_left > 0 || self.voices.iter().any(|v| v.string.is_struck());
+        self.slow = self.body.is_fading() || self.voices.iter().any(|v| v.string.is_struck());
         out
     }
 
@@ -389,23 +365,14 @@ impl WaveguideBank {
         if any_fine {
             bridge += self.decimator.tick(fine[0], fine[1]);
         }
-        let body = if SLOW && self.body_fade_left > 0 {
-            // Linear: the new body from 0 to 1 over the fade, the old from 1 to 0.
-            let total = (MUTE_FADE_S * self.sample_rate_hz).max(1.0);
-            let new = 1.0 - self.body_fade_left as f64 / total;
-            self.body_fade_left -= 1;
-            new * self.body.tick(bridge) + (1.0 - new) * self.body_before.tick(bridge)
-        } else {
+        let body = if SLOW {
             self.body.tick(bridge)
+        } else {
+            self.body.playing.tick(bridge)
         };
         super::filters::flush_tiny(body * self.output_scale)
     }
 }
-
-/// How long the body takes to move to a mute's modes and back, s: the old body fades out
-/// as the new fades in, so the switch does not click (a player takes longer to slide a
-/// mute on).
-pub const MUTE_FADE_S: f64 = 0.05;
 
 impl Instrument {
     /// The instrument the plugin plays at host rate `host_rate_hz`: strings and body at
@@ -482,7 +449,10 @@ impl Instrument {
             kind,
             sample_rate_hz,
             voices,
-            body: BodyModes::new(&kind.body_modes(), 1.0, sample_rate_hz),
+            body: FadingBody::new(
+                BodyModes::new(&kind.body_modes(), 1.0, sample_rate_hz),
+                sample_rate_hz,
+            ),
             custom_bodies: [None; InstrumentKind::COUNT],
             output_scale: kind.output_scale_per_n(),
             probe: (0.0, 0.0),
@@ -496,8 +466,6 @@ impl Instrument {
             hair: true,
             stick: false,
             slow: false,
-            body_before: BodyModes::new(&kind.body_modes(), 1.0, sample_rate_hz),
-            body_fade_left: 0,
         };
         Self::from_bank(
             bank,
@@ -530,7 +498,7 @@ impl Instrument {
             voice.contact.set_sample_rate(string_rate_hz);
             voice.awake = false;
         }
-        bank.body = bank.body_of(kind);
+        bank.body.playing = bank.body_of(kind);
         bank.output_scale = kind.output_scale_per_n();
     }
 
@@ -552,7 +520,7 @@ impl Instrument {
             (kept, n)
         });
         if kind == bank.kind {
-            bank.body = bank.body_of(kind);
+            bank.body.playing = bank.body_of(kind);
             bank.body_asleep = false;
         }
     }
