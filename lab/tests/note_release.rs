@@ -63,14 +63,20 @@ const LAWS: [Option<FrictionModel>; 5] = [
 /// Cases known to miss the criterion, with the law: the cello's F3 after Bb2 with the
 /// point laws. The released Bb2 falls 14-15 dB in its first 50 ms, but the new F3 is still
 /// 8-10 dB under its own steady level there (it speaks slowly: docs/testing.md), so the
-/// Bb2 is only 5.2-7.0 dB under it; and the viola's Bb3 after D#3 with paper B's thermal
-/// bow, 11.7 dB (measured at 48 kHz). The test fails if one of them comes to pass, so the
-/// list is kept true.
-const KNOWN_SLOW_NEXT: [(InstrumentKind, u8, &str); 5] = [
+/// Bb2 is only 5.2-7.0 dB under it. With paper B's thermal bow, whose sound leaves
+/// through the same body: the released note rings on in the body's modes (it falls
+/// 14-21 dB in 50 ms, as the point laws' do) while the new note is slower to speak (4-10
+/// dB under the point laws' there), so the cello's F3 after Bb2 reads +2.2 dB, its B2
+/// after E2 -6.8, its B3 after E3 -11.8, and the viola's Bb3 after D#3 -10.6 (measured
+/// at 48 kHz). The test fails if one of them comes to pass, so the list is kept true.
+const KNOWN_SLOW_NEXT: [(InstrumentKind, u8, &str); 8] = [
     (InstrumentKind::Cello, 46, "hyperbolic"),
     (InstrumentKind::Cello, 46, "static"),
     (InstrumentKind::Cello, 46, "lugre"),
     (InstrumentKind::Cello, 46, "elasto-plastic"),
+    (InstrumentKind::Cello, 46, "thermal"),
+    (InstrumentKind::Cello, 40, "thermal"),
+    (InstrumentKind::Cello, 52, "thermal"),
     (InstrumentKind::Viola, 51, "thermal"),
 ];
 

@@ -130,6 +130,8 @@ impl StringBank for WaveguideBank {
     type Settings = ();
     const SAMPLE_IS_FLUSHED: bool = true;
 
+    const HAS_BODY: bool = true;
+
     fn internal_rate_hz(&self) -> f64 {
         self.sample_rate_hz
     }

@@ -32,6 +32,7 @@
 //! violin.note_off(69);
 //! ```
 
+use super::body::{body_modes_for, BodyModes, FadingBody};
 use super::filters::flush_tiny;
 use super::fingering::{BowEnvelope, Fingering};
 use super::intonation::IntonationTable;
@@ -66,6 +67,11 @@ pub trait StringBank {
     /// Whether [`StringBank::sample`]'s output is already flushed of subnormals (then,
     /// without a resampler, it is not flushed again).
     const SAMPLE_IS_FLUSHED: bool = false;
+    /// Whether [`StringBank::sample`] already gives the sound through the instrument's
+    /// body (the point-bow bank's modes). Where it gives the force on the bridge (paper
+    /// B's modal bridge), [`FourStrings`] passes it through the same body at the host
+    /// rate ([`super::body::body_modes_for`], a mute loading it as it does the bank's).
+    const HAS_BODY: bool = false;
     /// The impedance of the string the force parameter is the force on when the strings
     /// are weighted ([`FourStrings::set_string_weighting`]), kg/s: string `i` is bowed
     /// with the force times its `Z0` over this.
@@ -189,6 +195,11 @@ pub struct FourStrings<B: StringBank> {
     pending: Option<B::Settings>,
     fade: f64,
     fade_step: f64,
+    /// The body at the host rate for a bank without one (`!B::HAS_BODY`), fading to a
+    /// mute's modes and back; unused otherwise.
+    body: FadingBody,
+    /// A mute on the bridge (con sordino).
+    muted: bool,
     /// The sound leaving the body at the host rate ([`Radiation`]).
     radiation: Radiation,
 }
@@ -444,8 +455,21 @@ impl<B: StringBank> FourStrings<B> {
             pending: None,
             fade: 1.0,
             fade_step: 1.0 / (RECONFIGURE_FADE_S * host_rate_hz).max(1.0),
+            body: FadingBody::new(
+                BodyModes::new(&kind.body_modes(), 1.0, host_rate_hz),
+                host_rate_hz,
+            ),
+            muted: false,
             radiation: Radiation::new(kind.a0_hz(), host_rate_hz),
         }
+    }
+
+    /// The body a bank without one plays at the host rate: the instrument's generic
+    /// modes (with a chosen bridge too: paper B's model plays the bridge itself, and its
+    /// sound leaves through the instrument's body), loaded by the mute if on.
+    fn host_body(&self) -> BodyModes {
+        let (modes, n) = body_modes_for(self.kind, None, self.muted);
+        BodyModes::new(&modes[..n], 1.0, self.host_rate_hz)
     }
 
     pub fn kind(&self) -> InstrumentKind {
@@ -493,6 +517,9 @@ impl<B: StringBank> FourStrings<B> {
         self.hands.open_notes = kind.open_notes();
         self.hands.free = [false; STRINGS];
         self.radiation.retune(kind.a0_hz(), self.host_rate_hz);
+        if !B::HAS_BODY {
+            self.body.playing = self.host_body();
+        }
         self.press_every_finger();
     }
 
@@ -519,6 +546,11 @@ impl<B: StringBank> FourStrings<B> {
     /// [`super::body::muted_bridge_mode`]).
     pub fn set_mute(&mut self, on: bool) {
         self.bank.set_mute(on);
+        if !B::HAS_BODY && on != self.muted {
+            self.muted = on;
+            let body = self.host_body();
+            self.body.fade_to(&body, self.host_rate_hz);
+        }
     }
 
     /// Stops the string for `note` and plucks it there (pizzicato): no bow lands, and a
@@ -819,6 +851,7 @@ impl<B: StringBank> FourStrings<B> {
             if let Some(r) = &mut self.resampler {
                 r.reset();
             }
+            self.body.reset();
             self.radiation.reset();
         }
     }
@@ -826,6 +859,7 @@ impl<B: StringBank> FourStrings<B> {
     /// Silences every string and forgets every note.
     pub fn reset(&mut self) {
         self.bank.reset();
+        self.body.reset();
         self.radiation.reset();
         self.hands.bows = [BowEnvelope::default(); STRINGS];
         self.hands.expressive = [false; STRINGS];
@@ -943,6 +977,11 @@ impl<B: StringBank> FourStrings<B> {
     /// The host sample `audio` with the probe, or silence (and a reset) if it is not finite.
     #[inline(always)]
     fn finish(&mut self, audio: f64) -> Frame {
+        let audio = if B::HAS_BODY {
+            audio
+        } else {
+            self.body.tick(audio)
+        };
         let audio = self.radiation.tick(audio);
         if !audio.is_finite() {
             // Cannot happen with finite inputs; if it ever does, recover to silence rather
