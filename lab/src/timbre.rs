@@ -17,8 +17,7 @@
 
 use colophony::analysis::{partial_amplitude, peak_frequency_hz};
 use colophony::dsp::intonation::TunedModel;
-use colophony::dsp::vocabulary::{midi_to_hz, BowControl, InstrumentKind};
-use colophony::performer::{Performer, Setup};
+use colophony::dsp::vocabulary::{midi_to_hz, InstrumentKind};
 use rayon::prelude::*;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -36,8 +35,8 @@ pub const PROFILE_HARMONICS: usize = 16;
 pub const PROFILE_FLOOR_DB: f64 = -60.0;
 /// Semitones between the notes played.
 pub const NOTE_STEP: usize = 3;
-/// The note's velocity, 0..=1 (100 of 127).
-pub const VELOCITY: f32 = 100.0 / 127.0;
+/// The note's MIDI velocity.
+pub const VELOCITY: u8 = 100;
 /// How long each note is held, s, and where its steady part starts.
 pub const NOTE_S: f64 = 2.0;
 pub const STEADY_FROM_S: f64 = 1.0;
@@ -95,27 +94,8 @@ pub fn notes(kind: InstrumentKind, reference: &[NoteSpectrum]) -> Vec<u8> {
 /// `note` played on `kind` with `model` at `rate_hz` through the performer at the plugin's
 /// defaults, its steady part's harmonics measured.
 pub fn played(kind: InstrumentKind, model: TunedModel, rate_hz: f64, note: u8) -> NoteSpectrum {
-    let setup = Setup {
-        instrument: kind,
-        point_law: match model {
-            TunedModel::Point(law) => Some(law),
-            TunedModel::Thermal => None,
-        },
-        ..Setup::default()
-    };
-    let mut performer = Performer::new(kind);
-    if performer.activate(&setup, rate_hz).is_err() {
-        return NoteSpectrum {
-            note,
-            fundamental_hz: midi_to_hz(note as f64),
-            amplitudes: Vec::new(),
-        };
-    }
-    performer.configure(&setup);
-    performer.note_on(note, VELOCITY);
-    let bow = BowControl::default();
-    let n = (NOTE_S * rate_hz) as usize;
-    let out: Vec<f64> = (0..n).map(|_| performer.tick(bow).audio).collect();
+    let out =
+        crate::midi_file::one_note_audio(kind, model.point_law(), note, VELOCITY, NOTE_S, rate_hz);
     measured(&out, rate_hz, note)
 }
 

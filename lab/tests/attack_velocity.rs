@@ -5,6 +5,7 @@
 
 use colophony::analysis::{cents, partial_amplitude, peak_frequency_hz, rms};
 use colophony::dsp::friction::FrictionModel;
+use colophony::dsp::intonation::TunedModel;
 use colophony::dsp::vocabulary::InstrumentKind;
 use colophony_lab::midi_file::one_note_audio;
 
@@ -81,13 +82,7 @@ const KNOWN_SLOW_HARD_ATTACK: [(InstrumentKind, u8, &str); 4] = [
 
 #[test]
 fn a_harder_note_velocity_starts_louder_and_both_speak_at_the_notes_pitch() {
-    let laws = [
-        Some(FrictionModel::Hyperbolic),
-        Some(FrictionModel::Stribeck),
-        Some(FrictionModel::LuGre),
-        Some(FrictionModel::ElastoPlastic),
-        None,
-    ];
+    let laws = TunedModel::ALL.map(TunedModel::point_law);
     let mut report = Vec::new();
     let mut failures = Vec::new();
     for kind in InstrumentKind::ALL {

@@ -5,6 +5,7 @@
 
 use colophony::analysis::{partial_amplitude, rms};
 use colophony::dsp::friction::FrictionModel;
+use colophony::dsp::intonation::TunedModel;
 use colophony::dsp::vocabulary::InstrumentKind;
 use colophony::performer::stroke::StrokeMode;
 use colophony_lab::midi_file::{perform, MidiEvent, Performance, Timed};
@@ -52,13 +53,16 @@ fn rms_db(x: &[f64]) -> f64 {
     20.0 * rms(x).max(1e-15).log10()
 }
 
-const LAWS: [Option<FrictionModel>; 5] = [
-    Some(FrictionModel::Hyperbolic),
-    Some(FrictionModel::Stribeck),
-    Some(FrictionModel::LuGre),
-    Some(FrictionModel::ElastoPlastic),
-    None,
-];
+/// Every model: the point laws, then paper B's thermal bow (`None`).
+const LAWS: [Option<FrictionModel>; TunedModel::COUNT] = {
+    let mut laws = [None; TunedModel::COUNT];
+    let mut i = 0;
+    while i < TunedModel::COUNT {
+        laws[i] = TunedModel::ALL[i].point_law();
+        i += 1;
+    }
+    laws
+};
 
 /// Cases known to miss the criterion, with the law: the cello's F3 after Bb2 with the
 /// point laws. The released Bb2 falls 14-15 dB in its first 50 ms, but the new F3 is still

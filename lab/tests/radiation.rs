@@ -6,7 +6,7 @@
 //! at every bow change.
 
 use colophony::analysis::rms;
-use colophony::dsp::friction::FrictionModel;
+use colophony::dsp::intonation::TunedModel;
 use colophony::dsp::vocabulary::InstrumentKind;
 use colophony_lab::midi_file::one_note_audio;
 
@@ -14,13 +14,7 @@ const FS: f64 = 48_000.0;
 
 #[test]
 fn a_held_stroke_sounds_without_the_bows_steady_push() {
-    let laws = [
-        Some(FrictionModel::Hyperbolic),
-        Some(FrictionModel::Stribeck),
-        Some(FrictionModel::LuGre),
-        Some(FrictionModel::ElastoPlastic),
-        None,
-    ];
+    let laws = TunedModel::ALL.map(TunedModel::point_law);
     let mut worst: f64 = 0.0;
     for kind in InstrumentKind::ALL {
         let open = kind.open_notes();

@@ -214,13 +214,7 @@ const PARTS: [Part; 13] = [
 /// Every model the plugin offers, by name, with its point law (`None`: paper B's thermal
 /// bow).
 fn laws() -> impl Iterator<Item = (&'static str, Option<FrictionModel>)> {
-    TunedModel::all().map(|m| {
-        let law = match m {
-            TunedModel::Point(law) => Some(law),
-            TunedModel::Thermal => None,
-        };
-        (m.name(), law)
-    })
+    TunedModel::all().map(|m| (m.name(), m.point_law()))
 }
 
 const RATES: [f64; 3] = [44_100.0, 48_000.0, 96_000.0];

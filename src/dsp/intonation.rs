@@ -80,6 +80,15 @@ impl TunedModel {
         Self::ALL.into_iter()
     }
 
+    /// Its point-bow friction law, `None` for paper B's thermal bow (the performer's
+    /// [`crate::performer::Setup::point_law`]).
+    pub const fn point_law(self) -> Option<FrictionModel> {
+        match self {
+            TunedModel::Point(law) => Some(law),
+            TunedModel::Thermal => None,
+        }
+    }
+
     /// Its row in the table.
     pub const fn row(self) -> usize {
         match self {
