@@ -212,7 +212,8 @@ fn first_helmholtz_run(probe: &[ContactSample], f0: f64, run: usize) -> Option<u
 /// Guettler's diagram on [`MinimalString`] (cello D3, beta 0.1; forces as fractions of
 /// Schelleng's `F_max` = 5.06 N, the bow from rest at constant acceleration to 0.1 m/s, 0:
 /// landing at speed), with the loss at the bridge and at the nut, and the plugin's cello at
-/// the same cells: ms from the bow's start to the first six periods of Helmholtz motion
+/// the same cells, with and without its string's stiffness (the nut's dispersion filter):
+/// ms from the bow's start to the first six periods of Helmholtz motion
 /// ([`first_helmholtz_run`]) and, in brackets, to Helmholtz motion that lasts to the end
 /// of 0.8 s ([`helmholtz_since`]). `cargo test --release -p colophony-lab --test
 /// attack_survey minimal -- --ignored --nocapture`.
@@ -234,6 +235,7 @@ fn minimal_string_guettler_survey() {
         "minimal, loss at the bridge",
         "minimal, loss at the nut",
         "the plugin's cello",
+        "the plugin's cello without its stiffness (no dispersion filter)",
     ] {
         println!("{model}: rows F / F_max, columns acceleration (m/s^2); ms to six periods of Helmholtz motion (to lasting Helmholtz motion)");
         for &frac in &fractions {
@@ -253,6 +255,9 @@ fn minimal_string_guettler_survey() {
                 } else {
                     let mut cello = Instrument::new(InstrumentKind::Cello, FS);
                     cello.set_friction_model(FrictionModel::Hyperbolic);
+                    if model.ends_with("(no dispersion filter)") {
+                        cello.set_dispersion_cap(0);
+                    }
                     cello.note_on(50);
                     (0..n)
                         .map(|i| {
