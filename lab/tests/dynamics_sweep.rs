@@ -9,7 +9,8 @@
 //! pairs play Helmholtz motion within 10 and within 5 cents, with the others listed. A
 //! survey, printed, not asserted (docs/testing.md, "Dynamics"). `cargo test
 //! --release -p colophony-lab --test dynamics_sweep -- --ignored --nocapture` (about
-//! 3 min on two cores; `MODELS=hyperbolic,thermal` for some of the models).
+//! 3 min on two cores; `MODELS=hyperbolic,thermal` for some of the models, `LEVELS=85,106`
+//! for other levels).
 use colophony::analysis::{cents, peak_frequency_hz, rms};
 use colophony::dsp::friction::FrictionModel;
 use colophony::dsp::vocabulary::{midi_to_hz, BowControl, InstrumentKind};
@@ -20,6 +21,14 @@ use rayon::prelude::*;
 
 const FS: f64 = 48_000.0;
 const LEVELS: [u8; 7] = [0, 21, 42, 64, 85, 106, 127];
+
+/// The CC11 levels swept: [`LEVELS`], or `LEVELS=a,b,..` (0-127, rising).
+fn levels() -> Vec<u8> {
+    std::env::var("LEVELS")
+        .ok()
+        .and_then(|list| list.split(',').map(|x| x.trim().parse().ok()).collect())
+        .unwrap_or_else(|| LEVELS.to_vec())
+}
 const SECONDS: f64 = 1.6;
 const FROM_S: f64 = 0.8;
 
@@ -64,6 +73,7 @@ fn play(
 #[test]
 #[ignore]
 fn dynamics_sweep_survey() {
+    let levels = levels();
     let models: Vec<Option<FrictionModel>> = FrictionModel::ALL
         .iter()
         .map(|&m| Some(m))
@@ -85,7 +95,7 @@ fn dynamics_sweep_survey() {
                 .map(|&note| {
                     (
                         note,
-                        LEVELS.iter().map(|&cc| play(kind, law, note, cc)).collect(),
+                        levels.iter().map(|&cc| play(kind, law, note, cc)).collect(),
                     )
                 })
                 .collect();
@@ -95,7 +105,7 @@ fn dynamics_sweep_survey() {
                 .collect();
             ranges.sort_by(f64::total_cmp);
             // The median level at each step, dB re CC11 127.
-            let steps: Vec<String> = (0..LEVELS.len())
+            let steps: Vec<String> = (0..levels.len())
                 .map(|k| {
                     let mut d: Vec<f64> = rows
                         .iter()
@@ -110,7 +120,7 @@ fn dynamics_sweep_survey() {
                 .filter(|(_, r)| r.windows(2).any(|w| w[1].0 <= w[0].0))
                 .map(|(n, _)| *n)
                 .collect();
-            let pairs = rows.len() * LEVELS.len();
+            let pairs = rows.len() * levels.len();
             let helm = |tol: f64| {
                 rows.iter()
                     .flat_map(|(_, r)| r.iter())
@@ -119,7 +129,7 @@ fn dynamics_sweep_survey() {
             };
             let mut off = String::new();
             for (note, r) in &rows {
-                for (&cc, (_, c, g)) in LEVELS.iter().zip(r) {
+                for (&cc, (_, c, g)) in levels.iter().zip(r) {
                     if !(*g == Some(Regime::Helmholtz) && c.abs() <= 5.0) {
                         let regime = match g {
                             Some(Regime::Helmholtz) => "H".to_string(),

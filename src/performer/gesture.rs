@@ -18,6 +18,14 @@ pub const DYNAMICS_RANGE_DB: f64 = 35.0;
 /// the softest (-35 dB: `x = log10(2) / 3`), as players bow nearer the fingerboard for
 /// piano and nearer the bridge for forte.
 pub const DYNAMICS_DRIFT_EXPONENT: f64 = std::f64::consts::LOG10_2 / 3.0;
+/// Paper B's thermal bow sticks and slips only above a bow speed: slower, the rosin heats
+/// too little in a slip to drop its friction and the string slides (docs/testing.md,
+/// "Dynamics"). With the window guard the dynamics take the thermal bow down to this
+/// fraction of the parameters' speed and force at most, per instrument (violin, viola,
+/// cello, double bass; measured by the dynamics sweep, `lab/tests/dynamics_sweep.rs`, and
+/// checked by `the_thermal_bow_keeps_sticking_at_its_slowest_dynamics`); below it the
+/// dynamics move only the bow's position, as they do for the point laws.
+pub const THERMAL_SLOWEST_SCALE: [f64; 4] = [0.6, 0.6, 0.5, 0.5];
 /// Time constant of the dynamics' smoothing, s (no zipper noise from 7-bit steps).
 pub const DYNAMICS_SMOOTHING_S: f64 = 0.01;
 /// Vibrato depth at the mod wheel's top, cents (peak, either side: players' wide vibrato).
@@ -93,6 +101,16 @@ pub(super) struct Gesture {
     /// last looked at for it ([`Performer::shape`]).
     pub(super) intonation_expression: f64,
     pub(super) intonation_scale: f64,
+}
+
+/// [`THERMAL_SLOWEST_SCALE`] for `kind`.
+pub fn thermal_slowest_scale(kind: InstrumentKind) -> f64 {
+    THERMAL_SLOWEST_SCALE[match kind {
+        InstrumentKind::Violin => 0,
+        InstrumentKind::Viola => 1,
+        InstrumentKind::Cello => 2,
+        InstrumentKind::DoubleBass => 3,
+    }]
 }
 
 impl Gesture {
@@ -207,17 +225,24 @@ impl Performer {
             };
         }
         // With the guard the force follows the velocity and the bow drifts from the
-        // bridge as the dynamics fall; without it only the velocity follows.
-        let (force_scale, away) = if self.setup.dynamics_guard {
-            (g.bow_scale, g.beta_scale)
+        // bridge as the dynamics fall; without it only the velocity follows. Paper B's
+        // thermal bow slows down no further than its slowest scale.
+        let (velocity_scale, force_scale, away) = if self.setup.dynamics_guard {
+            let scale = match self.setup.point_law {
+                None => g
+                    .bow_scale
+                    .max(thermal_slowest_scale(self.setup.instrument)),
+                Some(_) => g.bow_scale,
+            };
+            (scale, scale, g.beta_scale)
         } else {
-            (1.0, 1.0)
+            (g.bow_scale, 1.0, 1.0)
         };
-        let out = if g.bow_scale == 1.0 && speed == 1.0 && landing == 1.0 && away == 1.0 {
+        let out = if velocity_scale == 1.0 && speed == 1.0 && landing == 1.0 && away == 1.0 {
             bow
         } else {
             BowControl {
-                velocity_m_per_s: bow.velocity_m_per_s * g.bow_scale * speed,
+                velocity_m_per_s: bow.velocity_m_per_s * velocity_scale * speed,
                 force_n: bow.force_n * force_scale * landing,
                 position_beta: (bow.position_beta * away).clamp(MIN_NOTE_BETA, MAX_NOTE_BETA),
             }
@@ -230,7 +255,7 @@ impl Performer {
             && g.bow_scale == g.target
             && self.direct.is_idle()
             && self.stroke.is_settled();
-        self.steady = steady.then_some((g.bow_scale * speed, force_scale, away));
+        self.steady = steady.then_some((velocity_scale * speed, force_scale, away));
         // The intonation follows the guard's bow (the table is fitted with it); without
         // the guard it stays at full expression's. Looked at only when that bow's scale
         // changes (a vibrato runs this path every sample with the dynamics at rest).
@@ -401,6 +426,84 @@ mod tests {
             stats.slip_fraction
         );
         assert!(!helmholtz, "{regime:?}, {stats:?}");
+    }
+
+    /// Paper B's thermal model on `kind`: `note` bowed at the defaults with the
+    /// expression at `e` (or, with `e` negative, the bow scaled by `-e` from full
+    /// expression, around the guard); the RMS over 1.2..1.6 s and the regime of its last
+    /// 8 periods.
+    fn thermal_note_at(kind: InstrumentKind, note: u8, e: f32) -> (f64, Option<Regime>) {
+        let setup = Setup {
+            instrument: kind,
+            point_law: None,
+            ..Setup::default()
+        };
+        let mut p = Performer::new(kind);
+        p.activate(&setup, FS).unwrap();
+        p.set_controller(11, if e < 0.0 { 1.0 } else { e });
+        p.note_on(note, 0.8);
+        let d = BowControl::default();
+        let bow = if e < 0.0 {
+            let scale = -e as f64;
+            BowControl {
+                velocity_m_per_s: d.velocity_m_per_s * scale,
+                force_n: d.force_n * scale,
+                ..d
+            }
+        } else {
+            d
+        };
+        let n = (1.6 * FS) as usize;
+        let (mut audio, mut probe) = (Vec::with_capacity(n), Vec::with_capacity(n));
+        for i in 0..n {
+            if i % 256 == 0 {
+                p.configure(&setup);
+            }
+            let frame = p.tick(bow);
+            audio.push(frame.audio);
+            probe.push(ContactSample::new(&frame, &p.bow()));
+        }
+        let tail = &audio[(1.2 * FS) as usize..];
+        let rms = (tail.iter().map(|x| x * x).sum::<f64>() / tail.len() as f64).sqrt();
+        let f0 = midi_to_hz(note as f64);
+        let window = (8.0 * FS / f0) as usize;
+        (
+            rms,
+            classify_regime(&probe[n - window..], FS as f32, f0 as f32),
+        )
+    }
+
+    #[test]
+    fn the_thermal_bow_keeps_sticking_at_its_slowest_dynamics() {
+        // Below its slowest speed paper B's rosin heats too little to stick and slip: the
+        // cello's D3 bowed at 0.35 of the default bow (speed and force) slides.
+        let (_, slow) = thermal_note_at(InstrumentKind::Cello, 50, -0.35);
+        assert_eq!(slow, Some(Regime::Sliding));
+        // With the guard, every instrument's lowest and highest open strings stick and
+        // slip in Helmholtz motion at the softest expression (the bow at its slowest,
+        // drifted 1.5 times from the bridge) and where the speed stops falling (the bow at
+        // its slowest, nearest the bridge: the least heat), and the softest is the
+        // quieter.
+        for kind in InstrumentKind::ALL {
+            let slowest = thermal_slowest_scale(kind);
+            let floor_e = (1.0 + 20.0 * slowest.log10() / DYNAMICS_RANGE_DB) as f32;
+            let open = kind.open_notes();
+            for note in [open[0], open[open.len() - 1]] {
+                let (soft, soft_regime) = thermal_note_at(kind, note, 0.0);
+                let (floor, floor_regime) = thermal_note_at(kind, note, floor_e - 0.01);
+                assert_eq!(
+                    soft_regime,
+                    Some(Regime::Helmholtz),
+                    "{kind:?} {note} softest"
+                );
+                assert_eq!(
+                    floor_regime,
+                    Some(Regime::Helmholtz),
+                    "{kind:?} {note} at {floor_e}"
+                );
+                assert!(soft < floor, "{kind:?} {note}: {soft} against {floor}");
+            }
+        }
     }
 
     #[test]
