@@ -293,6 +293,13 @@ impl Curve {
     /// `f_NL(v, z)` and its partial derivatives `(f, df/dv, df/dz)`.
     #[inline(always)]
     fn eval(&self, v: f64, z: f64) -> (f64, f64, f64) {
+        let az = z.abs();
+        let same_sign = v * z > 0.0;
+        // The elasto-plastic bristle below its breakaway (or against the slip) is purely
+        // elastic: alpha = 0 whatever the Stribeck curve, so it is not evaluated.
+        if self.elasto_plastic && (!same_sign || az <= self.z_ba) {
+            return (v, 1.0, 0.0);
+        }
         // Stribeck: h(v) = f_c + (f_s - f_c) e^{-(v/v_s)^2}, |z_ss| = h / sigma0.
         let r = v / self.v_s;
         let e = exp_nonpositive(-(r * r));
@@ -303,14 +310,8 @@ impl Curve {
         }
         let dh = (self.f_s - self.f_c) * e * (-2.0 * r / self.v_s);
         let zss = h / self.sigma0;
-        let az = z.abs();
-        let same_sign = v * z > 0.0;
         // alpha and its partials
-        let (alpha, dalpha_dz, dalpha_dv) = if !self.elasto_plastic {
-            (1.0, 0.0, 0.0)
-        } else if !same_sign || az <= self.z_ba {
-            (0.0, 0.0, 0.0)
-        } else if az >= zss {
+        let (alpha, dalpha_dz, dalpha_dv) = if !self.elasto_plastic || az >= zss {
             (1.0, 0.0, 0.0)
         } else {
             let width = zss - self.z_ba;
