@@ -228,11 +228,11 @@ impl Performer {
         // bridge as the dynamics fall; without it only the velocity follows. Paper B's
         // thermal bow slows down no further than its slowest scale.
         let (velocity_scale, force_scale, away) = if self.setup.dynamics_guard {
-            let scale = match self.setup.point_law {
-                None => g
+            let scale = match self.source {
+                Source::Thermal(_) => g
                     .bow_scale
                     .max(thermal_slowest_scale(self.setup.instrument)),
-                Some(_) => g.bow_scale,
+                _ => g.bow_scale,
             };
             (scale, scale, g.beta_scale)
         } else {
