@@ -15,8 +15,9 @@
 
 use super::{profile, NoteSpectrum, PROFILE_FLOOR_DB, PROFILE_HARMONICS};
 
-/// IRLS iterations: the L1 fit's mean deviation changes by under 0.01 dB after about 30 on
-/// SHARC's notes.
+/// IRLS iterations: on SHARC's notes the fit's mean absolute deviation moves by under
+/// 0.01 dB from 30 to 120 iterations, and its score by the profile measure by under 0.1 dB
+/// (near-equal L1 solutions put a note's strongest harmonic differently).
 const ITERATIONS: usize = 60;
 /// The smallest residual an IRLS weight divides by, dB (keeps the weights finite).
 const MIN_RESIDUAL_DB: f64 = 0.05;
