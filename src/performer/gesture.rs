@@ -359,19 +359,39 @@ mod tests {
         let mut p = cello();
         p.set_controller(11, e);
         p.note_on(note, 0.8);
-        let bow = BowControl::default();
-        let n = (2.0 * FS) as usize;
+        played(
+            &mut p,
+            &Setup::default(),
+            note,
+            BowControl::default(),
+            2.0,
+            1.5,
+        )
+    }
+
+    /// `p`'s `note` (already on) with `bow` for `seconds`, `setup` configured every 256
+    /// samples as the plugin's blocks do: the RMS from `rms_from_s` to the end and the
+    /// regime of the last 8 periods on the probe.
+    fn played(
+        p: &mut Performer,
+        setup: &Setup,
+        note: u8,
+        bow: BowControl,
+        seconds: f64,
+        rms_from_s: f64,
+    ) -> (f64, Option<Regime>) {
+        let n = (seconds * FS) as usize;
         let mut audio = Vec::with_capacity(n);
         let mut probe = Vec::with_capacity(n);
         for i in 0..n {
             if i % 256 == 0 {
-                p.configure(&Setup::default());
+                p.configure(setup);
             }
             let frame = p.tick(bow);
             audio.push(frame.audio);
             probe.push(ContactSample::new(&frame, &p.bow()));
         }
-        let tail = &audio[(1.5 * FS) as usize..];
+        let tail = &audio[(rms_from_s * FS) as usize..];
         let rms = (tail.iter().map(|x| x * x).sum::<f64>() / tail.len() as f64).sqrt();
         let f0 = midi_to_hz(note as f64);
         let window = (8.0 * FS / f0) as usize;
@@ -453,24 +473,7 @@ mod tests {
         } else {
             d
         };
-        let n = (1.6 * FS) as usize;
-        let (mut audio, mut probe) = (Vec::with_capacity(n), Vec::with_capacity(n));
-        for i in 0..n {
-            if i % 256 == 0 {
-                p.configure(&setup);
-            }
-            let frame = p.tick(bow);
-            audio.push(frame.audio);
-            probe.push(ContactSample::new(&frame, &p.bow()));
-        }
-        let tail = &audio[(1.2 * FS) as usize..];
-        let rms = (tail.iter().map(|x| x * x).sum::<f64>() / tail.len() as f64).sqrt();
-        let f0 = midi_to_hz(note as f64);
-        let window = (8.0 * FS / f0) as usize;
-        (
-            rms,
-            classify_regime(&probe[n - window..], FS as f32, f0 as f32),
-        )
+        played(&mut p, &setup, note, bow, 1.6, 1.2)
     }
 
     #[test]
