@@ -21,11 +21,11 @@ pub const DYNAMICS_DRIFT_EXPONENT: f64 = std::f64::consts::LOG10_2 / 3.0;
 /// Paper B's thermal bow sticks and slips only above a bow speed: slower, the rosin heats
 /// too little in a slip to drop its friction and the string slides (docs/testing.md,
 /// "Dynamics"). With the window guard the dynamics take the thermal bow down to this
-/// fraction of the parameters' speed and force at most, per instrument (violin, viola,
-/// cello, double bass; measured by the dynamics sweep, `lab/tests/dynamics_sweep.rs`, and
+/// fraction of the parameters' speed and force at most, per instrument (in
+/// [`InstrumentKind::ALL`]'s order: violin, viola, cello, double bass; measured by the dynamics sweep, `lab/tests/dynamics_sweep.rs`, and
 /// checked by `the_thermal_bow_keeps_sticking_at_its_slowest_dynamics`); below it the
 /// dynamics move only the bow's position, as they do for the point laws.
-pub const THERMAL_SLOWEST_SCALE: [f64; 4] = [0.6, 0.6, 0.5, 0.5];
+pub const THERMAL_SLOWEST_SCALE: [f64; InstrumentKind::COUNT] = [0.6, 0.6, 0.5, 0.5];
 /// Time constant of the dynamics' smoothing, s (no zipper noise from 7-bit steps).
 pub const DYNAMICS_SMOOTHING_S: f64 = 0.01;
 /// Vibrato depth at the mod wheel's top, cents (peak, either side: players' wide vibrato).
@@ -105,12 +105,7 @@ pub(super) struct Gesture {
 
 /// [`THERMAL_SLOWEST_SCALE`] for `kind`.
 pub fn thermal_slowest_scale(kind: InstrumentKind) -> f64 {
-    THERMAL_SLOWEST_SCALE[match kind {
-        InstrumentKind::Violin => 0,
-        InstrumentKind::Viola => 1,
-        InstrumentKind::Cello => 2,
-        InstrumentKind::DoubleBass => 3,
-    }]
+    THERMAL_SLOWEST_SCALE[kind.index()]
 }
 
 impl Gesture {
