@@ -22,9 +22,10 @@ pub const DYNAMICS_DRIFT_EXPONENT: f64 = std::f64::consts::LOG10_2 / 3.0;
 /// too little in a slip to drop its friction and the string slides (docs/testing.md,
 /// "Dynamics"). With the window guard the dynamics take the thermal bow down to this
 /// fraction of the parameters' speed and force at most, per instrument (in
-/// [`InstrumentKind::ALL`]'s order: violin, viola, cello, double bass; measured by the dynamics sweep, `lab/tests/dynamics_sweep.rs`, and
-/// checked by `the_thermal_bow_keeps_sticking_at_its_slowest_dynamics`); below it the
-/// dynamics move only the bow's position, as they do for the point laws.
+/// [`InstrumentKind::ALL`]'s order: violin, viola, cello, double bass; measured by the
+/// dynamics sweep, `lab/tests/dynamics_sweep.rs`, and checked by
+/// `the_thermal_bow_keeps_sticking_at_its_slowest_dynamics`); below it the dynamics move
+/// only the bow's position, as they do for the point laws.
 pub const THERMAL_SLOWEST_SCALE: [f64; InstrumentKind::COUNT] = [0.6, 0.6, 0.5, 0.5];
 /// Time constant of the dynamics' smoothing, s (no zipper noise from 7-bit steps).
 pub const DYNAMICS_SMOOTHING_S: f64 = 0.01;
