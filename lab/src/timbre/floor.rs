@@ -182,40 +182,13 @@ fn fitted(
     }
 }
 
-/// Solves the symmetric positive-definite `a x = b` (`a` row-major, `n` by `n`) by
-/// Gaussian elimination with partial pivoting.
-fn solve(mut a: Vec<f64>, mut b: Vec<f64>, n: usize) -> Vec<f64> {
-    for col in 0..n {
-        let pivot = (col..n)
-            .max_by(|&i, &j| a[i * n + col].abs().total_cmp(&a[j * n + col].abs()))
-            .unwrap_or(col);
-        if pivot != col {
-            for k in 0..n {
-                a.swap(col * n + k, pivot * n + k);
-            }
-            b.swap(col, pivot);
-        }
-        let d = a[col * n + col];
-        if d == 0.0 {
-            continue;
-        }
-        for i in col + 1..n {
-            let f = a[i * n + col] / d;
-            if f != 0.0 {
-                for k in col..n {
-                    a[i * n + k] -= f * a[col * n + k];
-                }
-                b[i] -= f * b[col];
-            }
-        }
-    }
-    let mut x = vec![0.0; n];
-    for i in (0..n).rev() {
-        let s: f64 = (i + 1..n).map(|k| a[i * n + k] * x[k]).sum();
-        let d = a[i * n + i];
-        x[i] = if d == 0.0 { 0.0 } else { (b[i] - s) / d };
-    }
-    x
+/// Solves the symmetric positive-definite `a x = b` (`a` row-major, `n` by `n`) by its
+/// Cholesky factor (nalgebra); zeros if `a` is not positive definite.
+fn solve(a: Vec<f64>, b: Vec<f64>, n: usize) -> Vec<f64> {
+    let a = nalgebra::DMatrix::from_row_slice(n, n, &a);
+    let b = nalgebra::DVector::from_vec(b);
+    a.cholesky()
+        .map_or_else(|| vec![0.0; n], |c| c.solve(&b).as_slice().to_vec())
 }
 
 #[cfg(test)]
