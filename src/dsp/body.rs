@@ -18,28 +18,92 @@ use std::f64::consts::PI;
 
 pub const MAX_BODY_MODES: usize = 6;
 
-/// A mute's mass over the bridge's effective mass in its rocking mode (the bridge hill):
-/// a 1.5 g rubber mute on a violin bridge whose rocking mode moves about 0.5 g (a
-/// choice; the same ratio for the larger instruments, whose mutes and bridges grow
-/// together).
-pub const MUTE_MASS_RATIO: f64 = 3.0;
+/// A mute's mass over the bridge's effective mass in its rocking mode (the bridge hill).
+/// Chosen from SHARC's violin played open and muted (docs/articulations.md, "Measured
+/// mute"): through [`MuteLoad`], 1 puts the violin's loss over 2.5-5 kHz within 2 dB of
+/// the recording's band by band (1.5, 2 and 3 deeper than it by 1-3, 3-5 and 6-9 dB); the
+/// same ratio for the larger instruments, whose mutes and bridges grow together.
+pub const MUTE_MASS_RATIO: f64 = 1.0;
 /// The bridge's own modes (the hill) start here, over the violin's frequencies (times
-/// the instrument's body scale), Hz: the modes a mute loads.
+/// the instrument's body scale), Hz: the modes of paper B's fitted bridges a mute loads
+/// ([`muted_bridge_mode`]).
 pub const BRIDGE_MODES_FROM_HZ: f64 = 1500.0;
 
-/// `modes` with a mute on the bridge (con sordino): each bridge mode (from
-/// [`BRIDGE_MODES_FROM_HZ`] times `scale` up), a mass on a spring, carries the mute's
-/// mass too, so its frequency falls by `sqrt(1 / (1 + r))` and its amplitude by
-/// `1 / (1 + r)` (`r` = [`MUTE_MASS_RATIO`]); the body's own modes below are unchanged.
-pub fn muted(mode: BodyMode, scale: f64) -> BodyMode {
-    if mode.freq_hz < BRIDGE_MODES_FROM_HZ * scale {
-        return mode;
+/// A mute on the bridge, as a filter on the force the bridge passes to the body.
+///
+/// The bridge hill is the bridge rocking on its feet: its top, where the strings press
+/// (mass `m`), on a spring `k` (its waist) into the body's resistance `c` at its feet
+/// (Woodhouse's bridge-hill model, reduced to one degree of freedom; docs/articulations.md).
+/// The force it passes to the body is then `w_b^2 / (s^2 + B s + w_b^2)`, with
+/// `w_b^2 = k / m` and `B = k / c`. A mute of mass `r m` clamped on the top lowers the
+/// resonance to `w_m = w_b / sqrt(1 + r)` and keeps `B`. The generic body already holds the
+/// open bridge's hill (its last mode, [`InstrumentKind::bridge_hill`]), so the mute
+/// multiplies what it radiates by the loaded transmission over the open one:
+/// `R(s) = (w_m^2 / w_b^2) (s^2 + B s + w_b^2) / (s^2 + B s + w_m^2)`: unity at DC,
+/// `1 / (1 + r)` far above the hill and deepest near it. Bilinear, each resonance
+/// pre-warped, so the digital filter keeps unity at DC and both resonances where they are.
+///
+/// [`InstrumentKind::bridge_hill`]: super::vocabulary::InstrumentKind::bridge_hill
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MuteLoad {
+    b: [f64; 3],
+    a: [f64; 2],
+    s: [f64; 2],
+}
+
+impl MuteLoad {
+    /// The mute `mass_ratio` times the bridge's effective mass on the bridge `hill`, at
+    /// `sample_rate_hz`. Resonances at or above 0.45 of the rate are taken there (the
+    /// filter then passes everything unchanged if both are).
+    pub fn new(hill: BodyMode, mass_ratio: f64, sample_rate_hz: f64) -> Self {
+        let k = 2.0 * sample_rate_hz;
+        let warp = |f: f64| k * (PI * (f / sample_rate_hz).min(0.45)).tan();
+        let w_b = warp(hill.freq_hz);
+        let w_m = warp(hill.freq_hz / (1.0 + mass_ratio.max(0.0)).sqrt());
+        let bandwidth = w_b / hill.q;
+        let poly = |w: f64| {
+            [
+                k * k + bandwidth * k + w * w,
+                2.0 * (w * w - k * k),
+                k * k - bandwidth * k + w * w,
+            ]
+        };
+        let (n, d) = (poly(w_b), poly(w_m));
+        let g = (w_m * w_m) / (w_b * w_b) / d[0];
+        Self {
+            b: [g * n[0], g * n[1], g * n[2]],
+            a: [d[1] / d[0], d[2] / d[0]],
+            s: [0.0; 2],
+        }
     }
-    let loaded = 1.0 + MUTE_MASS_RATIO;
-    BodyMode {
-        freq_hz: mode.freq_hz / loaded.sqrt(),
-        q: mode.q,
-        gain: mode.gain / loaded,
+
+    /// The filter's magnitude at `freq_hz` (its digital frequency response).
+    pub fn gain_at(&self, freq_hz: f64, sample_rate_hz: f64) -> f64 {
+        let w = 2.0 * PI * freq_hz / sample_rate_hz;
+        let z1 = (w.cos(), -w.sin());
+        let z2 = ((2.0 * w).cos(), -(2.0 * w).sin());
+        let num = (
+            self.b[0] + self.b[1] * z1.0 + self.b[2] * z2.0,
+            self.b[1] * z1.1 + self.b[2] * z2.1,
+        );
+        let den = (
+            1.0 + self.a[0] * z1.0 + self.a[1] * z2.0,
+            self.a[0] * z1.1 + self.a[1] * z2.1,
+        );
+        num.0.hypot(num.1) / den.0.hypot(den.1)
+    }
+
+    /// Transposed direct form II.
+    #[inline]
+    pub fn tick(&mut self, x: f64) -> f64 {
+        let y = self.b[0] * x + self.s[0];
+        self.s[0] = self.b[1] * x - self.a[0] * y + self.s[1];
+        self.s[1] = self.b[2] * x - self.a[1] * y;
+        y
+    }
+
+    fn state_magnitude(&self) -> f64 {
+        self.s[0].abs().max(self.s[1].abs())
     }
 }
 
@@ -71,30 +135,26 @@ pub use super::vocabulary::BodyMode;
 /// mute on).
 pub const MUTE_FADE_S: f64 = 0.05;
 
-/// The modes `kind`'s body plays, and how many: `custom` (a fitted bridge's passive
-/// reduction, [`body_from_bridge`]; at most [`MAX_BODY_MODES`] are kept) or the generic
-/// ones, each loaded by a mute ([`muted`]) when `with_mute`.
-pub fn body_modes_for(
+/// The body `kind` plays at `sample_rate_hz`: its `custom` modes (a fitted bridge's
+/// passive reduction, [`body_from_bridge`]; at most [`MAX_BODY_MODES`] are kept) or the
+/// generic ones, with a mute on the bridge ([`MuteLoad`], on the instrument's bridge hill)
+/// when `with_mute`.
+pub fn body_for(
     kind: super::vocabulary::InstrumentKind,
     custom: Option<&[BodyMode]>,
     with_mute: bool,
-) -> ([BodyMode; MAX_BODY_MODES], usize) {
-    let mut modes = [BodyMode {
-        freq_hz: 0.0,
-        q: 1.0,
-        gain: 0.0,
-    }; MAX_BODY_MODES];
+    sample_rate_hz: f64,
+) -> BodyModes {
     let generic = kind.body_modes();
-    let chosen = custom.unwrap_or(&generic);
-    let n = chosen.len().min(MAX_BODY_MODES);
-    modes[..n].copy_from_slice(&chosen[..n]);
+    let mut body = BodyModes::new(custom.unwrap_or(&generic), 1.0, sample_rate_hz);
     if with_mute {
-        let scale = kind.spec().body_scale;
-        for mode in &mut modes[..n] {
-            *mode = muted(*mode, scale);
-        }
+        body.mute = Some(MuteLoad::new(
+            kind.bridge_hill(),
+            MUTE_MASS_RATIO,
+            sample_rate_hz,
+        ));
     }
-    (modes, n)
+    body
 }
 
 /// A body that moves to new modes without a click: the new modes start from the old
@@ -168,6 +228,8 @@ pub struct BodyModes {
     gains: [f64; MAX_BODY_MODES],
     count: usize,
     direct_gain: f64,
+    /// A mute on the bridge, filtering the body's output ([`body_for`]).
+    mute: Option<MuteLoad>,
 }
 
 impl BodyModes {
@@ -184,6 +246,7 @@ impl BodyModes {
             gains: zero,
             count: 0,
             direct_gain,
+            mute: None,
         };
         for mode in modes.iter().take(MAX_BODY_MODES) {
             if mode.freq_hz < 0.45 * sample_rate_hz {
@@ -216,7 +279,10 @@ impl BodyModes {
         for k in 0..self.count.min(MAX_BODY_MODES) {
             y += self.gains[k] * out[k];
         }
-        y
+        match &mut self.mute {
+            Some(mute) => mute.tick(y),
+            None => y,
+        }
     }
 
     /// Takes `other`'s modes and gains, keeping the ringing state: a mute put on or taken
@@ -224,39 +290,49 @@ impl BodyModes {
     /// is (`y = b0 x + s1`: the state carries it) instead of restarting from rest, which
     /// clicks. Modes `other` does not have fall silent.
     pub fn retune(&mut self, other: &BodyModes) {
-        let (s1, s2) = (self.s1, self.s2);
+        let (s1, s2, mute) = (self.s1, self.s2, self.mute);
         *self = other.clone();
         for k in 0..self.count {
             self.s1[k] = s1[k];
             self.s2[k] = s2[k];
+        }
+        if let (Some(new), Some(old)) = (&mut self.mute, mute) {
+            new.s = old.s;
         }
     }
 
     pub fn reset(&mut self) {
         self.s1 = [0.0; MAX_BODY_MODES];
         self.s2 = [0.0; MAX_BODY_MODES];
+        if let Some(mute) = &mut self.mute {
+            mute.s = [0.0; 2];
+        }
     }
 
-    /// Samples until every mode would ring out below `level` with no more input: each
-    /// mode's poles have radius `sqrt(a2)`, so its state falls by that factor per sample
-    /// (0 if already below).
+    /// Samples until every mode (and a mute's filter) would ring out below `level` with
+    /// no more input: each one's poles have radius `sqrt(a2)`, so its state falls by that
+    /// factor per sample (0 if already below).
     pub fn samples_below(&self, level: f64) -> f64 {
+        let below = |mag: f64, a2: f64| {
+            let r = a2.max(0.0).sqrt();
+            if mag <= level || !(r > 0.0 && r < 1.0) {
+                0.0
+            } else {
+                (level / mag).ln() / r.ln()
+            }
+        };
+        let mute = self
+            .mute
+            .map_or(0.0, |m| below(m.state_magnitude(), m.a[1]));
         (0..self.count)
-            .map(|k| {
-                let mag = self.state_magnitude(k);
-                let r = self.a2[k].max(0.0).sqrt();
-                if mag <= level || !(r > 0.0 && r < 1.0) {
-                    0.0
-                } else {
-                    (level / mag).ln() / r.ln()
-                }
-            })
-            .fold(0.0, f64::max)
+            .map(|k| below(self.state_magnitude(k), self.a2[k]))
+            .fold(mute, f64::max)
     }
 
     /// Whether every mode has rung out below `level` (state magnitude, N-scale).
     pub fn is_quiet(&self, level: f64) -> bool {
         (0..self.count).all(|k| self.state_magnitude(k) < level)
+            && self.mute.is_none_or(|m| m.state_magnitude() < level)
     }
 
     fn state_magnitude(&self, k: usize) -> f64 {
@@ -305,26 +381,61 @@ mod tests {
     use super::*;
     use crate::dsp::vocabulary::InstrumentKind;
 
-    /// A mute loads the bridge's modes only: the bridge hill's frequency falls by
-    /// `sqrt(1 / (1 + r))` (half, for `r` = 3) and its amplitude by `1 / (1 + r)`; the
-    /// body's modes below the bridge's, A0 and the B1 pair, are the same for every
-    /// instrument.
+    /// A mute on the bridge is the loaded bridge's transmission over the open one
+    /// (`R(s)` of [`MuteLoad`], written out here from the bridge-hill model): unity at
+    /// low frequencies, `1 / (1 + r)` far above the hill and deepest near it, on every
+    /// instrument and at 44.1-192 kHz; the body's modes below are the open body's.
     #[test]
-    fn a_mute_loads_the_bridge_hill_and_leaves_the_body_modes() {
+    fn a_mute_lowers_the_bridge_hill_as_a_mass_on_its_spring() {
+        let r = MUTE_MASS_RATIO;
+        // The analogue loaded-over-open transmission at `f` for the hill `(f_b, q)`.
+        let analogue = |f: f64, f_b: f64, q: f64| {
+            let x = f / f_b;
+            let num = (1.0 - x * x).hypot(x / q);
+            let den = (1.0 / (1.0 + r) - x * x).hypot(x / q);
+            num / den / (1.0 + r)
+        };
+        let db = |g: f64| 20.0 * g.log10();
         for kind in InstrumentKind::ALL {
-            let scale = kind.spec().body_scale;
-            for mode in kind.body_modes() {
-                let m = muted(mode, scale);
-                if mode.freq_hz >= BRIDGE_MODES_FROM_HZ * scale {
-                    // Exact ratios but for f64 rounding.
-                    assert!((m.freq_hz / mode.freq_hz - 0.5).abs() < 1e-12);
-                    assert!((m.gain / mode.gain - 0.25).abs() < 1e-12);
-                } else {
-                    assert_eq!(m, mode, "{kind:?}");
+            let hill = kind.bridge_hill();
+            for fs in [44_100.0, 48_000.0, 96_000.0, 192_000.0] {
+                let mute = MuteLoad::new(hill, r, fs);
+                // Unity at 10 Hz: the bridge is rigid far below its hill. 0.01 dB: the
+                // loaded resonance's own rise, `(f / f_m)^2` of it, is 1e-3 dB there.
+                let low = db(mute.gain_at(10.0, fs));
+                assert!(low.abs() < 0.01, "{kind:?} {fs}: {low}");
+                // The digital filter follows the analogue one: within 0.3 dB up to three
+                // times the hill, the bilinear transform's frequency warping (both
+                // resonances pre-warped) at 44.1 kHz.
+                for x in [0.25, 0.5, 0.7, 1.0, 1.4, 2.0, 3.0] {
+                    let f = x * hill.freq_hz;
+                    let got = db(mute.gain_at(f, fs));
+                    let want = db(analogue(f, hill.freq_hz, hill.q));
+                    assert!(
+                        (got - want).abs() < 0.3,
+                        "{kind:?} {fs} Hz, {f:.0} Hz: {got:.2} dB against {want:.2}"
+                    );
                 }
+                // The hill itself loses more than the far top keeps: deepest near it.
+                let at_hill = db(mute.gain_at(hill.freq_hz, fs));
+                let top = db(analogue(1e6, hill.freq_hz, hill.q));
+                assert!((top + 10.0 * (1.0 + r).log10() * 2.0).abs() < 0.01, "{top}");
+                assert!(
+                    at_hill < top - 3.0,
+                    "{kind:?} {fs}: {at_hill} against {top}"
+                );
+                // Stable: the poles' radius below one.
+                assert!(mute.a[1] > 0.0 && mute.a[1] < 1.0);
             }
+            // The body's modes are the open body's; only the mute's filter is added.
+            let open = body_for(kind, None, false, 48_000.0);
+            let muted = body_for(kind, None, true, 48_000.0);
+            assert_eq!(open.b0, muted.b0);
+            assert_eq!(open.gains, muted.gains);
+            assert!(open.mute.is_none() && muted.mute.is_some());
         }
     }
+
     use crate::dsp::bridge_data::shipped_bridge;
 
     #[test]

@@ -28,7 +28,7 @@
 //! ```
 
 pub use super::body::MUTE_FADE_S;
-use super::body::{body_modes_for, BodyMode, BodyModes, FadingBody, MAX_BODY_MODES};
+use super::body::{body_for, BodyMode, BodyModes, FadingBody, MAX_BODY_MODES};
 use super::friction::bristle::{BristleParams, SolverStats};
 use super::friction::{AnyFriction, BowInput, FrictionContact, FrictionModel, HyperbolicFriction};
 use super::halfband::HalfbandDecimator;
@@ -121,8 +121,7 @@ impl WaveguideBank {
         let custom = self.custom_bodies[kind.index()]
             .as_ref()
             .map(|(modes, n)| &modes[..*n]);
-        let (modes, n) = body_modes_for(kind, custom, self.muted);
-        BodyModes::new(&modes[..n], 1.0, self.sample_rate_hz)
+        body_for(kind, custom, self.muted, self.sample_rate_hz)
     }
 }
 

@@ -32,7 +32,7 @@
 //! violin.note_off(69);
 //! ```
 
-use super::body::{body_modes_for, BodyModes, FadingBody};
+use super::body::{body_for, BodyModes, FadingBody};
 use super::filters::flush_tiny;
 use super::fingering::{BowEnvelope, Fingering};
 use super::intonation::IntonationTable;
@@ -70,7 +70,7 @@ pub trait StringBank {
     /// Whether [`StringBank::sample`] already gives the sound through the instrument's
     /// body (the point-bow bank's modes). Where it gives the force on the bridge (paper
     /// B's modal bridge), [`FourStrings`] passes it through the same body at the host
-    /// rate ([`super::body::body_modes_for`], a mute loading it as it does the bank's).
+    /// rate ([`super::body::body_for`], a mute loading it as it does the bank's).
     const HAS_BODY: bool = false;
     /// The impedance of the string the force parameter is the force on when the strings
     /// are weighted ([`FourStrings::set_string_weighting`]), kg/s: string `i` is bowed
@@ -468,8 +468,7 @@ impl<B: StringBank> FourStrings<B> {
     /// modes (with a chosen bridge too: paper B's model plays the bridge itself, and its
     /// sound leaves through the instrument's body), loaded by the mute if on.
     fn host_body(&self) -> BodyModes {
-        let (modes, n) = body_modes_for(self.kind, None, self.muted);
-        BodyModes::new(&modes[..n], 1.0, self.host_rate_hz)
+        body_for(self.kind, None, self.muted, self.host_rate_hz)
     }
 
     pub fn kind(&self) -> InstrumentKind {

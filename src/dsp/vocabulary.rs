@@ -228,7 +228,8 @@ impl InstrumentKind {
         })
     }
 
-    /// Generic body modes (see [`super::body`]).
+    /// Generic body modes (see [`super::body`]); the last is the bridge hill
+    /// ([`InstrumentKind::bridge_hill`]).
     pub(crate) fn body_modes(self) -> [BodyMode; 5] {
         let scale = self.spec().body_scale;
         [
@@ -243,6 +244,13 @@ impl InstrumentKind {
             q,
             gain,
         })
+    }
+
+    /// The bridge hill: the bridge rocking on its feet, the last of
+    /// [`InstrumentKind::body_modes`] (its frequency and Q are what a mute loads,
+    /// [`super::body::MuteLoad`]).
+    pub fn bridge_hill(self) -> BodyMode {
+        self.body_modes()[4]
     }
 
     /// The body's air resonance A0, Hz: its first mode, where its radiation turns on

@@ -793,11 +793,10 @@ mod tests {
 
     /// Con sordino takes level out of the bridge hill and leaves the body's low modes:
     /// on the violin's A4 and D5 at the defaults, the harmonics' power between 2 and 4 kHz
-    /// (the bridge hill, where SHARC's muted violin loses 6-11 dB against its open one:
-    /// docs/articulations.md) falls with the mute by more than 2 dB against the power
-    /// below 1 kHz, which moves less than 1 dB. More than 2 dB, not SHARC's 6-11: the
-    /// generic body's hill stands only 0.6 of its direct path above it, so taking it
-    /// away entirely takes at most 4 dB. The CC and the parameter put the mute on.
+    /// (the bridge hill) falls with the mute by 6-12 dB against the power below 1 kHz,
+    /// which moves less than 1 dB. SHARC's muted violin loses 6-11 dB in those bands
+    /// against its open one (docs/articulations.md), the low ones within 1 dB of each
+    /// other; measured -8.7 and -9.7 dB. The CC and the parameter put the mute on.
     #[test]
     fn con_sordino_takes_level_out_of_the_bridge_hill() {
         let band = |x: &[f64], f0: f64, lo: f64, hi: f64| -> f64 {
@@ -833,7 +832,7 @@ mod tests {
             let (hill, low) = (db(levels[1].0, levels[0].0), db(levels[1].1, levels[0].1));
             eprintln!("con sordino, note {note}: hill {hill:+.1} dB, low {low:+.1} dB");
             assert!(
-                hill - low < -2.0,
+                (-12.0..-6.0).contains(&(hill - low)),
                 "note {note}: hill {hill:+.1} dB, low {low:+.1} dB"
             );
             assert!(low.abs() < 1.0, "note {note}: low {low:+.1} dB");
@@ -846,13 +845,17 @@ mod tests {
     }
 
     /// The mute put on and taken off while a note sounds moves the body to the new modes
-    /// over [`crate::dsp::instrument::MUTE_FADE_S`], from their ringing state, so the
+    /// over [`crate::dsp::body::MUTE_FADE_S`], from their ringing state, so the
     /// note leaves the same note left alone smoothly: their difference's largest step
     /// between samples over the 10 ms after each switch, against the note's own largest
-    /// step before it, under 2 % (measured 0.8-1.2 %; the new body switched in at once
-    /// from rest, without the fade, steps by 9.3 % on the violin). No switch adds a burst of high frequencies (the energy of the output's
-    /// second difference over the period after it stays under the largest of the ten
-    /// before it, where the note's own corners are).
+    /// step before it, stays under what the fade itself gives (the 10 ms's share of it,
+    /// a fifth, times the largest step of the note muted from the start minus the open
+    /// one) plus 2 % for the new body starting from the old one's state (the new body
+    /// switched in at once from rest, without the fade, steps by 9.3 % on the violin;
+    /// measured 4.4-7.3 % against allowances of 8.9-12.0 %). No switch adds a burst of high
+    /// frequencies (the energy of the output's second difference over the period after it
+    /// stays under the largest of the ten before it, where the note's own corners are, or the
+    /// same period of the note played from the start as switched to).
     #[test]
     fn switching_the_mute_during_a_note_does_not_click() {
         for kind in [InstrumentKind::Violin, InstrumentKind::Cello] {
@@ -863,10 +866,10 @@ mod tests {
                     ..Setup::default()
                 };
                 let note = kind.open_notes()[1] + 2;
-                let run = |switch: bool| {
+                let run_from = |setup: &Setup, switch: bool| {
                     let mut p = Performer::new(kind);
-                    p.activate(&setup, FS).unwrap();
-                    p.configure(&setup);
+                    p.activate(setup, FS).unwrap();
+                    p.configure(setup);
                     p.note_on(note, 0.8);
                     let mut out = play(&mut p, 0.6);
                     if switch {
@@ -875,35 +878,47 @@ mod tests {
                     out.extend(play(&mut p, 0.01));
                     out
                 };
-                let (left, out) = (run(false), run(true));
+                let (left, out) = (run_from(&setup, false), run_from(&setup, true));
+                let target = run_from(
+                    &Setup {
+                        con_sordino: on,
+                        ..setup
+                    },
+                    false,
+                );
                 let at = (0.6 * FS) as usize;
-                let difference: Vec<f64> = out[at - 1..]
-                    .iter()
-                    .zip(&left[at - 1..])
-                    .map(|(a, b)| a - b)
-                    .collect();
-                let step = difference
-                    .windows(2)
-                    .map(|w| (w[1] - w[0]).abs())
-                    .fold(0.0, f64::max)
-                    / left[..at]
-                        .windows(2)
+                let largest_step = |x: &[f64], y: &[f64]| {
+                    let d: Vec<f64> = x.iter().zip(y).map(|(a, b)| a - b).collect();
+                    d.windows(2)
                         .map(|w| (w[1] - w[0]).abs())
-                        .fold(0.0, f64::max);
+                        .fold(0.0, f64::max)
+                };
+                let note_step = largest_step(&left[..at], &vec![0.0; at]);
+                let step = largest_step(&out[at - 1..], &left[at - 1..]) / note_step;
+                let full = largest_step(&target[at - 1..], &left[at - 1..]) / note_step;
+                let allowed = 0.01 / crate::dsp::body::MUTE_FADE_S * full + 0.02;
                 let period = (FS / midi_to_hz(note as f64)).round() as usize;
-                let burst = |from: usize| -> f64 {
+                let burst = |x: &[f64], from: usize| -> f64 {
                     (from..from + period)
-                        .map(|n| (out[n] - 2.0 * out[n - 1] + out[n - 2]).powi(2))
+                        .map(|n| (x[n] - 2.0 * x[n - 1] + x[n - 2]).powi(2))
                         .sum()
                 };
-                let before = (1..=10).map(|k| burst(at - k * period)).fold(0.0, f64::max);
-                let after = burst(at);
+                // The mute taken off lets the open note's corners back: the fade's mix of
+                // the two bodies has no more of them than the larger of the two.
+                let before = (1..=10)
+                    .map(|k| burst(&out, at - k * period))
+                    .fold(burst(&target, at), f64::max);
+                let after = burst(&out, at);
                 eprintln!(
-                    "mute {on} on {kind:?} {note}: difference steps {:.2} % of the note's largest; high frequencies after the switch {:.3} of the largest before",
+                    "mute {on} on {kind:?} {note}: difference steps {:.2} % of the note's largest (allowed {:.2} %); high frequencies after the switch {:.3} of the largest before",
                     100.0 * step,
+                    100.0 * allowed,
                     after / before
                 );
-                assert!(step < 0.02, "{kind:?} mute {on}: {step}");
+                assert!(
+                    step < allowed,
+                    "{kind:?} mute {on}: {step} against {allowed}"
+                );
                 assert!(
                     after <= before,
                     "{kind:?} mute {on}: {after} against {before}"
@@ -916,10 +931,10 @@ mod tests {
     /// the bridge hill up (as on the point-bow body) lowers the harmonics above them
     /// against the low ones, and the strings are tuned for the bridge's phase delay, so the
     /// note keeps its pitch (within 3 cents, under what a player hears). The force on the
-    /// bridge leaves through the instrument's body, whose bridge modes the mute loads as
-    /// on the point-bow instrument: measured -2.8 dB over the hill against +0.0 below it
-    /// (the point-bow violin: -2.7 to -3.0 dB); the direction is asserted, the size
-    /// documented.
+    /// bridge leaves through the instrument's body, which the mute loads as on the
+    /// point-bow instrument ([`crate::dsp::body::MuteLoad`]): measured -4.9 dB from
+    /// 630 Hz against +0.2 dB below 315 Hz (the band starts below the cello's loaded hill,
+    /// 742 Hz); the direction is asserted, the size documented.
     #[test]
     fn con_sordino_mutes_the_thermal_bridge_and_keeps_the_pitch() {
         let kind = InstrumentKind::Cello;
