@@ -1103,4 +1103,34 @@ mod tests {
             last = d;
         }
     }
+
+    /// Released, an artificial harmonic's stopping finger lifts and damps it as after any
+    /// stopped note (lab/tests/note_release.rs): the harmonic's pitch over 0.05-0.15 s
+    /// after the key is let go is at least 12 dB under its last 0.1 s held (a stopped
+    /// note's release, 12 dB within 50 ms). The cello's G5 on its D string (stopped at G3,
+    /// touched at C4: at the defaults G5 is the G string's natural 8th partial, which
+    /// rings on), its F5 and its C6 (stopped at F3 and C4). Measured 92-150 dB down.
+    #[test]
+    fn a_released_artificial_harmonic_is_damped_by_the_lifting_finger() {
+        for (note, string) in [(79u8, Some(2usize)), (77, None), (84, None)] {
+            let setup = Setup {
+                articulation: Articulation::Harmonics,
+                preferred_string: string,
+                ..Setup::default()
+            };
+            let mut p = cello_with(&setup);
+            p.note_on(note, 0.8);
+            let mut out = play(&mut p, 1.0);
+            p.note_off(note);
+            out.extend(play(&mut p, 0.2));
+            let f = crate::dsp::vocabulary::midi_to_hz(note as f64);
+            let level = |from: f64, to: f64| {
+                let x = &out[(from * FS) as usize..(to * FS) as usize];
+                20.0 * partial_amplitude(x, FS, f).max(1e-15).log10()
+            };
+            let lost = level(0.9, 1.0) - level(1.05, 1.15);
+            eprintln!("artificial harmonic {note}: {lost:.1} dB down 0.05-0.15 s after");
+            assert!(lost > 12.0, "note {note}: {lost:.1} dB down");
+        }
+    }
 }
