@@ -52,6 +52,7 @@ impl Performer {
         if separate && self.held[note as usize & 127] {
             self.stroke
                 .start(self.setup.bow_strokes, stroke::velocity_step(velocity));
+            self.stroke.limit_onset(self.onset_floor());
             let velocity = stroke::velocity_step(velocity);
             self.stroke.set_tremolo(self.tremolo_stroke());
             let spiccato = self.articulation() == Articulation::Spiccato;

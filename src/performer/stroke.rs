@@ -272,6 +272,13 @@ impl Stroke {
         self.onset = (ONSET_OCTAVES_PER_VELOCITY * (v - mezzo)).min(0.0).exp2() - 1.0;
     }
 
+    /// Keeps the stroke's gentle start from setting out below `floor` (0..=1) of the asked
+    /// bow: for a contact that stops sticking under a bow speed (paper B's thermal bow,
+    /// [`super::gesture::THERMAL_SLOWEST_SCALE`]). A floor of 1 leaves no gentle start.
+    pub fn limit_onset(&mut self, floor: f64) {
+        self.onset = self.onset.max(floor.clamp(0.0, 1.0) - 1.0);
+    }
+
     /// The velocity (0..=1) the last stroke started with.
     pub fn velocity(&self) -> f64 {
         self.velocity
