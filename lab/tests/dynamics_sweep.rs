@@ -47,6 +47,8 @@ fn play(
     };
     let mut p = Performer::new(kind);
     p.activate(&setup, FS).expect("activate");
+    // As the plugin does: the block's setup (the source among it) before its events.
+    p.configure(&setup);
     p.set_controller(11, cc11 as f32 / 127.0);
     p.note_on(note, 100.0 / 127.0);
     let n = (SECONDS * FS) as usize;

@@ -477,6 +477,7 @@ mod tests {
         };
         let mut p = Performer::new(kind);
         p.activate(&setup, FS).unwrap();
+        p.configure(&setup);
         p.set_controller(11, if e < 0.0 { 1.0 } else { e });
         p.note_on(note, 0.8);
         let d = BowControl::default();
