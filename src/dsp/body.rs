@@ -274,9 +274,11 @@ impl BodyModes {
             self.s2[k] = self.neg_b0[k] * x - self.a2[k] * y;
             out[k] = y;
         }
-        // Summed in mode order, as the modes were added one by one.
+        // Summed in mode order, as the modes were added one by one. Every lane is added:
+        // an unused one adds `0 * 0 = +0`, which leaves any sum but a negative zero as it
+        // is, and needs no test of the mode count per lane.
         let mut y = self.direct_gain * x;
-        for k in 0..self.count.min(MAX_BODY_MODES) {
+        for k in 0..MAX_BODY_MODES {
             y += self.gains[k] * out[k];
         }
         match &mut self.mute {
