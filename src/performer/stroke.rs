@@ -476,6 +476,35 @@ mod tests {
     }
 
     #[test]
+    fn a_limited_gentle_start_sets_out_no_lower_than_its_floor() {
+        // After the ramp (velocity 30: 0.1 s at most), the level of the gentle start
+        // limited to `floor` against the unlimited one, at 0.11 s.
+        let level = |floor: Option<f64>| {
+            let mut s = Stroke::new(FS);
+            s.start(StrokeMode::Down, 30.0 / 127.0);
+            if let Some(floor) = floor {
+                s.limit_onset(floor);
+            }
+            let mut out = (0.0, 0.0);
+            for _ in 0..(0.11 * FS) as usize {
+                out = s.tick();
+            }
+            out.0
+        };
+        let left = (-0.11 / ONSET_RISE_S).exp();
+        let free = level(None);
+        // 0.33 of the bow at velocity 30 is under a floor of 0.6: the limited start sets
+        // out at 0.6 and rises from there (1e-3: the rise applied per sample).
+        assert!(((level(Some(0.6)) - (1.0 - 0.4 * left)).abs()) < 1e-3);
+        assert!(level(Some(0.6)) > free);
+        // A floor under the start's own depth changes nothing; a floor of 1 (or above,
+        // clamped) leaves no gentle start at all.
+        assert_eq!(level(Some(0.1)), free);
+        assert_eq!(level(Some(1.0)), 1.0);
+        assert_eq!(level(Some(7.0)), 1.0);
+    }
+
+    #[test]
     fn velocities_step_to_midi_resolution_and_bad_values_are_safe() {
         assert_eq!(velocity_step(64.0 / 127.0), 64.0 / 127.0);
         assert_eq!(velocity_step((64.0f64 / 127.0) as f32), 64.0 / 127.0);
