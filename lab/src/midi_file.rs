@@ -68,9 +68,14 @@ pub fn one_note_audio(
     held_s: f64,
     sample_rate_hz: f64,
 ) -> Vec<f64> {
-    let held = (held_s * sample_rate_hz) as u64;
     let how = Performance::plugin_defaults(kind, law, sample_rate_hz);
-    perform(&one_note(note, velocity, held), &how, |_, _| {})
+    one_note_performed(&how, note, velocity, held_s)
+}
+
+/// [`one_note_audio`] as `how` plays it (another setup than the defaults: a mute, say).
+pub fn one_note_performed(how: &Performance, note: u8, velocity: u8, held_s: f64) -> Vec<f64> {
+    let held = (held_s * how.sample_rate_hz) as u64;
+    perform(&one_note(note, velocity, held), how, |_, _| {})
         .expect("one note plays")
         .into_iter()
         .map(f64::from)

@@ -9,7 +9,7 @@
 
 use colophony::dsp::friction::FrictionModel;
 use colophony::dsp::vocabulary::InstrumentKind;
-use colophony_lab::midi_file::{one_note, perform, Performance};
+use colophony_lab::midi_file::{one_note_performed, Performance};
 use colophony_lab::timbre::{
     bands, long_term_spectrum, measured, notes, reference, NOTE_S, VELOCITY,
 };
@@ -50,18 +50,9 @@ fn the_mutes_loss_against_a_real_mutes() {
         for mute in [false, true] {
             let mut how = Performance::plugin_defaults(kind, law, FS);
             how.setup.con_sordino = mute;
-            let held = (NOTE_S * FS) as u64;
             let played: Vec<_> = chosen
                 .iter()
-                .map(|&note| {
-                    let out: Vec<f64> = perform(&one_note(note, VELOCITY, held), &how, |_, _| {})
-                        .expect("one note plays")
-                        .into_iter()
-                        .map(f64::from)
-                        .take(held as usize)
-                        .collect();
-                    measured(&out, FS, note)
-                })
+                .map(|&note| measured(&one_note_performed(&how, note, VELOCITY, NOTE_S), FS, note))
                 .collect();
             let refs: Vec<_> = played.iter().collect();
             spectra.push(long_term_spectrum(&refs, &bands));

@@ -78,7 +78,8 @@ impl MuteLoad {
     }
 
     /// The filter's magnitude at `freq_hz` (its digital frequency response).
-    pub fn gain_at(&self, freq_hz: f64, sample_rate_hz: f64) -> f64 {
+    #[cfg(test)]
+    fn gain_at(&self, freq_hz: f64, sample_rate_hz: f64) -> f64 {
         let w = 2.0 * PI * freq_hz / sample_rate_hz;
         let z1 = (w.cos(), -w.sin());
         let z2 = ((2.0 * w).cos(), -(2.0 * w).sin());

@@ -220,19 +220,14 @@ impl Performer {
                 g.bow_scale.powf(-DYNAMICS_DRIFT_EXPONENT)
             };
         }
+        let (bow_scale, beta_scale) = (g.bow_scale, g.beta_scale);
         // With the guard the force follows the velocity and the bow drifts from the
-        // bridge as the dynamics fall; without it only the velocity follows. Paper B's
-        // thermal bow slows down no further than its slowest scale.
-        let (velocity_scale, force_scale, away) = if self.setup.dynamics_guard {
-            let scale = match self.source {
-                Source::Thermal(_) => g
-                    .bow_scale
-                    .max(thermal_slowest_scale(self.setup.instrument)),
-                _ => g.bow_scale,
-            };
-            (scale, scale, g.beta_scale)
+        // bridge as the dynamics fall; without it only the velocity follows.
+        let velocity_scale = self.dynamics_velocity_scale(bow_scale);
+        let (force_scale, away) = if self.setup.dynamics_guard {
+            (velocity_scale, beta_scale)
         } else {
-            (g.bow_scale, 1.0, 1.0)
+            (1.0, 1.0)
         };
         let out = if velocity_scale == 1.0 && speed == 1.0 && landing == 1.0 && away == 1.0 {
             bow
@@ -246,6 +241,7 @@ impl Performer {
         // Steady from here on until a controller, a pressure or a note: the next samples
         // only multiply (the same bits: `speed` is +-1, so the order of the products does
         // not round differently).
+        let g = &self.gesture;
         let steady = g.vibrato_cents == 0.0
             && g.vibrato_now == 0.0
             && g.bow_scale == g.target
@@ -267,25 +263,32 @@ impl Performer {
         out
     }
 
-    /// The least share of the asked bow a soft note's gentle start may set out at
-    /// ([`super::stroke::Stroke::limit_onset`]). Paper B's thermal bow slides below its
-    /// slowest scale ([`THERMAL_SLOWEST_SCALE`]), so its gentle start stops where the
-    /// dynamics' scale times it reaches that floor (none at all once the dynamics are
-    /// there); the point laws' sets out as low as the velocity asks.
-    pub(super) fn onset_floor(&self) -> f64 {
-        match self.source {
-            Source::Thermal(_) => {
-                let slowest = thermal_slowest_scale(self.setup.instrument);
-                let target = self.gesture.target;
-                let scale = if self.setup.dynamics_guard {
-                    target.max(slowest)
-                } else {
-                    target
-                };
-                (slowest / scale.max(f64::MIN_POSITIVE)).min(1.0)
-            }
-            _ => 0.0,
+    /// Paper B's thermal bow's slowest scale of the parameters' bow
+    /// ([`THERMAL_SLOWEST_SCALE`]), below which its rosin slides; `None` for the other
+    /// sources.
+    fn slowest_bow_scale(&self) -> Option<f64> {
+        matches!(self.source, Source::Thermal(_))
+            .then(|| thermal_slowest_scale(self.setup.instrument))
+    }
+
+    /// The dynamics' factor on the bow's speed at the dynamics' scale `scale`: with the
+    /// guard, no lower than the source's slowest bow scale.
+    fn dynamics_velocity_scale(&self, scale: f64) -> f64 {
+        match self.slowest_bow_scale() {
+            Some(slowest) if self.setup.dynamics_guard => scale.max(slowest),
+            _ => scale,
         }
+    }
+
+    /// The least share of the asked bow a soft note's gentle start may set out at
+    /// ([`super::stroke::Stroke::limit_onset`]): where the dynamics' bow times it reaches
+    /// the source's slowest bow scale (none at all once the dynamics are there); the point
+    /// laws' sets out as low as the velocity asks.
+    pub(super) fn onset_floor(&self) -> f64 {
+        self.slowest_bow_scale().map_or(0.0, |slowest| {
+            let scale = self.dynamics_velocity_scale(self.gesture.target);
+            (slowest / scale.max(f64::MIN_POSITIVE)).min(1.0)
+        })
     }
 
     /// Tells the engines the expression the guard's bow `scale` plays (0..=1, so their
