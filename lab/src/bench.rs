@@ -536,11 +536,27 @@ fn children_cpu_s() -> f64 {
     0.0
 }
 
-/// Runs `cmd` to completion; its CPU time (user + system, s).
-fn child_cpu_s(cmd: &mut std::process::Command, what: &str) -> Result<f64, String> {
+/// Runs `cmd` to completion; its CPU time (user + system, s) and the timing floor it
+/// printed on standard error ([`crate::timing`], ns a sample), if it printed one.
+fn child_cpu_and_floor(
+    cmd: &mut std::process::Command,
+    what: &str,
+) -> Result<(f64, Option<f64>), String> {
     let before = children_cpu_s();
-    crate::precision::peers::run_checked(cmd, what)?;
-    Ok(children_cpu_s() - before)
+    let out = cmd
+        .output()
+        .map_err(|e| format!("cannot run {what}: {e}"))?;
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if !out.status.success() {
+        return Err(format!(
+            "{what} failed: {}",
+            stderr.lines().next().unwrap_or("no message")
+        ));
+    }
+    Ok((
+        children_cpu_s() - before,
+        crate::timing::parse_floor(&stderr),
+    ))
 }
 
 /// Rounds of [`peers`]: every process runs this many times, interleaved.
@@ -602,7 +618,7 @@ pub fn peers(seconds: f64, dir: &std::path::Path) -> Result<String, String> {
                 goal,
                 command: Box::new(move |secs: f64| {
                     let mut c = std::process::Command::new(&me);
-                    c.args(["render", "--note", "D3", "--friction", friction])
+                    c.args(["render", "--note", "D3", "--friction", friction, "--timing"])
                         .args(["--seconds", &format!("{secs}")]);
                     if let Some(q) = quality {
                         c.args(["--quality", q]);
@@ -667,9 +683,13 @@ pub fn peers(seconds: f64, dir: &std::path::Path) -> Result<String, String> {
         scene_row("thermal quartet, plugin quality", "quartet", Some(15.0)),
     ];
     let mut cpu = vec![Vec::with_capacity(PEER_ROUNDS); rows.len()];
+    // Each row's timing floor over the rounds, ns a 48 kHz sample.
+    let mut floors = vec![f64::INFINITY; rows.len()];
     for _round in 0..PEER_ROUNDS {
-        for (row, times) in rows.iter().zip(&mut cpu) {
-            times.push(child_cpu_s(&mut (row.command)(row.seconds), row.name)?);
+        for ((row, times), floor) in rows.iter().zip(&mut cpu).zip(&mut floors) {
+            let (t, f) = child_cpu_and_floor(&mut (row.command)(row.seconds), row.name)?;
+            times.push(t);
+            *floor = floor.min(f.unwrap_or(f64::INFINITY));
         }
     }
     let instructions: Vec<Option<f64>> = if valgrind_available() {
@@ -694,14 +714,19 @@ pub fn peers(seconds: f64, dir: &std::path::Path) -> Result<String, String> {
     let mut lines = vec![
         format!(
             "Whole processes, user + system CPU, best of {PEER_ROUNDS} (interleaved); spread = worst / best - 1; \
-             cello D3 at 48 kHz ({seconds} s; paper B's scenes {} s)",
-            rows[4].seconds
+             cello D3 at 48 kHz ({seconds} s; paper B's scenes {} s). Floor: each process's fastest \
+             stretch of {} samples, the least over the rounds, ns a 48 kHz sample (the sample loop \
+             with its output, no setup), which other load on the machine cannot raise; its \
+             measure against STK's floor or as a share of one core",
+            rows[4].seconds,
+            crate::timing::FLOOR_STRETCH
         ),
         String::new(),
-        "| what | CPU best (s) | spread | measured | range over the rounds | instructions a sample | goal | met |".into(),
-        "|---|---|---|---|---|---|---|---|".into(),
+        "| what | CPU best (s) | spread | measured | range over the rounds | floor (ns a sample) | floor measured | instructions a sample | goal | met (best, floor) |".into(),
+        "|---|---|---|---|---|---|---|---|---|---|".into(),
     ];
-    for ((row, times), instr) in rows.iter().zip(&cpu).zip(&instructions) {
+    let stk_floor = floors[0];
+    for (((row, times), instr), &floor) in rows.iter().zip(&cpu).zip(&instructions).zip(&floors) {
         let (b, w) = (best(times), worst(times));
         // Each round's value, the best's, and its unit.
         let (per_round, value, unit): (Vec<f64>, f64, &str) = match row.measure {
@@ -720,21 +745,38 @@ pub fn peers(seconds: f64, dir: &std::path::Path) -> Result<String, String> {
             format!("{value:.2}{unit}"),
             format!("{:.2}-{:.2}", best(&per_round), worst(&per_round)),
         );
+        // The floor's measure: against STK's floor, or the share of a core a 48 kHz
+        // stream takes at that time a sample.
+        let floor_value = floor.is_finite().then(|| match row.measure {
+            PeerMeasure::TimesStk => floor / stk_floor,
+            PeerMeasure::PercentOfCore => 100.0 * floor * 1e-9 * 48_000.0,
+        });
         let goal = row.goal.map_or(String::new(), |g| format!("<= {g}{unit}"));
-        let met = row
-            .goal
-            .map_or("", |g| if value <= g { "yes" } else { "no" });
+        let verdict = |v: f64, g: f64| if v <= g { "yes" } else { "no" };
+        let met = row.goal.map_or(String::new(), |g| {
+            format!(
+                "{}, {}",
+                verdict(value, g),
+                floor_value.map_or("-", |f| verdict(f, g))
+            )
+        });
         lines.push(format!(
-            "| {} | {b:.3} | {:.0} % | {measured} | {range} | {} | {goal} | {met} |",
+            "| {} | {b:.3} | {:.0} % | {measured} | {range} | {} | {} | {} | {goal} | {met} |",
             row.name,
             100.0 * (w / b - 1.0),
+            if floor.is_finite() {
+                format!("{floor:.1}")
+            } else {
+                "-".into()
+            },
+            floor_value.map_or("-".into(), |f| format!("{f:.2}{unit}")),
             instr.map_or("-".into(), |i| format!("{i:.0}")),
         ));
     }
     let (silent_s, bowed_s) = performer_silence_cost(4.0);
     let silence = 100.0 * silent_s / bowed_s;
     lines.push(format!(
-        "| silence through the performer (in-process, best of five) | | | {silence:.2} % of one bowed string | | | <= 1 % | {} |",
+        "| silence through the performer (in-process, best of five) | | | {silence:.2} % of one bowed string | | | | | <= 1 % | {} |",
         if silence <= 1.0 { "yes" } else { "no" }
     ));
     if instructions.iter().all(Option::is_none) {
@@ -838,6 +880,7 @@ pub fn peer_scene(name: &str, seconds: f64) -> Result<String, String> {
     // Each player's sum of squares over the last second: every one must sound.
     let mut energy = vec![0.0; players.len()];
     let last_second = blocks.saturating_sub((fs / block as f64) as usize);
+    let mut floor = crate::timing::Floor::new();
     for b in 0..blocks {
         mix.iter_mut().for_each(|x| *x = 0.0);
         for (p, e) in players.iter_mut().zip(&mut energy) {
@@ -847,6 +890,7 @@ pub fn peer_scene(name: &str, seconds: f64) -> Result<String, String> {
                 *e += out.iter().map(|x| x * x).sum::<f64>();
             }
         }
+        floor.advance(block);
     }
     let levels: Vec<String> = energy
         .iter()
@@ -856,6 +900,9 @@ pub fn peer_scene(name: &str, seconds: f64) -> Result<String, String> {
         return Err(format!(
             "peer scene {name}: a player is silent or not finite ({levels:?} dB)"
         ));
+    }
+    if floor.ns_per_sample().is_some() {
+        eprintln!("{}", floor.line());
     }
     Ok(format!(
         "{name}: {seconds} s; each player's level over the last second {} dB",

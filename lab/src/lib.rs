@@ -8,7 +8,8 @@
 //! - [`bench`](mod@bench), [`precision`], [`playing_space`], [`intonation_fit`]: real-time ratios, the
 //!   work-precision benchmark, the playing-space map and the intonation table;
 //! - [`admittance_fit`]: fitting a passive modal bridge to measured admittance;
-//! - [`timbre`]: the played notes' long-term spectrum against a real instrument's.
+//! - [`timbre`]: the played notes' long-term spectrum against a real instrument's;
+//! - [`timing`]: a timing floor that other load on the machine cannot raise.
 
 pub mod admittance_fit;
 pub mod bench;
@@ -20,3 +21,4 @@ pub mod precision;
 pub mod render;
 pub mod thermal_constants;
 pub mod timbre;
+pub mod timing;

@@ -58,6 +58,11 @@ enum Command {
         /// 2 friction force (N).
         #[arg(long)]
         probe: bool,
+        /// Print, on standard error, the fastest third of a second's render time a sample
+        /// (`floor_ns_per_sample X`): a floor other load on the machine cannot raise, as
+        /// `bench peers` reads it. Bowed notes of the point-bow strings only.
+        #[arg(long)]
+        timing: bool,
         /// Friction law: hyperbolic, static (Stribeck), lugre, elasto-plastic, or thermal
         /// (paper B's finite-width bow; see --nodes and --bow-width).
         #[arg(long, default_value = "hyperbolic", value_parser = parse_friction)]
@@ -239,6 +244,7 @@ fn main() -> ExitCode {
             reference_pitch,
             release,
             probe,
+            timing,
             friction,
             nodes,
             bow_width,
@@ -357,10 +363,20 @@ fn main() -> ExitCode {
                                 instrument.set_newton_tolerance(t);
                             }
                         };
+                        let mut floor = colophony_lab::timing::Floor::new();
                         if probe {
-                            render_frames(&settings, configure, |frame| wav.push(frame))?;
+                            render_frames(&settings, configure, |frame| {
+                                floor.advance(1);
+                                wav.push(frame)
+                            })?;
                         } else {
-                            render_blocks(&settings, configure, |audio| wav.push_audio(audio))?;
+                            render_blocks(&settings, configure, |audio| {
+                                floor.advance(audio.len());
+                                wav.push_audio(audio)
+                            })?;
+                        }
+                        if timing && floor.ns_per_sample().is_some() {
+                            eprintln!("{}", floor.line());
                         }
                         wav.finish()
                     })

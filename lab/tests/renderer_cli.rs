@@ -604,3 +604,35 @@ fn blank_png_bytes(w: u32, h: u32) -> usize {
     }
     std::fs::read(&path).unwrap().len()
 }
+
+#[test]
+fn timing_prints_a_floor_no_slower_than_the_whole_render() {
+    // `--timing` prints the fastest stretch's time a sample on standard error; the
+    // fastest stretch cannot be slower than the render's mean, setup included (the
+    // `wrote` line's time over the samples).
+    let out = scratch("timing.wav");
+    let run = colophony(&[
+        "render",
+        "--out",
+        out.to_str().unwrap(),
+        "--seconds",
+        "1",
+        "--timing",
+    ]);
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&run.stdout),
+        String::from_utf8_lossy(&run.stderr),
+    );
+    assert!(run.status.success(), "{stderr}");
+    let floor_ns = colophony_lab::timing::parse_floor(&stderr).expect("a floor line");
+    let took_s: f64 = stdout
+        .split(" s in ")
+        .nth(1)
+        .and_then(|rest| rest.split(" s,").next())
+        .and_then(|t| t.parse().ok())
+        .expect("the render's time");
+    assert!(
+        floor_ns > 0.0 && floor_ns <= took_s / 48_000.0 * 1e9,
+        "floor {floor_ns} ns against {took_s} s for 48000 samples"
+    );
+}
