@@ -451,7 +451,7 @@ impl Instrument {
             sample_rate_hz,
             voices,
             body: FadingBody::new(
-                BodyModes::new(&kind.body_modes(), 1.0, sample_rate_hz),
+                super::body::body_for(kind, None, false, sample_rate_hz),
                 sample_rate_hz,
             ),
             custom_bodies: [None; InstrumentKind::COUNT],

@@ -456,7 +456,7 @@ impl<B: StringBank> FourStrings<B> {
             fade: 1.0,
             fade_step: 1.0 / (RECONFIGURE_FADE_S * host_rate_hz).max(1.0),
             body: FadingBody::new(
-                BodyModes::new(&kind.body_modes(), 1.0, host_rate_hz),
+                super::body::body_for(kind, None, false, host_rate_hz),
                 host_rate_hz,
             ),
             muted: false,
