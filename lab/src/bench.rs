@@ -163,26 +163,104 @@ pub fn table1() -> Result<String, String> {
     let bridge = shipped_bridge(InstrumentKind::Cello).modes;
     let audio_s = 1.0;
     let mut lines = vec![
-        format!("The plugin's thermal cello (4 strings x 2 polarisations, {}-mode bridge, resampled to 48 kHz), 1 s of audio after a 0.2 s onset, best of three, % of one core:", bridge.len()),
+        format!(
+            "The plugin's thermal cello (4 strings x 2 polarisations, {}-mode bridge, resampled to \
+             48 kHz), {audio_s} s of audio a round after a 0.2 s onset, {TABLE1_ROUNDS} rounds with \
+             every row and scene interleaved in each, % of one core: the best round, its spread \
+             (worst / best - 1) and the floor (the fastest stretch of {} samples over the rounds, \
+             which other load on the machine cannot raise; lab/src/timing.rs):",
+            bridge.len(),
+            crate::timing::FLOOR_STRETCH
+        ),
         String::new(),
-        "| N_B | nodes C/G/D/A | internal rate (kHz) | C string bowed (%) | double stop C+G (%) | paper, C bowed, P9400 (%) |".to_string(),
-        "|---|---|---|---|---|---|".to_string(),
+        "| N_B | nodes C/G/D/A | internal rate (kHz) | C string bowed (%) | spread | floor (%) | double stop C+G (%) | spread | floor (%) | paper, C bowed, P9400 (%) |".to_string(),
+        "|---|---|---|---|---|---|---|---|---|---|".to_string(),
     ];
-    for (nodes, paper_percent) in paper {
-        let (cost, cello) = thermal_cello_cost(nodes, &bridge, bow, audio_s)?;
-        let n = cello.nodes_per_string();
+    let mut scenes = Vec::new();
+    for (nodes, _) in paper {
+        scenes.push(thermal_cello_scenes(nodes, &bridge, bow)?);
+    }
+    // Each scene's time a round, s, and its floor, s a sample.
+    let mut times = vec![[const { Vec::new() }; 2]; scenes.len()];
+    let mut floors = vec![[f64::INFINITY; 2]; scenes.len()];
+    let samples = (audio_s * TABLE1_RATE_HZ) as usize;
+    let mut out = vec![0.0; TABLE1_BLOCK];
+    for _round in 0..TABLE1_ROUNDS {
+        for ((pair, t), f) in scenes.iter_mut().zip(&mut times).zip(&mut floors) {
+            for (k, cello) in pair.iter_mut().enumerate() {
+                let mut floor = crate::timing::Floor::new();
+                let start = Instant::now();
+                for _ in 0..samples / TABLE1_BLOCK {
+                    cello.process(bow, &mut out);
+                    std::hint::black_box(&out);
+                    floor.advance(TABLE1_BLOCK);
+                }
+                t[k].push(start.elapsed().as_secs_f64());
+                f[k] = f[k].min(floor.ns_per_sample().unwrap_or(f64::INFINITY) * 1e-9);
+            }
+        }
+    }
+    let percent = |s: f64| 100.0 * s / audio_s;
+    for (((nodes, paper_percent), pair), (t, f)) in
+        paper.iter().zip(&scenes).zip(times.iter().zip(&floors))
+    {
+        let n = pair[0].nodes_per_string();
+        let cell = |k: usize| {
+            let best = t[k].iter().copied().fold(f64::INFINITY, f64::min);
+            let worst = t[k].iter().copied().fold(0.0, f64::max);
+            format!(
+                "{:.1} | {:.0} % | {:.1}",
+                percent(best),
+                100.0 * (worst / best - 1.0),
+                100.0 * f[k] * TABLE1_RATE_HZ
+            )
+        };
         lines.push(format!(
-            "| {nodes} | {}/{}/{}/{} | {:.1} | {:.1} | {:.1} | {paper_percent} |",
+            "| {nodes} | {}/{}/{}/{} | {:.1} | {} | {} | {paper_percent} |",
             n[0],
             n[1],
             n[2],
             n[3],
-            cello.internal_rate_hz() / 1e3,
-            100.0 * cost[0] / audio_s,
-            100.0 * cost[1] / audio_s,
+            pair[0].internal_rate_hz() / 1e3,
+            cell(0),
+            cell(1),
         ));
     }
     Ok(lines.join("\n"))
+}
+
+/// Rounds of [`table1`]: every row and scene is timed this many times, interleaved.
+const TABLE1_ROUNDS: usize = 5;
+/// [`table1`]'s output rate, Hz, and the block it processes.
+const TABLE1_RATE_HZ: f64 = 48_000.0;
+const TABLE1_BLOCK: usize = 512;
+
+/// The plugin's thermal cello at 48 kHz with `nodes` bow nodes over 1 cm bowed with
+/// `bow` for a 0.2 s onset: the C string alone, and the double stop C+G.
+fn thermal_cello_scenes(
+    nodes: usize,
+    bridge: &[colophony::dsp::bridge::BridgeMode],
+    bow: BowControl,
+) -> Result<[colophony::dsp::thermal_instrument::ThermalInstrument; 2], String> {
+    use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
+    let scene = |notes: &[u8]| -> Result<ThermalInstrument, String> {
+        let mut cello = ThermalInstrument::new(
+            InstrumentKind::Cello,
+            bridge,
+            TABLE1_RATE_HZ,
+            ThermalSettings {
+                nodes,
+                width_m: 0.01,
+            },
+        )?;
+        for &note in notes {
+            cello.note_on(note);
+        }
+        let mut onset = vec![0.0; (0.2 * TABLE1_RATE_HZ) as usize];
+        cello.process(bow, &mut onset);
+        Ok(cello)
+    };
+    Ok([scene(&[36])?, scene(&[36, 43])?])
 }
 
 /// Paper B's Figure 6 bow: 0.15 m/s, beta 0.07, 300 N/m over 1 cm (3 N).
@@ -191,49 +269,6 @@ const FIG6_BOW: BowControl = BowControl {
     force_n: 3.0,
     position_beta: 0.07,
 };
-
-/// Seconds of CPU for `audio_s` of the plugin's thermal cello at 48 kHz with `nodes` bow
-/// nodes over 1 cm, after a 0.2 s onset, best of three: the C string bowed, and the
-/// double stop C+G. Returns the instrument of the last run too.
-fn thermal_cello_cost(
-    nodes: usize,
-    bridge: &[colophony::dsp::bridge::BridgeMode],
-    bow: BowControl,
-    audio_s: f64,
-) -> Result<
-    (
-        [f64; 2],
-        colophony::dsp::thermal_instrument::ThermalInstrument,
-    ),
-    String,
-> {
-    use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
-    let out_rate = 48_000.0;
-    let mut cost = [0.0; 2];
-    let mut instrument = None;
-    for (k, notes) in [&[36u8][..], &[36, 43][..]].iter().enumerate() {
-        let mut cello = ThermalInstrument::new(
-            InstrumentKind::Cello,
-            bridge,
-            out_rate,
-            ThermalSettings {
-                nodes,
-                width_m: 0.01,
-            },
-        )?;
-        for &note in *notes {
-            cello.note_on(note);
-        }
-        let mut out = vec![0.0; (audio_s * out_rate) as usize];
-        cello.process(bow, &mut out[..(0.2 * out_rate) as usize]);
-        cost[k] = best_of_three(|| {
-            cello.process(bow, &mut out);
-            std::hint::black_box(&out);
-        });
-        instrument = Some(cello);
-    }
-    Ok((cost, instrument.expect("two runs")))
-}
 
 /// Seconds of CPU for `seconds` of the performer in the plugin's 512-sample blocks,
 /// silent (every engine asleep: a silent block is skipped whole, `Performer::skip`) or
