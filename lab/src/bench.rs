@@ -168,13 +168,14 @@ pub fn table1() -> Result<String, String> {
              48 kHz), {audio_s} s of audio a round after a 0.2 s onset, {TABLE1_ROUNDS} rounds with \
              every row and scene interleaved in each, % of one core: the best round, its spread \
              (worst / best - 1) and the floor (the fastest stretch of {} samples over the rounds, \
-             which other load on the machine cannot raise; lab/src/timing.rs):",
+             which other load on the machine cannot raise; lab/src/timing.rs), and where valgrind \
+             is installed the instructions a 48 kHz sample (callgrind, 0.5 s against 0.25 s):",
             bridge.len(),
             crate::timing::FLOOR_STRETCH
         ),
         String::new(),
-        "| N_B | nodes C/G/D/A | internal rate (kHz) | C string bowed (%) | spread | floor (%) | double stop C+G (%) | spread | floor (%) | paper, C bowed, P9400 (%) |".to_string(),
-        "|---|---|---|---|---|---|---|---|---|---|".to_string(),
+        "| N_B | nodes C/G/D/A | internal rate (kHz) | C string bowed (%) | spread | floor (%) | instructions a sample | double stop C+G (%) | spread | floor (%) | instructions a sample | paper, C bowed, P9400 (%) |".to_string(),
+        "|---|---|---|---|---|---|---|---|---|---|---|---|".to_string(),
     ];
     let mut scenes = Vec::new();
     for (nodes, _) in paper {
@@ -200,6 +201,24 @@ pub fn table1() -> Result<String, String> {
             }
         }
     }
+    // Instructions a 48 kHz sample of each scene where valgrind is installed: callgrind on
+    // `bench peer-scene:cello-c@N` (and `cello-cg@N`) for 0.25 s and 0.5 s, their
+    // difference (the setup and the attack cancel).
+    let me = std::env::current_exe().map_err(|e| e.to_string())?;
+    let with_valgrind = valgrind_available();
+    let instructions = |nodes: usize, k: usize| -> String {
+        if !with_valgrind {
+            return "-".into();
+        }
+        let scene = format!("peer-scene:{}@{nodes}", ["cello-c", "cello-cg"][k]);
+        let command = |secs: f64| {
+            let mut c = std::process::Command::new(&me);
+            c.args(["bench", &scene, "--seconds", &format!("{secs}")]);
+            c
+        };
+        instructions_per_sample(&command, 0.25, 0.5, &scene)
+            .map_or("-".into(), |i| format!("{i:.0}"))
+    };
     let percent = |s: f64| 100.0 * s / audio_s;
     for (((nodes, paper_percent), pair), (t, f)) in
         paper.iter().zip(&scenes).zip(times.iter().zip(&floors))
@@ -209,10 +228,11 @@ pub fn table1() -> Result<String, String> {
             let best = t[k].iter().copied().fold(f64::INFINITY, f64::min);
             let worst = t[k].iter().copied().fold(0.0, f64::max);
             format!(
-                "{:.1} | {:.0} % | {:.1}",
+                "{:.1} | {:.0} % | {:.1} | {}",
                 percent(best),
                 100.0 * (worst / best - 1.0),
-                100.0 * f[k] * TABLE1_RATE_HZ
+                100.0 * f[k] * TABLE1_RATE_HZ,
+                instructions(*nodes, k)
             )
         };
         lines.push(format!(
@@ -863,7 +883,8 @@ fn instructions_per_sample(
 /// prints nothing (the parent times the process): `cello-c` (the cello's open C, `N_B`
 /// 60 over 1 cm, paper B's Figure 6 bow), `cello-cg` (the double stop C+G, the same) and
 /// `quartet` (two violins, a viola and a cello, each bowing one note at the plugin's
-/// default quality, the plugin's default bow).
+/// default quality, the plugin's default bow). `cello-c@N` and `cello-cg@N` bow with
+/// `N` nodes instead of 60 ([`table1`]'s rows).
 pub fn peer_scene(name: &str, seconds: f64) -> Result<String, String> {
     use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
     if !(seconds.is_finite() && seconds > 0.0 && seconds <= 3600.0) {
@@ -890,9 +911,28 @@ pub fn peer_scene(name: &str, seconds: f64) -> Result<String, String> {
     let good = colophony::quality::Quality::Good
         .fixed_thermal_nodes()
         .expect("the good preset fixes its node count");
-    let (mut players, bow) = match name {
-        "cello-c" => (vec![build(InstrumentKind::Cello, 60, &[36])?], FIG6_BOW),
-        "cello-cg" => (vec![build(InstrumentKind::Cello, 60, &[36, 43])?], FIG6_BOW),
+    let (scene, cello_nodes) = match name.split_once('@') {
+        Some((scene, n)) if scene != "quartet" => (
+            scene,
+            n.parse::<usize>()
+                .map_err(|_| format!("peer scene '{name}': '{n}' is not a node count"))?,
+        ),
+        Some(_) => {
+            return Err(format!(
+                "peer scene '{name}': the quartet takes no node count"
+            ))
+        }
+        None => (name, 60),
+    };
+    let (mut players, bow) = match scene {
+        "cello-c" => (
+            vec![build(InstrumentKind::Cello, cello_nodes, &[36])?],
+            FIG6_BOW,
+        ),
+        "cello-cg" => (
+            vec![build(InstrumentKind::Cello, cello_nodes, &[36, 43])?],
+            FIG6_BOW,
+        ),
         "quartet" => (
             vec![
                 build(InstrumentKind::Violin, good, &[76])?,
@@ -902,11 +942,9 @@ pub fn peer_scene(name: &str, seconds: f64) -> Result<String, String> {
             ],
             BowControl::default(),
         ),
-        other => {
-            return Err(format!(
-                "unknown peer scene '{other}': cello-c, cello-cg or quartet"
-            ))
-        }
+        other => return Err(format!(
+            "unknown peer scene '{other}': cello-c, cello-cg (each with @N for N nodes) or quartet"
+        )),
     };
     let block = 512;
     let mut out = vec![0.0; block];
