@@ -598,16 +598,7 @@ fn child_cpu_and_floor(
     what: &str,
 ) -> Result<(f64, Option<f64>), String> {
     let before = children_cpu_s();
-    let out = cmd
-        .output()
-        .map_err(|e| format!("cannot run {what}: {e}"))?;
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    if !out.status.success() {
-        return Err(format!(
-            "{what} failed: {}",
-            stderr.lines().next().unwrap_or("no message")
-        ));
-    }
+    let (_, stderr) = crate::precision::peers::run_checked_both(cmd, what)?;
     Ok((
         children_cpu_s() - before,
         crate::timing::parse_floor(&stderr),
@@ -942,9 +933,11 @@ pub fn peer_scene(name: &str, seconds: f64) -> Result<String, String> {
             ],
             BowControl::default(),
         ),
-        other => return Err(format!(
+        other => {
+            return Err(format!(
             "unknown peer scene '{other}': cello-c, cello-cg (each with @N for N nodes) or quartet"
-        )),
+        ))
+        }
     };
     let block = 512;
     let mut out = vec![0.0; block];

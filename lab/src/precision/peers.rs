@@ -75,17 +75,22 @@ pub fn ensure_installed() -> Result<(), String> {
 
 /// Runs `cmd` to completion: its standard output, or the first line of its error.
 pub(crate) fn run_checked(cmd: &mut Command, what: &str) -> Result<String, String> {
+    run_checked_both(cmd, what).map(|(stdout, _)| stdout)
+}
+
+/// [`run_checked`], with the standard error of a run that succeeded too.
+pub(crate) fn run_checked_both(cmd: &mut Command, what: &str) -> Result<(String, String), String> {
     let out = cmd
         .output()
         .map_err(|e| format!("cannot run {what}: {e}"))?;
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
     if !out.status.success() {
-        let err = String::from_utf8_lossy(&out.stderr);
         return Err(format!(
             "{what} failed: {}",
             err.lines().next().unwrap_or("no message")
         ));
     }
-    Ok(String::from_utf8_lossy(&out.stdout).into_owned())
+    Ok((String::from_utf8_lossy(&out.stdout).into_owned(), err))
 }
 
 /// Runs a built driver; returns the fastest render time (s) and the audio.
