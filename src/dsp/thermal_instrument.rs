@@ -49,6 +49,7 @@
 use super::bridge::{solve_junction, BridgeMode, ModalBridge};
 use super::intonation;
 use super::resample::Resampler;
+use super::strings::HARMONIC_FINGER_RESISTANCE_Z0;
 pub use super::strings::{FourStrings, RECONFIGURE_FADE_S};
 use super::strings::{InternalSample, StringBank, StringBow};
 use super::thermal::{
@@ -255,9 +256,11 @@ impl ThermalBank {
         -phase / w
     }
 
-    /// Tunes string `i` to `f0_hz` with the bridge's delay accounted for.
+    /// Tunes string `i` to `f0_hz` with the bridge's delay accounted for (at the touched
+    /// partial's frequency while a finger touches the string for a harmonic).
     fn tune(&mut self, i: usize, f0_hz: f64) -> bool {
-        let delay = self.bridge_delay(i, f0_hz);
+        let partial = self.core.strings[i].touched_partial() as f64;
+        let delay = self.bridge_delay(i, f0_hz * partial);
         self.core.strings[i].set_fundamental_with_delay(f0_hz, delay)
     }
 }
@@ -318,6 +321,22 @@ impl StringBank for ThermalBank {
 
     fn set_finger_reflection(&mut self, i: usize, reflection: f64) {
         self.core.strings[i].set_finger_reflection(reflection);
+    }
+
+    const TOUCHABLE: bool = true;
+
+    /// The light finger on both polarisations of string `i`, at the node of `partial`
+    /// nearest the bridge ([`ThermalString::set_touch`]); the string is retuned at its
+    /// stopped pitch with the loop matched at the partial.
+    fn touch(&mut self, i: usize, partial: Option<u32>) {
+        let string = &mut self.core.strings[i];
+        let resistance = HARMONIC_FINGER_RESISTANCE_Z0 * string.z0_kg_per_s();
+        let before = string.touched_partial();
+        string.set_touch(partial.map(|n| (n, resistance)));
+        let f0 = string.fundamental_hz();
+        if (before > 1 || string.touched_partial() > 1) && f0 > 0.0 {
+            self.tune(i, f0);
+        }
     }
 
     fn wake(&mut self, _i: usize) {

@@ -89,10 +89,12 @@ impl Performer {
             Source::Thermal(k) => {
                 self.choose_auto_nodes(note);
                 let settings = self.thermal_settings();
+                let harmonic = self.articulation() == Articulation::Harmonics;
                 if let Some(engine) = self.thermal.get_mut(k) {
                     // A new node count fades the instrument out and lands the note after.
                     engine.set_settings(settings);
                     let landed = match glide {
+                        _ if harmonic => engine.harmonic(note).or_else(|| engine.note_on(note)),
                         Some(seconds) => engine.note_on_gliding(note, seconds),
                         None => engine.note_on(note),
                     };

@@ -492,6 +492,10 @@ pub struct ThermalString {
     thermal_active: bool,
     /// Terminated by a modal bridge, not its own `bridge_admittance`.
     modal_bridge: bool,
+    /// A light finger touching the string (a harmonic, [`ThermalString::set_touch`]): the
+    /// partial whose node it touches nearest the bridge (0: none) and the share of the
+    /// string's velocity it takes out there, `R / (R + 2 Z)`.
+    touch: (u32, f64),
 }
 
 /// `R = -(I + Z Y)^-1 (I - Z Y)` for a real 2x2 `Y`.
@@ -540,18 +544,23 @@ fn check_psd(name: &str, y: [[f64; 2]; 2]) -> Result<(), String> {
 /// `d` in `[0.5, 2.5)`: `2 m + d = fs / f0 - loss delay - extra`, `extra` being a
 /// termination's phase delay at `f0` in samples (a modal bridge's; 0 for the real 2x2
 /// terminations).
+///
+/// With `partial` above 1 (a harmonic) the loop's delay is matched at the fundamental's
+/// `partial`-th multiple instead: the loop holds `partial` periods of the partial there,
+/// the filters' phase delays and `extra_delay` taken at that frequency.
 fn loop_tuning(
     fs: f64,
     f0: f64,
+    partial: u32,
     (q1, q_hi): (f64, f64),
     extra_delay: f64,
     termination_gain: f64,
 ) -> (OnePoleLoss, usize, f64) {
-    let w1 = 2.0 * PI * f0 / fs;
+    let w = 2.0 * PI * f0 * partial.max(1) as f64 / fs;
     let loss = OnePoleLoss::for_string(f0, fs, q1, q_hi, termination_gain);
-    let remainder = fs / f0 - loss.phase_delay(w1) - extra_delay;
+    let remainder = fs / f0 - loss.phase_delay(w) - extra_delay;
     let (m, d) = split_loop(remainder);
-    let a = Allpass1::coefficient_for_delay(d, w1);
+    let a = Allpass1::coefficient_for_delay(d, w);
     (loss, m, a)
 }
 
@@ -657,6 +666,7 @@ impl ThermalString {
             thermal_active: true,
             half_y: 0.5 / spec.z0_kg_per_s,
             modal_bridge: false,
+            touch: (0, 0.0),
         })
     }
 
@@ -693,6 +703,7 @@ impl ThermalString {
         let (loss, m, a) = loop_tuning(
             fs,
             self.spec.f0_hz,
+            1,
             (self.spec.q1, self.spec.q_hi),
             0.0,
             self.termination_gain(),
@@ -799,13 +810,20 @@ impl ThermalString {
     /// [`ThermalString::set_fundamental`] on an end whose reflection delays the
     /// fundamental by `extra_delay` samples more than the string's own terminations (a
     /// modal bridge's phase delay at `f0`): the loop is shortened by it.
+    ///
+    /// With a finger touching ([`ThermalString::set_touch`]) the loop is tuned at its
+    /// partial `n` instead (`extra_delay` is then the end's delay at `n f0`), and the finger
+    /// moves to that partial's node nearest the bridge.
     pub fn set_fundamental_with_delay(&mut self, f0_hz: f64, extra_delay: f64) -> bool {
         if !(f0_hz.is_finite() && f0_hz > 0.0 && extra_delay.is_finite()) {
             return false;
         }
+        let fs = self.internal_rate_hz;
+        let partial = self.touch.0.max(1);
         let (loss, m, a) = loop_tuning(
-            self.internal_rate_hz,
+            fs,
             f0_hz,
+            partial,
             (self.spec.q1, self.spec.q_hi),
             extra_delay,
             self.termination_gain(),
@@ -820,7 +838,49 @@ impl ThermalString {
         self.spec.f0_hz = f0_hz;
         self.spec.length_m = self.c_m_per_s / (2.0 * f0_hz);
         self.waves.retune(m, loss, a);
+        if self.touch.0 >= 2 {
+            // The round trip bridge-finger-bridge, `2 x + 1` samples plus the bridge end's
+            // delays at the partial (its loss filter's and `extra_delay`), is one period
+            // of the partial, to the nearest sample.
+            let w = 2.0 * PI * f0_hz * partial as f64 / fs;
+            let period = fs / (f0_hz * partial as f64);
+            let x = 0.5 * (period - 1.0 - loss.phase_delay(w) - extra_delay);
+            let x = x.round().max(1.0) as usize;
+            // A finger inside the bow's clearance or beyond the string touches nothing.
+            let clear = x > BOW_CLEARANCE && x + BOW_CLEARANCE < m;
+            self.waves
+                .set_touch(x, if clear { self.touch.1 } else { 0.0 });
+        }
         true
+    }
+
+    /// A light finger touches the string at the node of its partial `partial` (2 or more)
+    /// nearest the bridge, with a resistance of `resistance_kg_per_s`, or leaves it
+    /// (`None`): a harmonic. The modes with a node there pass the finger untouched; the
+    /// others lose energy at each pass. It is placed, and the loop tuned at the partial, by
+    /// the next [`ThermalString::set_fundamental_with_delay`] (the end's delay is then
+    /// asked at the partial's frequency). Only takes energy out; never allocates.
+    pub fn set_touch(&mut self, touch: Option<(u32, f64)>) {
+        self.touch = match touch {
+            Some((partial, r)) if partial >= 2 && r.is_finite() && r > 0.0 => {
+                (partial, r / (r + 2.0 * self.spec.z0_kg_per_s))
+            }
+            _ => (0, 0.0),
+        };
+        if self.touch.0 == 0 {
+            self.waves.set_touch(0, 0.0);
+        }
+    }
+
+    /// The partial a touching finger leaves sounding (1: no finger).
+    pub fn touched_partial(&self) -> u32 {
+        self.touch.0.max(1)
+    }
+
+    /// Where the touching finger is, samples from the bridge (`None`: no finger, or
+    /// none that fits the string at this rate).
+    pub fn touch_position(&self) -> Option<usize> {
+        self.waves.touch_at()
     }
 
     /// The horizontal wave's amplitude kept per round trip by the string's real

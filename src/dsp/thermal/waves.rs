@@ -38,6 +38,10 @@ pub(super) struct Waves {
     /// The stopping finger's share of the nut's reflection: 1 while it presses, less while
     /// it leaves the string (`ThermalString::set_finger_reflection`).
     finger: f64,
+    /// A light finger touching the string (a harmonic): its position (samples from the
+    /// bridge) and the share of the string's velocity there it takes out each sample
+    /// (`R / (R + 2 Z)`); a share of 0 touches nothing.
+    touch: (usize, f64),
 }
 
 /// Where the bow's `n` nodes sit in the rings this sample.
@@ -71,6 +75,7 @@ impl Waves {
             dropped: [0.0; 2],
             wake_sum: f64::INFINITY,
             finger: 1.0,
+            touch: (0, 0.0),
         }
     }
 
@@ -88,6 +93,7 @@ impl Waves {
     /// A new loop (configuration): `m` samples, fresh loss and Thiran filters.
     pub(super) fn set_loop(&mut self, m: usize, loss: OnePoleLoss, thiran: f64) {
         self.m = m;
+        self.touch = (0, 0.0);
         self.loss = [loss; 2];
         self.fraction = [Allpass1::new(thiran); 2];
     }
@@ -96,6 +102,9 @@ impl Waves {
     /// the waves stay where they are.
     pub(super) fn retune(&mut self, m: usize, loss: OnePoleLoss, thiran: f64) {
         self.m = m;
+        if self.touch.0 + 1 >= m {
+            self.touch = (0, 0.0);
+        }
         for p in 0..2 {
             self.loss[p].g = loss.g;
             self.loss[p].p = loss.p;
@@ -123,6 +132,21 @@ impl Waves {
     /// The stopping finger's share of the nut's reflection, 0..=1.
     pub(super) fn set_finger(&mut self, reflection: f64) {
         self.finger = reflection.clamp(0.0, 1.0);
+    }
+
+    /// A light finger at position `x` (samples from the bridge, inside the string) taking
+    /// `share` (0..1) of the string's velocity there each sample, or none (`share` 0).
+    pub(super) fn set_touch(&mut self, x: usize, share: f64) {
+        self.touch = if share > 0.0 && x > 0 && x + 1 < self.m {
+            (x, share.min(1.0))
+        } else {
+            (0, 0.0)
+        };
+    }
+
+    /// Where a finger touches, samples from the bridge (`None`: no finger).
+    pub(super) fn touch_at(&self) -> Option<usize> {
+        (self.touch.1 > 0.0).then_some(self.touch.0)
     }
 
     pub(super) fn bridge_reflection(&self) -> [[f64; 2]; 2] {
@@ -238,6 +262,9 @@ impl Waves {
     /// advances time.
     #[inline(always)]
     pub(super) fn finish_sample(&mut self, leaving_bridge: [f64; 2]) {
+        if self.touch.1 > 0.0 {
+            self.touch_junction();
+        }
         let j = (self.m - 1).wrapping_sub(self.t) & self.mask();
         let mut at_nut = [0.0; 2];
         for p in 0..2 {
@@ -264,6 +291,24 @@ impl Waves {
             self.left[p][next] = from_nut;
         }
         self.t = next;
+    }
+
+    /// The touching finger, one sample: where it touches, the string's velocity `v` meets
+    /// the finger's force `-R v'`, so `v' = v (1 - R / (R + 2 Z))` and each travelling
+    /// wave there gains `v' - v` (in both polarisations: a fingertip resists every way).
+    /// It only takes energy out.
+    #[cold]
+    fn touch_junction(&mut self) {
+        let (x, share) = self.touch;
+        let jr = x.wrapping_sub(self.t) & self.mask();
+        let jl = self.left[0].back(self.t, self.m - 1 - x);
+        for p in 0..2 {
+            if !self.asleep[p] {
+                let dv = -share * (self.right[p][jr] + self.left[p][jl]);
+                self.right[p][jr] += dv;
+                self.left[p][jl] += dv;
+            }
+        }
     }
 
     /// Energy of each polarisation's waves and end filters, `[h, v]`, J, on a string of
