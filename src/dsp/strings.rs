@@ -109,6 +109,10 @@ pub trait StringBank {
     /// stopped pitch stays, its partial sounds at that many times it. Banks that cannot
     /// touch ignore it.
     fn touch(&mut self, _i: usize, _partial: Option<u32>) {}
+    /// A harmonic on partial `n` is bowed `sqrt(n)` times nearer the bridge than the
+    /// asked position, not `n` times (the part between the bridge and the finger bowed
+    /// where a stopped string of that length would be).
+    const HARMONIC_BOW_AT_ROOT: bool = false;
     /// Whether [`StringBank::pluck`] plucks.
     const PLUCKABLE: bool = false;
     /// Plucks string `i` (pizzicato) as [`super::waveguide::WaveguideString::pluck`]:
@@ -280,7 +284,9 @@ impl Hands {
         }
         let divisor = bank.force_divisor();
         let probed = self.probed;
-        bank.sample(probed, move |i| self.string_bow(i, bow, divisor))
+        bank.sample(probed, move |i| {
+            self.string_bow(i, bow, divisor, B::HARMONIC_BOW_AT_ROOT)
+        })
     }
 
     /// One internal sample of the lifting fingers: each one's reflection dips to
@@ -348,7 +354,13 @@ impl Hands {
 
     /// String `i`'s bow for this internal sample (its envelope moves one step).
     #[inline(always)]
-    fn string_bow(&mut self, i: usize, bow: BowControl, divisor: f64) -> StringBow {
+    fn string_bow(
+        &mut self,
+        i: usize,
+        bow: BowControl,
+        divisor: f64,
+        harmonic_at_root: bool,
+    ) -> StringBow {
         let gain = self.bows[i].tick(self.ramp_step);
         // Weighted, a string is never bowed harder than the force parameter's top.
         let base = if self.weighted {
@@ -366,19 +378,25 @@ impl Hands {
         } else {
             let e = self.fingering.expression(i);
             // A harmonic is bowed as its part between the bridge and the touching finger
-            // would be as a stopped string: that much nearer the bridge.
+            // would be as a stopped string: that much nearer the bridge (or by the square
+            // root of the partial, [`StringBank::HARMONIC_BOW_AT_ROOT`]).
             let partial = self.fingering.partial(i) as f64;
-            let lighter = if partial > 1.0 {
-                HARMONIC_FORCE_SCALE
+            let (lighter, nearer) = if partial > 1.0 {
+                let nearer = if harmonic_at_root {
+                    partial.sqrt()
+                } else {
+                    partial
+                };
+                (HARMONIC_FORCE_SCALE, nearer)
             } else {
-                1.0
+                (1.0, 1.0)
             };
             StringBow {
                 velocity_m_per_s: bow.velocity_m_per_s,
                 force: base * e.force_scale * gain * lighter,
                 position_beta: (bow.position_beta * e.position_scale)
                     .clamp(MIN_NOTE_BETA, MAX_NOTE_BETA)
-                    / partial,
+                    / nearer,
             }
         }
     }

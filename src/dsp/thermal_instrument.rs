@@ -324,6 +324,12 @@ impl StringBank for ThermalBank {
     }
 
     const TOUCHABLE: bool = true;
+    /// Chosen by measurement (docs/articulations.md#harmonics): bowed at the touched
+    /// part's own place (a `n`-th of the asked position), the thermal contact on the
+    /// violin's and viola's 8th partials, 1-2 % of the string from the bridge, sticks
+    /// without sounding (4 of their 38 test harmonics silent, 12 with the octave below
+    /// stronger); at `sqrt(n)` none is silent and 4 are.
+    const HARMONIC_BOW_AT_ROOT: bool = true;
 
     /// The light finger on both polarisations of string `i`, at the node of `partial`
     /// nearest the bridge ([`ThermalString::set_touch`]); the string is retuned at its

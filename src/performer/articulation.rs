@@ -723,49 +723,56 @@ mod tests {
         assert!(db < -30.0, "the octave below at {db:+.1} dB");
     }
 
-    /// Bowed harmonics on paper B's thermal cello: the light finger touches both
-    /// polarisations at the partial's node (`ThermalString::set_touch`). The natural
-    /// harmonics of every open string and artificial ones every fifth semitone from two
-    /// octaves above the C string, at the defaults (velocity 0.8), each note once: every
-    /// one speaks (over -55 dBFS in the last second; measured -40.1 at the quietest), its
-    /// octave below more than 30 dB under it (the partial without a node at the finger
-    /// dies; measured 80 dB under at the least), all within 10 cents and at least 17 of
-    /// the 18 within 5 (measured: 17, the C string's 2nd partial at +5.2 cents): floors on
-    /// what is measured. (The violin's and viola's highest artificial harmonics do not all
-    /// speak: docs/articulations.md#harmonics.)
+    /// Bowed harmonics on paper B's thermal strings: the light finger touches both
+    /// polarisations at the partial's node (`ThermalString::set_touch`). The same notes as
+    /// the point-bow test on the violin, viola and cello (19 each), at the defaults
+    /// (velocity 0.8), each once. Every one speaks (over -55 dBFS in the last second;
+    /// measured -46.0 at the quietest). On the cello every one sounds its partial within
+    /// 5 cents with its octave below more than 30 dB under it (measured: within 3.1 cents,
+    /// 74 dB under at the least). Over the three, at least 50 of 57 do so within 10 cents
+    /// (measured 51: the violin's 8th partials and highest artificial harmonics miss,
+    /// docs/articulations.md#harmonics): floors on what is measured.
     #[test]
-    fn bowed_harmonics_on_the_thermal_cello_sound_their_partial_in_tune() {
-        let kind = InstrumentKind::Cello;
-        let notes = harmonic_test_notes(kind);
-        let mut within_5 = 0;
-        for &note in &notes {
-            let setup = Setup {
-                instrument: kind,
-                point_law: None,
-                articulation: Articulation::Harmonics,
-                ..Setup::default()
-            };
-            let (tail, off, level) = harmonic_played(&setup, note);
-            let f = crate::dsp::vocabulary::midi_to_hz(note as f64);
-            let below = partial_amplitude(&tail, FS, 0.5 * f);
-            let octave = 20.0 * (below / partial_amplitude(&tail, FS, f)).log10();
-            eprintln!(
-                "thermal harmonic, cello {note}: {off:+.2} cents, {level:.1} dBFS, the octave \
-                 below {octave:+.1} dB"
-            );
-            assert!(level > -55.0, "{note} does not speak: {level:.1} dBFS");
-            assert!(
-                octave < -30.0,
-                "{note}: the octave below at {octave:+.1} dB"
-            );
-            assert!(off.abs() < 10.0, "{note}: {off:+.2} cents");
-            within_5 += (off.abs() < 5.0) as usize;
+    fn bowed_harmonics_on_the_thermal_strings_sound_their_partial() {
+        let mut sounding = 0;
+        let mut total = 0;
+        for kind in [
+            InstrumentKind::Violin,
+            InstrumentKind::Viola,
+            InstrumentKind::Cello,
+        ] {
+            for note in harmonic_test_notes(kind) {
+                let setup = Setup {
+                    instrument: kind,
+                    point_law: None,
+                    articulation: Articulation::Harmonics,
+                    ..Setup::default()
+                };
+                let (tail, off, level) = harmonic_played(&setup, note);
+                let f = crate::dsp::vocabulary::midi_to_hz(note as f64);
+                let below = partial_amplitude(&tail, FS, 0.5 * f);
+                let octave = 20.0 * (below / partial_amplitude(&tail, FS, f)).log10();
+                eprintln!(
+                    "thermal harmonic, {kind:?} {note}: {off:+.2} cents, {level:.1} dBFS, the \
+                     octave below {octave:+.1} dB"
+                );
+                assert!(
+                    level > -55.0,
+                    "{kind:?} {note} does not speak: {level:.1} dBFS"
+                );
+                let partial = octave < -30.0;
+                if kind == InstrumentKind::Cello {
+                    assert!(
+                        partial && off.abs() < 5.0,
+                        "cello {note}: {off:+.2} cents, the octave below {octave:+.1} dB"
+                    );
+                }
+                total += 1;
+                sounding += (partial && off.abs() < 10.0) as usize;
+            }
         }
-        assert!(
-            within_5 + 1 >= notes.len(),
-            "{within_5} of {} within 5 cents",
-            notes.len()
-        );
+        eprintln!("{sounding} of {total} sound their partial within 10 cents");
+        assert!(sounding >= 50 && total == 57, "{sounding} of {total}");
     }
 
     /// Released, a natural harmonic rings on as an open string does
