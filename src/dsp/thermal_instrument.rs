@@ -603,6 +603,14 @@ impl ThermalInstrument {
         &self.bank.core.strings[i]
     }
 
+    /// The bow's stick plays the strings instead of its hair (`true`, col legno tratto,
+    /// [`ThermalString::set_stick`]) or the hair again (`false`). Real-time safe.
+    pub fn set_stick_contact(&mut self, stick: bool) {
+        for string in &mut self.bank.core.strings {
+            string.set_stick(stick);
+        }
+    }
+
     /// Polarisations asleep now, of eight (all eight while the whole instrument sleeps).
     pub fn asleep_polarisations(&self) -> usize {
         if !self.bank.awake {

@@ -800,6 +800,81 @@ mod tests {
         assert!(lost < 6.0, "the natural harmonic: {lost:.1} dB down");
     }
 
+    /// `note` of `kind` played with `articulation` and `point_law` (`None`: paper B's
+    /// thermal model) at the defaults for 2 s: the level of its second second (dBFS), the
+    /// largest friction force on the way (N) and the second second's strongest peak
+    /// within 60 cents of the note (cents).
+    fn bowed_with(
+        kind: InstrumentKind,
+        note: u8,
+        point_law: Option<crate::dsp::friction::FrictionModel>,
+        articulation: Articulation,
+    ) -> (f64, f64, f64) {
+        let setup = Setup {
+            instrument: kind,
+            point_law,
+            articulation,
+            ..Setup::default()
+        };
+        let mut p = Performer::new(kind);
+        p.activate(&setup, FS).unwrap();
+        p.configure(&setup);
+        p.note_on(note, 0.8);
+        let bow = BowControl::default();
+        let (mut out, mut largest) = (Vec::new(), 0.0f64);
+        for _ in 0..96_000 {
+            let frame = p.tick(bow);
+            out.push(frame.audio);
+            largest = largest.max(frame.friction_force_n.abs());
+        }
+        let f = crate::dsp::vocabulary::midi_to_hz(note as f64);
+        let tail = &out[48_000..];
+        (
+            20.0 * rms(tail).log10(),
+            largest,
+            cents(peak_frequency_hz(tail, FS, f, 60.0), f),
+        )
+    }
+
+    /// Col legno tratto on paper B's thermal strings: every node plays the stick (the
+    /// point-bow strings' hyperbolic law with the wood's coefficients, no hair). Through
+    /// the performer at the defaults, on notes of the cello, viola and violin: the largest
+    /// friction force of the stick over the hair's is the ratio of their static
+    /// frictions (`STICK_MU_S` over the cool rosin's 0.8) within 20 % (measured 0.90-0.93
+    /// of it: the thermal hair's largest force overshoots its static limit where the
+    /// vertical junction presses harder at the attack), the note sounds within 15 cents
+    /// of its pitch (the repertoire's criterion; measured within 10.2) and fainter than
+    /// arco (measured 8.5-21.6 dB: at the thermal model's lighter default force the
+    /// stick's small friction drop holds a weak motion).
+    #[test]
+    fn thermal_col_legno_tratto_plays_the_stick_at_the_note_fainter_than_the_hair() {
+        use crate::dsp::instrument::STICK_MU_S;
+        let rosin = crate::dsp::thermal::ThermalParams::default().mu_cold;
+        for (kind, note) in [
+            (InstrumentKind::Cello, 36u8),
+            (InstrumentKind::Cello, 50),
+            (InstrumentKind::Cello, 55),
+            (InstrumentKind::Viola, 60),
+            (InstrumentKind::Violin, 69),
+            (InstrumentKind::Violin, 76),
+        ] {
+            let (arco_db, hair, _) = bowed_with(kind, note, None, Articulation::Arco);
+            let (tratto_db, stick, off) =
+                bowed_with(kind, note, None, Articulation::ColLegnoTratto);
+            let ratio = stick / hair / (STICK_MU_S / rosin);
+            eprintln!(
+                "thermal {kind:?} {note}: arco {arco_db:.1} dB, tratto {tratto_db:.1} dB at \
+                 {off:+.1} cents, stick over hair {ratio:.3} of the static ratio"
+            );
+            assert!((ratio - 1.0).abs() < 0.2, "{kind:?} {note}: {ratio:.3}");
+            assert!(off.abs() < 15.0, "{kind:?} {note}: {off:+.1} cents");
+            assert!(
+                tratto_db < arco_db,
+                "{kind:?} {note}: arco {arco_db:.1} dB, tratto {tratto_db:.1} dB"
+            );
+        }
+    }
+
     /// Col legno tratto draws the stick across the string: through the performer at the
     /// defaults, on notes of every instrument, the largest friction force the stick
     /// exerts, over the hair's on the same note, is the stick's static friction over the
@@ -817,27 +892,9 @@ mod tests {
             (InstrumentKind::Violin, 76),
             (InstrumentKind::DoubleBass, 40),
         ] {
-            let played = |articulation| {
-                let setup = Setup {
-                    instrument: kind,
-                    articulation,
-                    ..Setup::default()
-                };
-                let mut p = Performer::new(kind);
-                p.activate(&setup, FS).unwrap();
-                p.configure(&setup);
-                p.note_on(note, 0.8);
-                let bow = BowControl::default();
-                let (mut out, mut largest) = (Vec::new(), 0.0f64);
-                for _ in 0..96_000 {
-                    let frame = p.tick(bow);
-                    out.push(frame.audio);
-                    largest = largest.max(frame.friction_force_n.abs());
-                }
-                (20.0 * rms(&out[48_000..]).log10(), largest)
-            };
-            let (arco_db, hair) = played(Articulation::Arco);
-            let (tratto_db, stick) = played(Articulation::ColLegnoTratto);
+            let law = Setup::default().point_law;
+            let (arco_db, hair, _) = bowed_with(kind, note, law, Articulation::Arco);
+            let (tratto_db, stick, _) = bowed_with(kind, note, law, Articulation::ColLegnoTratto);
             let rosin = crate::dsp::friction::HyperbolicFriction::default().mu_s;
             let ratio = stick / hair / (STICK_MU_S / rosin);
             eprintln!(

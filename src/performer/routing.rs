@@ -90,7 +90,9 @@ impl Performer {
                 self.choose_auto_nodes(note);
                 let settings = self.thermal_settings();
                 let harmonic = self.articulation() == Articulation::Harmonics;
+                let stick = self.articulation() == Articulation::ColLegnoTratto;
                 if let Some(engine) = self.thermal.get_mut(k) {
+                    engine.set_stick_contact(stick);
                     // A new node count fades the instrument out and lands the note after.
                     engine.set_settings(settings);
                     let landed = match glide {

@@ -80,6 +80,8 @@
 
 use super::delay::split_loop;
 use super::filters::{Allpass1, OnePoleLoss};
+use super::friction::{BowInput, FrictionContact, HyperbolicFriction, LoadLine};
+use super::instrument::{STICK_MU_D, STICK_MU_S};
 use super::vocabulary::InstrumentKind;
 use grid::ThermalGrid;
 use hair::{solve_nodes, sum_lanes, NodeConsts, Nodes};
@@ -492,10 +494,24 @@ pub struct ThermalString {
     thermal_active: bool,
     /// Terminated by a modal bridge, not its own `bridge_admittance`.
     modal_bridge: bool,
+    /// The bow's stick plays the string instead of its hair (col legno tratto,
+    /// [`ThermalString::set_stick`]).
+    stick: bool,
+    /// The stick's contact on each node (allocated for the most nodes).
+    stick_nodes: Vec<HyperbolicFriction>,
     /// A light finger touching the string (a harmonic, [`ThermalString::set_touch`]): the
     /// partial whose node it touches nearest the bridge (0: none) and the share of the
     /// string's velocity it takes out there, `R / (R + 2 Z)`.
     touch: (u32, f64),
+}
+
+/// The bow's stick on one node, at rest: the point-bow strings' stick (the hyperbolic
+/// law with the wood's coefficients).
+fn stick_contact() -> HyperbolicFriction {
+    let mut stick = HyperbolicFriction::default();
+    stick.mu_s = STICK_MU_S;
+    stick.mu_d = STICK_MU_D;
+    stick
 }
 
 /// `R = -(I + Z Y)^-1 (I - Z Y)` for a real 2x2 `Y`.
@@ -666,6 +682,8 @@ impl ThermalString {
             thermal_active: true,
             half_y: 0.5 / spec.z0_kg_per_s,
             modal_bridge: false,
+            stick: false,
+            stick_nodes: vec![stick_contact(); max_nodes],
             touch: (0, 0.0),
         })
     }
@@ -747,7 +765,12 @@ impl ThermalString {
         // Hair constants per node (trapezoid).
         let k_h = self.hair.k_n_per_m_per_m * dx;
         let c_h = self.hair.c_kg_per_s_per_m * dx;
-        let a = 1.0 / (c_h + 0.5 * k_h * dt);
+        // The stick is stiff: no hair yields between it and the string (`v_h = 0`).
+        let a = if self.stick {
+            0.0
+        } else {
+            1.0 / (c_h + 0.5 * k_h * dt)
+        };
         let m_y = self.hair.vertical_mass_kg_per_m * dx;
         let k_y = self.hair.vertical_k_n_per_m_per_m * dx;
         let c_y = self.hair.vertical_c_kg_per_s_per_m * dx;
@@ -852,6 +875,46 @@ impl ThermalString {
                 .set_touch(x, if clear { self.touch.1 } else { 0.0 });
         }
         true
+    }
+
+    /// The bow's stick drawn across the string instead of its hair (`true`, col legno
+    /// tratto): on every node the point-bow strings' stick, the hyperbolic law with the
+    /// wood's [`STICK_MU_S`] and [`STICK_MU_D`] (no rosin, so no thermal softening; the
+    /// grid still runs, unread), and no hair yields (the stick is stiff); the vertical
+    /// plane is the bow's as before. `false` gives the hair back. The hair's state and
+    /// the stick's are put at rest at each change. Never allocates.
+    pub fn set_stick(&mut self, stick: bool) {
+        if stick == self.stick {
+            return;
+        }
+        self.stick = stick;
+        self.consts = self.node_consts();
+        self.nodes.hair_x.fill(0.0);
+        self.nodes.hair_v.fill(0.0);
+        self.stick_nodes.fill(stick_contact());
+    }
+
+    /// The stick's horizontal contact on the `n_b` nodes just solved (their vertical
+    /// junctions give the normal forces): each node's force from the hyperbolic law on
+    /// its load line `v_s = v_p + F / 2Z`, replacing the thermal law's.
+    #[cold]
+    fn stick_solve(&mut self, n_b: usize, v_b: f64) {
+        let nodes = &mut self.nodes;
+        for (i, contact) in self.stick_nodes[..n_b].iter_mut().enumerate() {
+            let v_p = f64::from(nodes.vp[i]);
+            let f = contact.solve(
+                LoadLine {
+                    free_velocity_m_per_s: v_p,
+                    admittance_s_per_kg: self.half_y,
+                },
+                BowInput {
+                    velocity_m_per_s: v_b,
+                    normal_force_n: f64::from(nodes.normal[i]),
+                },
+            );
+            nodes.force[i] = f as NodeReal;
+            nodes.v_delta[i] = (v_p + f * self.half_y - v_b) as NodeReal;
+        }
     }
 
     /// A light finger touches the string at the node of its partial `partial` (2 or more)
@@ -1154,6 +1217,10 @@ impl ThermalString {
                 ..self.consts
             };
             solve_nodes(self.wide_simd, k, nodes, temps, n_b);
+            if self.stick {
+                self.stick_solve(n_b, bow.velocity_m_per_s);
+            }
+            let nodes = &mut self.nodes;
             self.waves.scatter(span, &nodes.force, &nodes.fy, half_y);
             string_velocity = f64::from(nodes.vp[mid]) + f64::from(nodes.force[mid]) * half_y;
         }
