@@ -127,6 +127,8 @@ struct Core {
     arriving: [[f64; 2]; STRINGS],
     leaving: [[f64; 2]; STRINGS],
     impedances: [f64; STRINGS],
+    /// A light finger touches some string (a harmonic): its junction runs each sample.
+    touching: bool,
     /// The probed string's last internal sample: string velocity at the bow's middle node,
     /// and the string whose nodes give the total friction force (summed when asked,
     /// [`StringBank::probe`]; `None`: lifted and idle, no force).
@@ -169,6 +171,11 @@ impl Core {
             &self.impedances,
             &mut self.leaving,
         );
+        if self.touching {
+            for string in &mut self.strings {
+                string.touch_junction();
+            }
+        }
         for (string, leaving) in self.strings.iter_mut().zip(&self.leaving) {
             string.finish_sample(*leaving);
         }
@@ -343,6 +350,7 @@ impl StringBank for ThermalBank {
         if (before > 1 || string.touched_partial() > 1) && f0 > 0.0 {
             self.tune(i, f0);
         }
+        self.core.touching = self.core.strings.iter().any(|s| s.touched_partial() > 1);
     }
 
     fn wake(&mut self, _i: usize) {
@@ -558,6 +566,7 @@ impl ThermalInstrument {
                 arriving: [[0.0; 2]; STRINGS],
                 leaving: [[0.0; 2]; STRINGS],
                 impedances: std::array::from_fn(|i| open[i].z0_kg_per_s),
+                touching: false,
                 probe: (0.0, None),
             },
             wave_speeds,

@@ -1254,6 +1254,7 @@ impl ThermalString {
             rb[0][0] * at_bridge[0] + rb[0][1] * at_bridge[1],
             rb[1][0] * at_bridge[0] + rb[1][1] * at_bridge[1],
         ];
+        self.touch_junction();
         self.finish_sample(outgoing);
         // Force on the bridge: incoming minus outgoing waves times Z, horizontal.
         frame.bridge_force_n = z * (at_bridge[0] - outgoing[0]);
@@ -1272,6 +1273,14 @@ impl ThermalString {
     #[inline(always)]
     pub fn finish_sample(&mut self, leaving_bridge: [f64; 2]) {
         self.waves.finish_sample(leaving_bridge)
+    }
+
+    /// The touching finger's junction ([`ThermalString::set_touch`]) for this sample:
+    /// call once per sample before [`ThermalString::finish_sample`] while a finger
+    /// touches (nothing without one).
+    #[inline]
+    pub fn touch_junction(&mut self) {
+        self.waves.touch_junction();
     }
 
     pub fn z0_kg_per_s(&self) -> f64 {

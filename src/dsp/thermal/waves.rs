@@ -262,9 +262,6 @@ impl Waves {
     /// advances time.
     #[inline(always)]
     pub(super) fn finish_sample(&mut self, leaving_bridge: [f64; 2]) {
-        if self.touch.1 > 0.0 {
-            self.touch_junction();
-        }
         let j = (self.m - 1).wrapping_sub(self.t) & self.mask();
         let mut at_nut = [0.0; 2];
         for p in 0..2 {
@@ -296,10 +293,13 @@ impl Waves {
     /// The touching finger, one sample: where it touches, the string's velocity `v` meets
     /// the finger's force `-R v'`, so `v' = v (1 - R / (R + 2 Z))` and each travelling
     /// wave there gains `v' - v` (in both polarisations: a fingertip resists every way).
-    /// It only takes energy out.
-    #[cold]
-    fn touch_junction(&mut self) {
+    /// It only takes energy out. Once per sample, before [`Waves::finish_sample`]; nothing
+    /// without a finger.
+    pub(super) fn touch_junction(&mut self) {
         let (x, share) = self.touch;
+        if share == 0.0 {
+            return;
+        }
         let jr = x.wrapping_sub(self.t) & self.mask();
         let jl = self.left[0].back(self.t, self.m - 1 - x);
         for p in 0..2 {
