@@ -74,3 +74,58 @@ pub fn split_loop(remainder: f64) -> (usize, f64) {
     let m = ((remainder - 0.5) / 2.0).floor().max(0.0) as usize;
     (m, remainder - 2.0 * m as f64)
 }
+
+/// A string pulled aside into two straight lines meeting at a kink rounded over a
+/// finger's width (a pluck), as the slopes `c y0'` (m/s) its travelling waves take, sample
+/// by sample along the delay lines from the bridge.
+#[derive(Debug, Clone, Copy)]
+pub struct PluckShape {
+    /// `c y0'` between the bridge and the kink, m/s.
+    pub bridge_side: f64,
+    /// `c y0'` between the kink and the nut, m/s.
+    pub nut_side: f64,
+    start: f64,
+    end: f64,
+    width: f64,
+}
+
+impl PluckShape {
+    /// The shape of a string `length` samples long (one way), of which the delay lines
+    /// hold `lines`, pulled aside by `scale` (the displacement times the rate, m/s) at
+    /// `position_beta` of its length from the bridge, the kink rounded over `width` of it
+    /// (at least a sample) and kept a sample inside the lines. `None` if the lines are too
+    /// short for it.
+    pub fn new(
+        length: f64,
+        lines: f64,
+        position_beta: f64,
+        width: f64,
+        scale: f64,
+    ) -> Option<Self> {
+        let w = (width.clamp(0.0, 0.5) * length).max(1.0);
+        let x0 = (position_beta * length).clamp(0.5 * w + 1.0, lines - 0.5 * w - 1.0);
+        if !(x0 > 0.0 && x0 < lines && scale.is_finite()) {
+            return None;
+        }
+        Some(Self {
+            bridge_side: scale / x0,
+            nut_side: -scale / (length - x0),
+            start: x0 - 0.5 * w,
+            end: x0 + 0.5 * w,
+            width: w,
+        })
+    }
+
+    /// The slope at sample `k` of the lines (its middle, `k + 0.5`), m/s.
+    #[inline]
+    pub fn slope(&self, k: usize) -> f64 {
+        let x = k as f64 + 0.5;
+        if x <= self.start {
+            self.bridge_side
+        } else if x >= self.end {
+            self.nut_side
+        } else {
+            self.bridge_side + (self.nut_side - self.bridge_side) * (x - self.start) / self.width
+        }
+    }
+}

@@ -330,6 +330,16 @@ impl StringBank for ThermalBank {
         self.core.strings[i].set_finger_reflection(reflection);
     }
 
+    const PLUCKABLE: bool = true;
+
+    /// Plucks string `i` ([`ThermalString::pluck`]); the bow's stick strikes nothing here
+    /// (col legno battuto plays the waveguide strings).
+    fn pluck(&mut self, i: usize, displacement_m: f64, position_beta: f64, width: f64) -> bool {
+        let plucked = self.core.strings[i].pluck(displacement_m, position_beta, width);
+        self.awake |= plucked;
+        plucked
+    }
+
     const TOUCHABLE: bool = true;
     /// Chosen by measurement (docs/articulations.md#harmonics): bowed at the touched
     /// part's own place (a `n`-th of the asked position), the thermal contact on the

@@ -62,7 +62,7 @@
 //! assert!(out.bridge_force_n.is_finite());
 //! ```
 
-use super::delay::{split_loop, DelayLine};
+use super::delay::{split_loop, DelayLine, PluckShape};
 use super::filters::{Allpass1, AllpassChain, OnePoleLoss};
 use super::friction::{BowInput, FrictionContact, LoadLine};
 use std::f64::consts::PI;
@@ -441,30 +441,23 @@ impl WaveguideString {
         // delay lines, short of the nut's filters).
         let length = 0.5 * self.loop_samples;
         let lines = self.m as f64;
-        let w = (width.clamp(0.0, 0.5) * length).max(1.0);
-        let x0 = (position_beta * length).clamp(0.5 * w + 1.0, lines - 0.5 * w - 1.0);
-        if !(x0 > 0.0 && x0 < lines) {
+        let Some(shape) = PluckShape::new(
+            length,
+            lines,
+            position_beta,
+            width,
+            displacement_m * self.sample_rate_hz,
+        ) else {
             return;
-        }
-        // c y0' on either side of the kink, m/s (c = one sample's length times fs).
-        let bridge_side = displacement_m * self.sample_rate_hz / x0;
-        let nut_side = -displacement_m * self.sample_rate_hz / (length - x0);
+        };
         // The string the nut's filters stand for (their delay at the fundamental, both
         // ways) holds the nut side's slope too: it leaves them towards the bridge over
         // that many samples, added to what they give out.
-        self.pluck_tail += 0.5 * nut_side;
+        self.pluck_tail += 0.5 * shape.nut_side;
         let filters = (self.loop_samples - 2.0 * lines).round().max(0.0) as u32;
         self.pluck_tail_samples = self.pluck_tail_samples.max(filters);
-        let (start, end) = (x0 - 0.5 * w, x0 + 0.5 * w);
         for k in 0..self.m {
-            let x = k as f64 + 0.5;
-            let slope = if x <= start {
-                bridge_side
-            } else if x >= end {
-                nut_side
-            } else {
-                bridge_side + (nut_side - bridge_side) * (x - start) / w
-            };
+            let slope = shape.slope(k);
             let i = self.right.back(self.t, k);
             self.right[i] -= 0.5 * slope;
             let i = self.left.back(self.t, self.m - 1 - k);

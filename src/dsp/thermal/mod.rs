@@ -935,6 +935,19 @@ impl ThermalString {
         }
     }
 
+    /// Plucks the string (pizzicato) in its horizontal polarisation: pulled
+    /// `displacement_m` aside at `position_beta` of its length from the bridge, the kink
+    /// rounded over `width` of it (the finger's contact), and let go from rest; added to
+    /// what the string already does. False (nothing changed) for a non-finite pluck or a
+    /// string too short for it. Never allocates.
+    pub fn pluck(&mut self, displacement_m: f64, position_beta: f64, width: f64) -> bool {
+        if !(displacement_m.is_finite() && position_beta.is_finite() && width.is_finite()) {
+            return false;
+        }
+        self.waves
+            .pluck(displacement_m * self.internal_rate_hz, position_beta, width)
+    }
+
     /// The partial a touching finger leaves sounding (1: no finger).
     pub fn touched_partial(&self) -> u32 {
         self.touch.0.max(1)

@@ -9,7 +9,7 @@
 //! write contiguous slices ([`Waves::gather`], [`Waves::scatter`]).
 
 use super::NodeReal;
-use crate::dsp::delay::DelayLine;
+use crate::dsp::delay::{DelayLine, PluckShape};
 use crate::dsp::filters::{flush_tiny, Allpass1, OnePoleLoss};
 
 /// Both polarisations' delay lines, end filters and reflections, and their sleep state.
@@ -142,6 +142,31 @@ impl Waves {
         } else {
             (0, 0.0)
         };
+    }
+
+    /// Plucks the horizontal polarisation: adds the travelling waves of a string pulled
+    /// aside into two straight lines meeting at `position_beta` of the delay lines'
+    /// length (from the bridge), the kink rounded over `width` of it, and let go from
+    /// rest. `slope_scale` is the displacement times the rate (m/s): the slopes `c y0'`
+    /// are it over the distances to each end in samples. A displacement at rest is two
+    /// waves of half its slope, `v_r = -c y0' / 2` and `v_l = c y0' / 2` (d'Alembert):
+    /// they cancel in the string's velocity and carry its shape. The shape closes on the
+    /// lines (the end filters' few samples of delay hold none of it). False (nothing
+    /// added) if the lines are too short for the pluck.
+    pub(super) fn pluck(&mut self, slope_scale: f64, position_beta: f64, width: f64) -> bool {
+        let lines = self.m as f64;
+        let Some(shape) = PluckShape::new(lines, lines, position_beta, width, slope_scale) else {
+            return false;
+        };
+        let mask = self.mask();
+        for k in 0..self.m {
+            let slope = shape.slope(k);
+            self.right[0][k.wrapping_sub(self.t) & mask] -= 0.5 * slope;
+            let i = self.left[0].back(self.t, self.m - 1 - k);
+            self.left[0][i] += 0.5 * slope;
+        }
+        self.asleep[0] = false;
+        true
     }
 
     /// Where a finger touches, samples from the bridge (`None`: no finger).
