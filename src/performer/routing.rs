@@ -222,7 +222,8 @@ impl Performer {
                 if let Some(engine) = self.thermal.get_mut(k) {
                     engine.note_off(note);
                 }
-                // A pizzicato note plays the waveguide strings ([`articulation`]).
+                // A note struck with the stick plays the waveguide strings
+                // ([`articulation`]).
                 self.instrument.note_off(note);
             }
             Source::Rubbed(_) if was_held => self.rubbed.note_off(),
