@@ -881,7 +881,7 @@ impl ThermalString {
     /// tratto): on every node the point-bow strings' stick, the hyperbolic law with the
     /// wood's [`STICK_MU_S`] and [`STICK_MU_D`] (no rosin, so no thermal softening; the
     /// grid still runs, unread), and no hair yields (the stick is stiff); the vertical
-    /// plane is the bow's as before. `false` gives the hair back. The hair's state and
+    /// plane is the hair's. `false` gives the hair back. The hair's state and
     /// the stick's are put at rest at each change. Never allocates.
     pub fn set_stick(&mut self, stick: bool) {
         if stick == self.stick {
