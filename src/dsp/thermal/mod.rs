@@ -879,10 +879,10 @@ impl ThermalString {
 
     /// The bow's stick drawn across the string instead of its hair (`true`, col legno
     /// tratto): on every node the point-bow strings' stick, the hyperbolic law with the
-    /// wood's [`STICK_MU_S`] and [`STICK_MU_D`] (no rosin, so no thermal softening; the
-    /// grid still runs, unread), and no hair yields (the stick is stiff); the vertical
-    /// plane is the hair's. `false` gives the hair back. The hair's state and
-    /// the stick's are put at rest at each change. Never allocates.
+    /// wood's [`STICK_MU_S`] and [`STICK_MU_D`] (no rosin, so no thermal softening: the
+    /// thermal grid idles), and no hair yields (the stick is stiff); the vertical plane
+    /// is the hair's. `false` gives the hair back. The hair's state, the stick's and the
+    /// grid's temperatures are put at rest at each change. Never allocates.
     pub fn set_stick(&mut self, stick: bool) {
         if stick == self.stick {
             return;
@@ -892,6 +892,8 @@ impl ThermalString {
         self.nodes.hair_x.fill(0.0);
         self.nodes.hair_v.fill(0.0);
         self.stick_nodes.fill(stick_contact());
+        self.grid.clear();
+        self.thermal_active = false;
     }
 
     /// The stick's horizontal contact on the `n_b` nodes just solved (their vertical
@@ -1240,18 +1242,20 @@ impl ThermalString {
         if !on {
             string_velocity = self.waves.velocity_h(self.bow_start + mid);
         }
-        // The grid idles once the bow is off and the contact has cooled to nothing.
-        if on || self.thermal_active {
+        // The grid idles once the bow is off and the contact has cooled to nothing, and
+        // while the stick plays (its friction does not depend on the temperature).
+        let heated = on && !self.stick;
+        if heated || self.thermal_active {
             self.grid.update(
                 self.wide_simd,
                 &self.nodes.v_delta[..n_b],
                 &self.nodes.force[..n_b],
             );
-            if !on {
+            if !heated {
                 self.thermal_active = self.grid.any_warm();
             }
         }
-        if on {
+        if heated {
             self.thermal_active = true;
         }
 
