@@ -281,6 +281,24 @@ fn a_touching_finger_only_takes_energy_out_and_leaves_its_partial() {
     );
 }
 
+/// The cello's C string at 10 nodes (90.3 kHz), nearly lossless (`Q` 1e6; its own small
+/// terminations lose the same share at every frequency).
+fn lossless_cello_c() -> ThermalString {
+    let spec = ThermalStringSpec {
+        q1: 1e6,
+        q_hi: 1e6,
+        ..ThermalStringSpec::cello_c()
+    };
+    ThermalString::new(
+        spec,
+        10,
+        0.01,
+        ThermalParams::default(),
+        HairParams::default(),
+    )
+    .unwrap()
+}
+
 /// A plucked thermal string (pizzicato on paper B's strings, `ThermalString::pluck`):
 /// the cello's C string, 10 nodes (90.3 kHz), nearly lossless (`Q` 1e6; its own small
 /// terminations lose the same share at every frequency), pulled 1 mm aside and let go.
@@ -295,19 +313,7 @@ fn a_plucked_thermal_string_holds_the_pulled_strings_energy_and_its_partials() {
     use colophony::analysis::partial_amplitude;
     use std::f64::consts::PI;
     for (beta, width) in [(0.2, 0.0), (0.25, 0.0), (0.13, 0.05), (0.37, 0.02)] {
-        let spec = ThermalStringSpec {
-            q1: 1e6,
-            q_hi: 1e6,
-            ..ThermalStringSpec::cello_c()
-        };
-        let mut s = ThermalString::new(
-            spec,
-            10,
-            0.01,
-            ThermalParams::default(),
-            HairParams::default(),
-        )
-        .unwrap();
+        let mut s = lossless_cello_c();
         let fs = s.internal_rate_hz();
         let f0 = s.fundamental_hz();
         let d = 1e-3;
@@ -352,6 +358,54 @@ fn a_plucked_thermal_string_holds_the_pulled_strings_energy_and_its_partials() {
             } else {
                 assert!(m < 0.05, "beta {beta}: partial {n} at a node reads {m:.3}");
             }
+        }
+    }
+}
+
+/// A thermal string struck with the bow's stick (col legno battuto on paper B's strings,
+/// `ThermalString::strike`): the cello's C string, 10 nodes, nearly lossless (`Q` 1e6),
+/// struck at three bow positions by a light and a heavier stick. The contact ends by
+/// itself (the string's reflections push the stick away, well within `MAX_STRIKE_S`),
+/// the stick rebounds, and the string keeps what the stick lost: its energy plus the
+/// rebound's is the stick's `m u0^2 / 2` within 3 % (the stick's backward-Euler step
+/// takes `F^2 dt^2 / 2m` a sample, and the string's own terminations a little) and never
+/// more.
+#[test]
+fn a_struck_thermal_string_keeps_what_the_stick_loses() {
+    use colophony::dsp::waveguide::MAX_STRIKE_S;
+    for beta in [0.05, 0.1, 0.2] {
+        for (mass, u0) in [(0.003, 1.0), (0.01, 0.3)] {
+            let mut s = lossless_cello_c();
+            let fs = s.internal_rate_hz();
+            let lifted = ThermalBowControl {
+                force_n_per_m: 0.0,
+                position_beta: beta,
+                ..FIG6_BOW
+            };
+            assert!(s.strike(mass, u0));
+            let mut samples = 0;
+            while s.is_struck() {
+                s.tick(lifted);
+                samples += 1;
+            }
+            let u1 = s.striker_velocity_m_per_s();
+            let brought = 0.5 * mass * u0 * u0;
+            let kept = s.energy_j() + 0.5 * mass * u1 * u1;
+            println!(
+                "thermal strike beta {beta} m {mass} u0 {u0}: contact {:.2} ms, rebound \
+                 {u1:+.3} m/s, string + rebound {:.4} of the stick's energy",
+                1e3 * samples as f64 / fs,
+                kept / brought
+            );
+            assert!(
+                (samples as f64) < MAX_STRIKE_S * fs,
+                "the string pushes it away"
+            );
+            assert!(u1 < 0.0, "the stick rebounds: {u1} m/s");
+            assert!(
+                kept <= brought && kept > 0.97 * brought,
+                "beta {beta}: {kept:.4e} J of {brought:.4e}"
+            );
         }
     }
 }

@@ -56,8 +56,8 @@ use super::thermal::{
     HairParams, ThermalBowControl, ThermalCapacity, ThermalParams, ThermalString, ThermalStringSpec,
 };
 use super::vocabulary::{
-    midi_to_hz, InstrumentKind, HIGHEST_TUNING_SEMITONES, LOWEST_TUNING_SEMITONES, SLEEP_ENERGY_J,
-    STRINGS,
+    midi_to_hz, InstrumentKind, Strike, HIGHEST_TUNING_SEMITONES, LOWEST_TUNING_SEMITONES,
+    SLEEP_ENERGY_J, STRINGS,
 };
 
 /// Most bow nodes on the lowest string (paper B's Figure 6 uses 60).
@@ -129,6 +129,9 @@ struct Core {
     impedances: [f64; STRINGS],
     /// A light finger touches some string (a harmonic): its junction runs each sample.
     touching: bool,
+    /// The bow's stick strikes some string (col legno battuto): a struck string takes
+    /// the stick's contact instead of the bow's.
+    striking: bool,
     /// The probed string's last internal sample: string velocity at the bow's middle node,
     /// and the string whose nodes give the total friction force (summed when asked,
     /// [`StringBank::probe`]; `None`: lifted and idle, no force).
@@ -139,9 +142,31 @@ impl Core {
     /// One internal sample, `bow_of(i)` giving string `i`'s bow (force per metre);
     /// returns the horizontal force on the bridge, N.
     #[inline(always)]
-    fn tick(&mut self, probed: usize, mut bow_of: impl FnMut(usize) -> StringBow) -> f64 {
+    fn tick(&mut self, probed: usize, bow_of: impl FnMut(usize) -> StringBow) -> f64 {
+        if self.striking {
+            self.tick_with::<true>(probed, bow_of)
+        } else {
+            self.tick_with::<false>(probed, bow_of)
+        }
+    }
+
+    /// [`Core::tick`], with `STRIKING` while the bow's stick strikes some string.
+    #[inline(always)]
+    fn tick_with<const STRIKING: bool>(
+        &mut self,
+        probed: usize,
+        mut bow_of: impl FnMut(usize) -> StringBow,
+    ) -> f64 {
         for (i, string) in self.strings.iter_mut().enumerate() {
             let bow = bow_of(i);
+            if STRIKING && string.is_struck() {
+                let velocity = string.strike_contact(bow.position_beta);
+                if i == probed {
+                    self.probe = (velocity, None);
+                }
+                self.arriving[i] = string.arriving_at_bridge();
+                continue;
+            }
             // A pressing force only (the force parameter is never negative; this keeps a
             // stray sign from pulling the hair off the string).
             let force = bow.force.max(0.0);
@@ -178,6 +203,9 @@ impl Core {
         }
         for (string, leaving) in self.strings.iter_mut().zip(&self.leaving) {
             string.finish_sample(*leaving);
+        }
+        if STRIKING {
+            self.striking = self.strings.iter().any(ThermalString::is_struck);
         }
         force[0]
     }
@@ -332,12 +360,20 @@ impl StringBank for ThermalBank {
 
     const PLUCKABLE: bool = true;
 
-    /// Plucks string `i` ([`ThermalString::pluck`]); the bow's stick strikes nothing here
-    /// (col legno battuto plays the waveguide strings).
+    /// Plucks string `i` ([`ThermalString::pluck`]).
     fn pluck(&mut self, i: usize, displacement_m: f64, position_beta: f64, width: f64) -> bool {
         let plucked = self.core.strings[i].pluck(displacement_m, position_beta, width);
         self.awake |= plucked;
         plucked
+    }
+
+    /// Strikes string `i` with the bow's stick at its bow's middle node
+    /// ([`ThermalString::strike`]).
+    fn strike(&mut self, i: usize, strike: Strike) -> bool {
+        let struck = self.core.strings[i].strike(strike.mass_kg, strike.velocity_m_per_s);
+        self.core.striking |= struck;
+        self.awake |= struck;
+        struck
     }
 
     const TOUCHABLE: bool = true;
@@ -470,6 +506,7 @@ impl StringBank for ThermalBank {
         }
         self.core.bridge.reset();
         self.core.probe = (0.0, None);
+        self.core.striking = false;
         self.awake = false;
     }
 
@@ -577,6 +614,7 @@ impl ThermalInstrument {
                 leaving: [[0.0; 2]; STRINGS],
                 impedances: std::array::from_fn(|i| open[i].z0_kg_per_s),
                 touching: false,
+                striking: false,
                 probe: (0.0, None),
             },
             wave_speeds,

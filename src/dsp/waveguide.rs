@@ -471,22 +471,15 @@ impl WaveguideString {
     /// does. The string takes from the stick what the stick loses: momentum
     /// `m (u0 - u1)` and, the contact being lossless, energy `m (u0^2 - u1^2) / 2`.
     pub fn strike(&mut self, mass_kg: f64, velocity_m_per_s: f64) {
-        if !self.playable
-            || !(mass_kg.is_finite() && mass_kg > 0.0)
-            || !(velocity_m_per_s.is_finite() && velocity_m_per_s > 0.0)
-        {
-            return;
+        let striker = Striker::new(mass_kg, velocity_m_per_s, self.sample_rate_hz);
+        if self.playable && striker.is_on() {
+            self.striker = striker;
         }
-        self.striker = Striker {
-            mass_kg,
-            velocity_m_per_s,
-            samples_left: (MAX_STRIKE_S * self.sample_rate_hz).ceil() as u32 + 1,
-        };
     }
 
     /// Whether a striking stick is on the string.
     pub fn is_struck(&self) -> bool {
-        self.striker.samples_left > 0
+        self.striker.is_on()
     }
 
     /// The stopping finger's reflection, 0..=1: 1 while it presses the string, less while
@@ -796,7 +789,7 @@ impl WaveguideString {
 /// that pushes the string while it moves toward it faster than the string gives way, and
 /// leaves once the string would pull on it (a contact can only push).
 #[derive(Debug, Clone, Copy, Default)]
-struct Striker {
+pub(crate) struct Striker {
     mass_kg: f64,
     velocity_m_per_s: f64,
     /// Samples of contact left before the stick is taken away whatever the string does
@@ -829,13 +822,41 @@ fn struck_junction(
 pub const MAX_STRIKE_S: f64 = 0.02;
 
 impl Striker {
+    /// A stick of `mass_kg` arriving at `velocity_m_per_s` on a string sampled at
+    /// `sample_rate_hz`; none (already off) for a mass or speed that is not finite and
+    /// positive.
+    pub(crate) fn new(mass_kg: f64, velocity_m_per_s: f64, sample_rate_hz: f64) -> Self {
+        if !(mass_kg.is_finite() && mass_kg > 0.0)
+            || !(velocity_m_per_s.is_finite() && velocity_m_per_s > 0.0)
+            || !(sample_rate_hz.is_finite() && sample_rate_hz > 0.0)
+        {
+            return Self::default();
+        }
+        Self {
+            mass_kg,
+            velocity_m_per_s,
+            samples_left: (MAX_STRIKE_S * sample_rate_hz).ceil() as u32 + 1,
+        }
+    }
+
+    /// Whether the stick is on the string.
+    #[inline(always)]
+    pub(crate) fn is_on(&self) -> bool {
+        self.samples_left > 0
+    }
+
+    /// The stick's velocity toward the string, m/s (negative once it rebounds).
+    pub(crate) fn velocity_m_per_s(&self) -> f64 {
+        self.velocity_m_per_s
+    }
+
     /// The contact force this sample, N, for the string's free velocity `v_free` at the
     /// contact and its admittance there `y` (s/kg), over a sample of `dt` s. In contact
     /// the string moves with the stick at the end of the sample (backward Euler for the
     /// stick: `u' = u - F dt / m`, `v_free + y F = u'`), so
     /// `F = (u - v_free) / (y + dt / m)`; a force that would pull ends the contact.
     #[inline]
-    fn push(&mut self, v_free: f64, y: f64, dt: f64) -> f64 {
+    pub(crate) fn push(&mut self, v_free: f64, y: f64, dt: f64) -> f64 {
         let force = (self.velocity_m_per_s - v_free) / (y + dt / self.mass_kg);
         self.samples_left = self.samples_left.saturating_sub(1);
         if !(force > 0.0) || self.samples_left == 0 {

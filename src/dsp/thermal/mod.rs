@@ -83,6 +83,7 @@ use super::filters::{Allpass1, OnePoleLoss};
 use super::friction::{BowInput, FrictionContact, HyperbolicFriction, LoadLine};
 use super::instrument::{STICK_MU_D, STICK_MU_S};
 use super::vocabulary::InstrumentKind;
+use super::waveguide::Striker;
 use grid::ThermalGrid;
 use hair::{solve_nodes, sum_lanes, NodeConsts, Nodes};
 use waves::Waves;
@@ -503,7 +504,14 @@ pub struct ThermalString {
     /// partial whose node it touches nearest the bridge (0: none) and the share of the
     /// string's velocity it takes out there, `R / (R + 2 Z)`.
     touch: (u32, f64),
+    /// The bow's stick striking the string (col legno battuto, [`ThermalString::strike`]).
+    striker: Striker,
 }
+
+/// The direction the striking stick moves in, `[h, v]` (a unit vector): the stick's
+/// wood meets the string square on from above, as a bouncing bow does (the vertical
+/// plane, [`ThermalString::strike`]).
+pub const STRIKE_DIRECTION: [f64; 2] = [1.0, 0.0];
 
 /// The bow's stick on one node, at rest: the point-bow strings' stick (the hyperbolic
 /// law with the wood's coefficients).
@@ -685,6 +693,7 @@ impl ThermalString {
             stick: false,
             stick_nodes: vec![stick_contact(); max_nodes],
             touch: (0, 0.0),
+            striker: Striker::default(),
         })
     }
 
@@ -950,6 +959,53 @@ impl ThermalString {
             .pluck(displacement_m * self.internal_rate_hz, position_beta, width)
     }
 
+    /// Strikes the string with the bow's stick (col legno battuto): a rigid `mass_kg`
+    /// arriving at `velocity_m_per_s` along [`STRIKE_DIRECTION`] at the bow's middle
+    /// node, which pushes the string until the string would pull it back (the point-bow
+    /// strings' stick, [`crate::dsp::waveguide::WaveguideString::strike`]). The string
+    /// takes what the stick loses, momentum `m (u0 - u1)` and energy
+    /// `m (u0^2 - u1^2) / 2`. While it is on, [`ThermalString::strike_contact`] replaces
+    /// the bow's contact. False (nothing changed) for a mass or speed that is not finite
+    /// and positive. Never allocates.
+    pub fn strike(&mut self, mass_kg: f64, velocity_m_per_s: f64) -> bool {
+        let striker = Striker::new(mass_kg, velocity_m_per_s, self.internal_rate_hz);
+        if !striker.is_on() {
+            return false;
+        }
+        self.striker = striker;
+        self.waves.wake();
+        true
+    }
+
+    /// Whether a striking stick is on the string.
+    #[inline(always)]
+    pub fn is_struck(&self) -> bool {
+        self.striker.is_on()
+    }
+
+    /// The stick's velocity along [`STRIKE_DIRECTION`], m/s (negative once it rebounds).
+    pub fn striker_velocity_m_per_s(&self) -> f64 {
+        self.striker.velocity_m_per_s()
+    }
+
+    /// One sample of the striking stick's contact ([`ThermalString::strike`]) at the
+    /// middle node of a bow at `position_beta`, instead of the bow's: the string's free
+    /// velocity along the stick's direction meets the stick through the string's
+    /// admittance there, `1 / 2Z` (the stick is rigid: no hair between them). Returns the
+    /// horizontal string velocity there, m/s.
+    #[cold]
+    pub fn strike_contact(&mut self, position_beta: f64) -> f64 {
+        let m = self.waves.len();
+        let x = ((position_beta.clamp(0.01, 0.5) * m as f64 + 0.5) as usize).clamp(1, m - 2);
+        let [d_h, d_v] = STRIKE_DIRECTION;
+        let [v_h, v_v] = self.waves.velocity_at(x);
+        let dt = 1.0 / self.internal_rate_hz;
+        let force = self.striker.push(d_h * v_h + d_v * v_v, self.half_y, dt);
+        let dv = force * self.half_y;
+        self.waves.push_at(x, [d_h * dv, d_v * dv]);
+        v_h + d_h * dv
+    }
+
     /// The partial a touching finger leaves sounding (1: no finger).
     pub fn touched_partial(&self) -> u32 {
         self.touch.0.max(1)
@@ -1101,7 +1157,7 @@ impl ThermalString {
     /// than `threshold_j`. Only with the bow off this string (else nothing happens).
     /// Walks the delay lines: once per block.
     pub fn sleep_quiet_polarisations(&mut self, threshold_j: f64) {
-        if self.contact_active {
+        if self.contact_active || self.is_struck() {
             return;
         }
         self.waves
@@ -1123,6 +1179,7 @@ impl ThermalString {
 
     pub fn reset(&mut self) {
         self.waves.reset();
+        self.striker = Striker::default();
         let n = &mut self.nodes;
         for v in [
             &mut n.hair_x,
@@ -1141,8 +1198,13 @@ impl ThermalString {
     /// One sample at the internal rate with the string's own (2x2 admittance) bridge. A bow
     /// force of zero lifts the bow (no contact in either plane).
     pub fn tick(&mut self, bow: ThermalBowControl) -> ThermalFrame {
+        let velocity = if self.is_struck() {
+            self.strike_contact(bow.position_beta)
+        } else {
+            self.tick_contact(bow)
+        };
         let mut frame = ThermalFrame {
-            string_velocity_m_per_s: self.tick_contact(bow),
+            string_velocity_m_per_s: velocity,
             ..ThermalFrame::default()
         };
         self.contact_sums(&mut frame);
