@@ -1,0 +1,63 @@
+//! Survey (ignored; `cargo test --release -p colophony-lab --test thermal_free_pitch --
+//! --ignored --nocapture`): the pitch of paper B's thermal strings ringing free, every
+//! semitone of every instrument from the lowest open string to an octave above the
+//! highest. Each note is plucked at velocity 0.8 on a fresh thermal instrument (48 kHz, its
+//! shipped bridge, 10 nodes) and its strongest peak within 40 cents of equal temperament
+//! read over 0.05-0.5 s, in the output and in the string's velocity under the bow; beside
+//! it, `Z_s |Y_hh|` at the note (the four strings' impedances summed times the bridge's
+//! horizontal admittance), how strongly the string and the bridge are coupled there.
+//! A plucked or struck thermal note is tuned by the bridge's phase delay at its pitch
+//! alone (no intonation table: that is for the bowed sound).
+
+use colophony::analysis::{cents, peak_frequency_hz};
+use colophony::dsp::bridge::ModalBridge;
+use colophony::dsp::bridge_data::shipped_bridge;
+use colophony::dsp::engine::Engine;
+use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
+use colophony::dsp::vocabulary::{midi_to_hz, BowControl, InstrumentKind};
+use colophony::performer::articulation::pluck_for;
+
+const FS: f64 = 48_000.0;
+
+#[test]
+#[ignore]
+fn thermal_free_pitch_map() {
+    for kind in InstrumentKind::ALL {
+        let modes = shipped_bridge(kind).modes;
+        let bridge = ModalBridge::new(&modes, FS).unwrap();
+        let z_s: f64 = kind.strings().iter().map(|s| s.z0_kg_per_s).sum();
+        let open = kind.open_notes();
+        let (mut within, mut count) = (0, 0);
+        println!("{kind:?}: note, cents in the output / in the string, Z_s |Y_hh|");
+        for note in open[0]..=open[3] + 12 {
+            let mut engine =
+                ThermalInstrument::new(kind, &modes, FS, ThermalSettings::default()).unwrap();
+            engine.pluck(note, pluck_for(kind, 0.8));
+            let frames: Vec<_> = (0..(0.5 * FS) as usize)
+                .map(|_| Engine::tick(&mut engine, BowControl::default()))
+                .collect();
+            let f = midi_to_hz(note as f64);
+            let read = |signal: Vec<f64>| {
+                cents(
+                    peak_frequency_hz(&signal[(0.05 * FS) as usize..], FS, f, 40.0),
+                    f,
+                )
+            };
+            let out = read(frames.iter().map(|x| x.audio).collect());
+            let string = read(
+                frames
+                    .iter()
+                    .map(|x| x.bow_point_velocity_m_per_s)
+                    .collect(),
+            );
+            let y = bridge.response(f)[0][0];
+            within += (out.abs() < 5.0) as usize;
+            count += 1;
+            println!(
+                "  {note}: {out:+.1} / {string:+.1} cents, {:.2}",
+                z_s * y.0.hypot(y.1)
+            );
+        }
+        println!("{kind:?}: {within} of {count} within 5 cents in the output");
+    }
+}
