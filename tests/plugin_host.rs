@@ -454,6 +454,46 @@ fn processing_does_not_allocate_through_notes_parameter_changes_and_instrument_s
     }
 }
 
+/// Every articulation played on paper B's thermal strings (the finger's pluck and touch,
+/// the stick's strike and stroke on the thermal strings themselves) through the plugin
+/// built with `assert_process_allocs`: reaching the end is the assertion that nothing
+/// allocates; the output is finite and sounds (above -60 dBFS over each articulation's
+/// stretch, far below a note's level).
+#[test]
+fn every_articulation_on_the_thermal_strings_processes_without_allocation() {
+    let mut plugin = active_plugin(FS, BLOCK);
+    let mut score = Score::new().at(0, plugin.text("Friction Model", "Thermal (paper B)"));
+    let articulations = [
+        "Arco",
+        "Pizzicato",
+        "Tremolo",
+        "Spiccato",
+        "Col legno",
+        "Sautillé",
+        "Harmonics",
+        "Col legno tratto",
+    ];
+    let stretch = secs(0.3, FS);
+    for (k, articulation) in articulations.iter().enumerate() {
+        let t = k as u64 * stretch + 1;
+        score.push(t, plugin.text("Articulation", articulation));
+        score.push(t + 2, Event::note_on(50));
+        score.push(t + 61, Event::note_on(57));
+        score.push(t + stretch - 200, Event::note_off(50));
+        score.push(t + stretch - 100, Event::note_off(57));
+    }
+    let frames = (articulations.len() as u64 * stretch) as usize;
+    let out = plugin.render(frames, BLOCK, &score);
+    let x = channel_f64(&out, 0);
+    assert!(x.iter().all(|v| v.is_finite()));
+    for (k, articulation) in articulations.iter().enumerate() {
+        let from = k * stretch as usize;
+        let level = rms(&x[from..from + stretch as usize]);
+        println!("{articulation}: {:.1} dBFS", 20.0 * level.log10());
+        assert!(level > 1e-3, "{articulation}: {level:.2e}");
+    }
+}
+
 #[test]
 fn notes_outside_the_instruments_range_are_ignored_silently() {
     let mut plugin = active_plugin(FS, BLOCK);
