@@ -501,8 +501,8 @@ pub struct ThermalString {
     /// The stick's contact on each node (allocated for the most nodes).
     stick_nodes: Vec<HyperbolicFriction>,
     /// A light finger touching the string (a harmonic, [`ThermalString::set_touch`]): the
-    /// partial whose node it touches nearest the bridge (0: none) and the share of the
-    /// string's velocity it takes out there, `R / (R + 2 Z)`.
+    /// partial whose node it touches nearest the bridge (0: none) and its resistance over
+    /// the string's two sides', `R / 2Z`.
     touch: (u32, f64),
     /// The bow's stick striking the string (col legno battuto, [`ThermalString::strike`]).
     striker: Striker,
@@ -873,13 +873,13 @@ impl ThermalString {
         if self.touch.0 >= 2 {
             // The round trip bridge-finger-bridge, `2 x + 1` samples plus the bridge end's
             // delays at the partial (its loss filter's and `extra_delay`), is one period
-            // of the partial, to the nearest sample.
+            // of the partial; the finger sits between the two samples around `x`.
             let w = 2.0 * PI * f0_hz * partial as f64 / fs;
             let period = fs / (f0_hz * partial as f64);
             let x = 0.5 * (period - 1.0 - loss.phase_delay(w) - extra_delay);
-            let x = x.round().max(1.0) as usize;
+            let x = x.max(1.0);
             // A finger inside the bow's clearance or beyond the string touches nothing.
-            let clear = x > BOW_CLEARANCE && x + BOW_CLEARANCE < m;
+            let clear = x > BOW_CLEARANCE as f64 && (x as usize) + BOW_CLEARANCE + 1 < m;
             self.waves
                 .set_touch(x, if clear { self.touch.1 } else { 0.0 });
         }
@@ -937,12 +937,12 @@ impl ThermalString {
     pub fn set_touch(&mut self, touch: Option<(u32, f64)>) {
         self.touch = match touch {
             Some((partial, r)) if partial >= 2 && r.is_finite() && r > 0.0 => {
-                (partial, r / (r + 2.0 * self.spec.z0_kg_per_s))
+                (partial, r / (2.0 * self.spec.z0_kg_per_s))
             }
             _ => (0, 0.0),
         };
         if self.touch.0 == 0 {
-            self.waves.set_touch(0, 0.0);
+            self.waves.set_touch(0.0, 0.0);
         }
     }
 
@@ -1013,7 +1013,7 @@ impl ThermalString {
 
     /// Where the touching finger is, samples from the bridge (`None`: no finger, or
     /// none that fits the string at this rate).
-    pub fn touch_position(&self) -> Option<usize> {
+    pub fn touch_position(&self) -> Option<f64> {
         self.waves.touch_at()
     }
 

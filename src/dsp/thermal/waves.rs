@@ -38,10 +38,22 @@ pub(super) struct Waves {
     /// The stopping finger's share of the nut's reflection: 1 while it presses, less while
     /// it leaves the string (`ThermalString::set_finger_reflection`).
     finger: f64,
-    /// A light finger touching the string (a harmonic): its position (samples from the
-    /// bridge) and the share of the string's velocity there it takes out each sample
-    /// (`R / (R + 2 Z)`); a share of 0 touches nothing.
-    touch: (usize, f64),
+    /// A light finger touching the string (a harmonic), [`Touch`]; `k` 0 touches nothing.
+    touch: Touch,
+}
+
+/// A light finger between two samples: at `x + w1` samples from the bridge (`x` whole,
+/// `w1` in `[0, 1)`), sensing the string's velocity interpolated there,
+/// `v^ = (1 - w1) v_x + w1 v_x+1`, and pressing back `-R v^` shared between the two
+/// samples with the same weights (a rank-one damper: it takes `R v^2` out and nothing
+/// else, and leaves a mode with its node at `x + w1` all but untouched). `k` is
+/// `rho / (1 + rho ((1 - w1)^2 + w1^2))` with `rho = R / 2Z`: each sample's waves gain
+/// `-k w v^f` from the free interpolated velocity `v^f`.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(super) struct Touch {
+    x: usize,
+    w1: f64,
+    k: f64,
 }
 
 /// Where the bow's `n` nodes sit in the rings this sample.
@@ -75,7 +87,7 @@ impl Waves {
             dropped: [0.0; 2],
             wake_sum: f64::INFINITY,
             finger: 1.0,
-            touch: (0, 0.0),
+            touch: Touch::default(),
         }
     }
 
@@ -93,7 +105,7 @@ impl Waves {
     /// A new loop (configuration): `m` samples, fresh loss and Thiran filters.
     pub(super) fn set_loop(&mut self, m: usize, loss: OnePoleLoss, thiran: f64) {
         self.m = m;
-        self.touch = (0, 0.0);
+        self.touch = Touch::default();
         self.loss = [loss; 2];
         self.fraction = [Allpass1::new(thiran); 2];
     }
@@ -102,8 +114,8 @@ impl Waves {
     /// the waves stay where they are.
     pub(super) fn retune(&mut self, m: usize, loss: OnePoleLoss, thiran: f64) {
         self.m = m;
-        if self.touch.0 + 1 >= m {
-            self.touch = (0, 0.0);
+        if self.touch.x + 2 >= m {
+            self.touch = Touch::default();
         }
         for p in 0..2 {
             self.loss[p].g = loss.g;
@@ -136,11 +148,18 @@ impl Waves {
 
     /// A light finger at position `x` (samples from the bridge, inside the string) taking
     /// `share` (0..1) of the string's velocity there each sample, or none (`share` 0).
-    pub(super) fn set_touch(&mut self, x: usize, share: f64) {
-        self.touch = if share > 0.0 && x > 0 && x + 1 < self.m {
-            (x, share.min(1.0))
+    pub(super) fn set_touch(&mut self, at: f64, rho: f64) {
+        let x = at.floor();
+        self.touch = if rho > 0.0 && rho.is_finite() && x >= 1.0 && (x as usize) + 2 < self.m {
+            let w1 = at - x;
+            let w0 = 1.0 - w1;
+            Touch {
+                x: x as usize,
+                w1,
+                k: rho / (1.0 + rho * (w0 * w0 + w1 * w1)),
+            }
         } else {
-            (0, 0.0)
+            Touch::default()
         };
     }
 
@@ -170,8 +189,8 @@ impl Waves {
     }
 
     /// Where a finger touches, samples from the bridge (`None`: no finger).
-    pub(super) fn touch_at(&self) -> Option<usize> {
-        (self.touch.1 > 0.0).then_some(self.touch.0)
+    pub(super) fn touch_at(&self) -> Option<f64> {
+        (self.touch.k > 0.0).then_some(self.touch.x as f64 + self.touch.w1)
     }
 
     pub(super) fn bridge_reflection(&self) -> [[f64; 2]; 2] {
@@ -333,23 +352,33 @@ impl Waves {
         self.t = next;
     }
 
-    /// The touching finger, one sample: where it touches, the string's velocity `v` meets
-    /// the finger's force `-R v'`, so `v' = v (1 - R / (R + 2 Z))` and each travelling
-    /// wave there gains `v' - v` (in both polarisations: a fingertip resists every way).
-    /// It only takes energy out. Once per sample, before [`Waves::finish_sample`]; nothing
-    /// without a finger.
+    /// The touching finger, one sample ([`Touch`]): in both polarisations (a fingertip
+    /// resists every way), each of its two samples' travelling waves gain `-k w v^f`, so
+    /// the string there moves at `v + F / 2Z` with the finger's force `F`. It only takes
+    /// energy out. Once per sample, before [`Waves::finish_sample`]; nothing without a
+    /// finger.
     pub(super) fn touch_junction(&mut self) {
-        let (x, share) = self.touch;
-        if share == 0.0 {
+        let Touch { x, w1, k } = self.touch;
+        if k == 0.0 {
             return;
         }
-        let jr = x.wrapping_sub(self.t) & self.mask();
-        let jl = self.left[0].back(self.t, self.m - 1 - x);
+        let w0 = 1.0 - w1;
+        let mask = self.mask();
+        let (r0, r1) = (
+            x.wrapping_sub(self.t) & mask,
+            (x + 1).wrapping_sub(self.t) & mask,
+        );
+        let l0 = self.left[0].back(self.t, self.m - 1 - x);
+        let l1 = self.left[0].back(self.t, self.m - 2 - x);
         for p in 0..2 {
             if !self.asleep[p] {
-                let dv = -share * (self.right[p][jr] + self.left[p][jl]);
-                self.right[p][jr] += dv;
-                self.left[p][jl] += dv;
+                let v_free = w0 * (self.right[p][r0] + self.left[p][l0])
+                    + w1 * (self.right[p][r1] + self.left[p][l1]);
+                let dv = -k * v_free;
+                self.right[p][r0] += w0 * dv;
+                self.left[p][l0] += w0 * dv;
+                self.right[p][r1] += w1 * dv;
+                self.left[p][l1] += w1 * dv;
             }
         }
     }
