@@ -281,3 +281,75 @@ fn minimal_string_guettler_survey() {
         }
     }
 }
+
+/// How long the bow drags the string before its first slip, against the quasi-static
+/// estimate: bowed from rest at a constant acceleration `a`, the string follows the bow
+/// until its pull, `K y` with `K = T / (beta (1 - beta) L)` (the two sides of the string
+/// as springs) and `y = a t^2 / 2`, reaches the static friction `mu_s F`, so the first
+/// slip comes at `t1 = sqrt(2 mu_s F / (K a))`. The plugin's cello D3 (hyperbolic law,
+/// beta 0.1, the bow from rest to 0.1 m/s): ms to the first slip, `t1`, and ms to
+/// Helmholtz motion that lasts to the end of 0.6 s. `cargo test --release -p
+/// colophony-lab --test attack_survey first_slip -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn first_slip_after_the_bow_drags_the_string() {
+    use colophony::dsp::friction::HyperbolicFriction;
+    use colophony::dsp::instrument::Instrument;
+    use colophony::measure::regime::{helmholtz_since, slip_onsets};
+    let (note, beta) = (50u8, 0.1);
+    let f0 = midi_to_hz(note as f64);
+    let d = InstrumentKind::Cello.strings()[2];
+    let length = InstrumentKind::Cello.string_length_m() * d.open_hz / f0;
+    let tension = d.z0_kg_per_s * 2.0 * length * f0;
+    let k = tension / (beta * (1.0 - beta) * length);
+    let mu_s = HyperbolicFriction::default().mu_s;
+    println!(
+        "cello D3, beta {beta}: K = {k:.0} N/m, mu_s {mu_s}; rows force (N), columns \
+         acceleration (m/s^2): first slip / t1 / lasting Helmholtz motion, ms"
+    );
+    let accels = [0.5, 1.0, 2.0, 5.0, 10.0, 20.0];
+    let n = (0.6 * FS) as usize;
+    let ms = |k: Option<usize>| k.map_or("never".into(), |k| format!("{:.0}", k as f64 / FS * 1e3));
+    let mut spans = String::new();
+    for force_n in [1.0, 2.0, 3.0, 4.0] {
+        let mut row = format!("{force_n:>4}");
+        for &a in &accels {
+            let mut cello = Instrument::new(InstrumentKind::Cello, FS);
+            cello.set_friction_model(FrictionModel::Hyperbolic);
+            cello.note_on(note);
+            let probe: Vec<ContactSample> = (0..n)
+                .map(|i| {
+                    if i % 256 == 0 {
+                        cello.update_sleep();
+                    }
+                    let bow = BowControl {
+                        velocity_m_per_s: (a * i as f64 / FS).min(0.1),
+                        force_n,
+                        position_beta: beta,
+                    };
+                    ContactSample::new(&cello.tick(bow), &bow)
+                })
+                .collect();
+            let first = slip_onsets(&probe).first().copied();
+            let t1 = (2.0 * mu_s * force_n / (k * a)).sqrt() * 1e3;
+            let lasting = helmholtz_since(&probe, FS as f32, f0 as f32);
+            row += &format!(
+                " {:>16}",
+                format!("{} / {t1:.0} / {}", ms(first), ms(lasting))
+            );
+            if force_n == 3.0 && a == 2.0 {
+                // The spans between slips up to the lasting motion, in periods.
+                let onsets = slip_onsets(&probe);
+                let end = lasting.unwrap_or(n);
+                spans = onsets
+                    .windows(2)
+                    .take_while(|w| w[0] <= end)
+                    .map(|w| format!("{:.2}", (w[1] - w[0]) as f64 * f0 / FS))
+                    .collect::<Vec<_>>()
+                    .join(" ");
+            }
+        }
+        println!("{row}");
+    }
+    println!("3 N at 2 m/s^2, spans between slips up to the lasting motion (periods): {spans}");
+}
