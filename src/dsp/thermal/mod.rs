@@ -508,9 +508,11 @@ pub struct ThermalString {
     striker: Striker,
 }
 
-/// The direction the striking stick moves in, `[h, v]` (a unit vector): the stick's
-/// wood meets the string square on from above, as a bouncing bow does (the vertical
-/// plane, [`ThermalString::strike`]).
+/// The direction the striking stick moves in, `[h, v]` (a unit vector,
+/// [`ThermalString::strike`]): the bowing plane, as on the point-bow strings. From above
+/// (`[0, 1]`, as a bouncing bow moves) the note is about 10 dB fainter, the instrument
+/// hearing the vertical polarisation only through the bridge's coupling
+/// (docs/articulations.md#col-legno-battuto).
 pub const STRIKE_DIRECTION: [f64; 2] = [1.0, 0.0];
 
 /// The bow's stick on one node, at rest: the point-bow strings' stick (the hyperbolic

@@ -146,8 +146,9 @@ impl Waves {
         self.finger = reflection.clamp(0.0, 1.0);
     }
 
-    /// A light finger at position `x` (samples from the bridge, inside the string) taking
-    /// `share` (0..1) of the string's velocity there each sample, or none (`share` 0).
+    /// A light finger at `at` samples from the bridge (between two samples, inside the
+    /// string) of resistance `rho` times the string's two sides' `2 Z` ([`Touch`]), or
+    /// none (`rho` 0).
     pub(super) fn set_touch(&mut self, at: f64, rho: f64) {
         let x = at.floor();
         self.touch = if rho > 0.0 && rho.is_finite() && x >= 1.0 && (x as usize) + 2 < self.m {
