@@ -49,7 +49,6 @@
 use super::bridge::{solve_junction, BridgeMode, ModalBridge};
 use super::intonation;
 use super::resample::Resampler;
-use super::strings::HARMONIC_FINGER_RESISTANCE_Z0;
 pub use super::strings::{FourStrings, RECONFIGURE_FADE_S};
 use super::strings::{InternalSample, StringBank, StringBow};
 use super::thermal::{
@@ -118,6 +117,16 @@ impl ThermalSettings {
         }
     }
 }
+
+/// The harmonic finger's resistance on the thermal strings, in units of the string's
+/// impedance: `R = Z0`, lighter than the point-bow strings'
+/// [`super::strings::HARMONIC_FINGER_RESISTANCE_Z0`]: it passes two thirds of a wave,
+/// reflects a ninth of its energy and takes four ninths out (at `2 Z0`: half, a quarter
+/// and a half). Chosen by measurement on the 57 test
+/// harmonics of the violin, viola and cello at the defaults (docs/articulations.md#harmonics):
+/// 53, 55, 55, 53 and 53 sound their partial within 10 cents at 0.5, 0.75, 1, 1.5 and 2
+/// `Z0`, and at 4 `Z0` some do not speak.
+pub const THERMAL_FINGER_Z0: f64 = 1.0;
 
 /// The strings and bridge at the internal rate.
 #[derive(Debug, Clone)]
@@ -385,11 +394,11 @@ impl StringBank for ThermalBank {
     const HARMONIC_BOW_AT_ROOT: bool = true;
 
     /// The light finger on both polarisations of string `i`, at the node of `partial`
-    /// nearest the bridge ([`ThermalString::set_touch`]); the string is retuned at its
-    /// stopped pitch with the loop matched at the partial.
+    /// nearest the bridge ([`ThermalString::set_touch`]), of [`THERMAL_FINGER_Z0`]; the
+    /// string is retuned at its stopped pitch with the loop matched at the partial.
     fn touch(&mut self, i: usize, partial: Option<u32>) {
         let string = &mut self.core.strings[i];
-        let resistance = HARMONIC_FINGER_RESISTANCE_Z0 * string.z0_kg_per_s();
+        let resistance = THERMAL_FINGER_Z0 * string.z0_kg_per_s();
         let before = string.touched_partial();
         string.set_touch(partial.map(|n| (n, resistance)));
         let f0 = string.fundamental_hz();
