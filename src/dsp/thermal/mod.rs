@@ -508,13 +508,6 @@ pub struct ThermalString {
     striker: Striker,
 }
 
-/// The direction the striking stick moves in, `[h, v]` (a unit vector,
-/// [`ThermalString::strike`]): the bowing plane, as on the point-bow strings. From above
-/// (`[0, 1]`, as a bouncing bow moves) the note is about 10 dB fainter, the instrument
-/// hearing the vertical polarisation only through the bridge's coupling
-/// (docs/articulations.md#col-legno-battuto).
-pub const STRIKE_DIRECTION: [f64; 2] = [1.0, 0.0];
-
 /// The bow's stick on one node, at rest: the point-bow strings' stick (the hyperbolic
 /// law with the wood's coefficients).
 fn stick_contact() -> HyperbolicFriction {
@@ -962,8 +955,10 @@ impl ThermalString {
     }
 
     /// Strikes the string with the bow's stick (col legno battuto): a rigid `mass_kg`
-    /// arriving at `velocity_m_per_s` along [`STRIKE_DIRECTION`] at the bow's middle
-    /// node, which pushes the string until the string would pull it back (the point-bow
+    /// arriving at `velocity_m_per_s` in the bowing plane (as on the point-bow strings;
+    /// from above the note is about 10 dB fainter, the instrument hearing the vertical
+    /// polarisation only through the bridge's coupling: docs/articulations.md) at the
+    /// bow's middle node, which pushes the string until the string would pull it back (the point-bow
     /// strings' stick, [`crate::dsp::waveguide::WaveguideString::strike`]). The string
     /// takes what the stick loses, momentum `m (u0 - u1)` and energy
     /// `m (u0^2 - u1^2) / 2`. While it is on, [`ThermalString::strike_contact`] replaces
@@ -985,27 +980,25 @@ impl ThermalString {
         self.striker.is_on()
     }
 
-    /// The stick's velocity along [`STRIKE_DIRECTION`], m/s (negative once it rebounds).
+    /// The stick's velocity toward the string, m/s (negative once it rebounds).
     pub fn striker_velocity_m_per_s(&self) -> f64 {
         self.striker.velocity_m_per_s()
     }
 
     /// One sample of the striking stick's contact ([`ThermalString::strike`]) at the
     /// middle node of a bow at `position_beta`, instead of the bow's: the string's free
-    /// velocity along the stick's direction meets the stick through the string's
-    /// admittance there, `1 / 2Z` (the stick is rigid: no hair between them). Returns the
-    /// horizontal string velocity there, m/s.
+    /// horizontal velocity there meets the stick through the string's admittance,
+    /// `1 / 2Z` (the stick is rigid: no hair between them). Returns the string's
+    /// horizontal velocity there, m/s.
     #[cold]
     pub fn strike_contact(&mut self, position_beta: f64) -> f64 {
         let m = self.waves.len();
         let x = ((position_beta.clamp(0.01, 0.5) * m as f64 + 0.5) as usize).clamp(1, m - 2);
-        let [d_h, d_v] = STRIKE_DIRECTION;
-        let [v_h, v_v] = self.waves.velocity_at(x);
+        let v_free = self.waves.velocity_h(x);
         let dt = 1.0 / self.internal_rate_hz;
-        let force = self.striker.push(d_h * v_h + d_v * v_v, self.half_y, dt);
-        let dv = force * self.half_y;
-        self.waves.push_at(x, [d_h * dv, d_v * dv]);
-        v_h + d_h * dv
+        let dv = self.striker.push(v_free, self.half_y, dt) * self.half_y;
+        self.waves.push_h(x, dv);
+        v_free + dv
     }
 
     /// The partial a touching finger leaves sounding (1: no finger).

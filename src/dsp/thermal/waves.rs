@@ -289,22 +289,13 @@ impl Waves {
             + self.left[0][self.left[0].back(self.t, self.m - 1 - x)]
     }
 
-    /// The `[h, v]` velocity at position `x` (no bow there).
-    pub(super) fn velocity_at(&self, x: usize) -> [f64; 2] {
-        let jr = x.wrapping_sub(self.t) & self.mask();
-        let jl = self.left[0].back(self.t, self.m - 1 - x);
-        [0, 1].map(|p| self.right[p][jr] + self.left[p][jl])
-    }
-
-    /// Adds `dv` (`[h, v]`, m/s) to both travelling waves leaving position `x`: a point
+    /// Adds `dv` (m/s) to both horizontal travelling waves leaving position `x`: a point
     /// force `F` there gives `F / 2Z` each way.
-    pub(super) fn push_at(&mut self, x: usize, dv: [f64; 2]) {
+    pub(super) fn push_h(&mut self, x: usize, dv: f64) {
         let jr = x.wrapping_sub(self.t) & self.mask();
         let jl = self.left[0].back(self.t, self.m - 1 - x);
-        for (p, dv) in dv.into_iter().enumerate() {
-            self.right[p][jr] += dv;
-            self.left[p][jl] += dv;
-        }
+        self.right[0][jr] += dv;
+        self.left[0][jl] += dv;
     }
 
     /// The `[h, v]` velocity waves arriving at the bridge this sample (after the loss
