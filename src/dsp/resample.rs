@@ -544,13 +544,18 @@ impl Resampler {
             let dx = self.g * steps;
             let table_end = (HALF_WIDTH * TABLE_STEPS) as f64;
             let mut acc = 0.0;
+            let history = &self.history[..=mask];
             for k in first..=last {
                 let ax = x.abs();
                 if ax < table_end {
-                    let i = ax as usize;
+                    // SAFETY: `ax` is finite (NaN fails the test above) and lies in
+                    // [0, table_end), far inside i32, so the conversion truncates as
+                    // `as` would, without `as`'s saturating checks on every tap.
+                    let i = unsafe { ax.to_int_unchecked::<i32>() } as usize;
                     let f = ax - i as f64;
-                    let h = self.table[i] + f * (self.table[i + 1] - self.table[i]);
-                    acc += self.history[(k as usize) & mask] * h;
+                    let [t0, t1] = [self.table[i], self.table[i + 1]];
+                    let h = t0 + f * (t1 - t0);
+                    acc += history[(k as usize) & mask] * h;
                 }
                 x -= dx;
             }
