@@ -187,7 +187,7 @@ struct Interpolation {
 }
 
 impl Interpolation {
-    /// Tuned so that its phase delay at `w` rad/sample (`w` under `pi / 6`) is `delay`
+    /// Tuned so that its phase delay at `w` rad/sample (`w` under `pi / 2`) is `delay`
     /// (0 to 3 samples): with `p` its fraction, `atan2(f sin w, 1 - f + f cos w) = p w`.
     fn set(&mut self, delay: f64, w: f64) {
         let i = (delay.floor().max(0.0) as usize).min(2);
