@@ -21,6 +21,39 @@ use colophony::performer::{Performer, Setup};
 
 const FS: f64 = 48_000.0;
 
+/// The contact probe of the bare cello (no performer), `note` bowed with the hyperbolic
+/// law for `n` samples at `force_n` and `beta`, the bow's speed `velocity(i)` at sample
+/// `i`; `stiff` false takes the strings' dispersion filter out.
+fn bare_cello_probe(
+    note: u8,
+    force_n: f64,
+    beta: f64,
+    n: usize,
+    stiff: bool,
+    velocity: impl Fn(usize) -> f64,
+) -> Vec<ContactSample> {
+    use colophony::dsp::instrument::Instrument;
+    let mut cello = Instrument::new(InstrumentKind::Cello, FS);
+    cello.set_friction_model(FrictionModel::Hyperbolic);
+    if !stiff {
+        cello.set_dispersion_cap(0);
+    }
+    cello.note_on(note);
+    (0..n)
+        .map(|i| {
+            if i % 256 == 0 {
+                cello.update_sleep();
+            }
+            let bow = BowControl {
+                velocity_m_per_s: velocity(i),
+                force_n,
+                position_beta: beta,
+            };
+            ContactSample::new(&cello.tick(bow), &bow)
+        })
+        .collect()
+}
+
 #[test]
 #[ignore]
 fn attacks_through_the_performer_survey() {
@@ -77,7 +110,6 @@ fn attacks_through_the_performer_survey() {
 #[test]
 #[ignore]
 fn guettler_diagram_survey() {
-    use colophony::dsp::instrument::Instrument;
     use colophony::measure::regime::helmholtz_since;
     let note: u8 = std::env::var("NOTE").map_or(50, |s| s.parse().expect("NOTE: a MIDI note"));
     let beta: f64 = std::env::var("BETA").map_or(0.1, |s| s.parse().expect("BETA: 0.02-0.25"));
@@ -91,23 +123,13 @@ fn guettler_diagram_survey() {
     for force_n in [0.25, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 6.0] {
         let mut row = format!("{force_n:>5} ");
         for &a in &accels {
-            let mut cello = Instrument::new(InstrumentKind::Cello, FS);
-            cello.set_friction_model(FrictionModel::Hyperbolic);
-            cello.note_on(note);
-            let n = (0.6 * FS) as usize;
-            let mut probe = Vec::with_capacity(n);
-            for i in 0..n {
-                if i % 256 == 0 {
-                    cello.update_sleep();
+            let probe = bare_cello_probe(note, force_n, beta, (0.6 * FS) as usize, true, |i| {
+                if a == 0.0 {
+                    0.1
+                } else {
+                    (a * i as f64 / FS).min(0.1)
                 }
-                let t = i as f64 / FS;
-                let bow = BowControl {
-                    velocity_m_per_s: if a == 0.0 { 0.1 } else { (a * t).min(0.1) },
-                    force_n,
-                    position_beta: beta,
-                };
-                probe.push(ContactSample::new(&cello.tick(bow), &bow));
-            }
+            });
             row += &match helmholtz_since(&probe, FS as f32, f0 as f32) {
                 Some(k) => format!("{:>7.0}", k as f64 / FS * 1e3),
                 None => "  never".into(),
@@ -220,7 +242,6 @@ fn first_helmholtz_run(probe: &[ContactSample], f0: f64, run: usize) -> Option<u
 #[test]
 #[ignore]
 fn minimal_string_guettler_survey() {
-    use colophony::dsp::instrument::Instrument;
     use colophony::measure::regime::helmholtz_since;
     let f0 = midi_to_hz(50.0);
     let accels = [0.0, 0.1, 0.2, 0.5, 1.0, 2.0, 5.0];
@@ -253,25 +274,8 @@ fn minimal_string_guettler_survey() {
                     let mut s = MinimalString::new(f0, 0.1, model.ends_with("bridge"));
                     (0..n).map(|i| s.tick(bow_velocity(i), force)).collect()
                 } else {
-                    let mut cello = Instrument::new(InstrumentKind::Cello, FS);
-                    cello.set_friction_model(FrictionModel::Hyperbolic);
-                    if model.ends_with("(no dispersion filter)") {
-                        cello.set_dispersion_cap(0);
-                    }
-                    cello.note_on(50);
-                    (0..n)
-                        .map(|i| {
-                            if i % 256 == 0 {
-                                cello.update_sleep();
-                            }
-                            let bow = BowControl {
-                                velocity_m_per_s: bow_velocity(i),
-                                force_n: force,
-                                position_beta: 0.1,
-                            };
-                            ContactSample::new(&cello.tick(bow), &bow)
-                        })
-                        .collect()
+                    let stiff = !model.ends_with("(no dispersion filter)");
+                    bare_cello_probe(50, force, 0.1, n, stiff, bow_velocity)
                 };
                 let first = ms(first_helmholtz_run(&probe, f0, 6));
                 let lasting = ms(helmholtz_since(&probe, FS as f32, f0 as f32));
@@ -294,7 +298,6 @@ fn minimal_string_guettler_survey() {
 #[ignore]
 fn first_slip_after_the_bow_drags_the_string() {
     use colophony::dsp::friction::HyperbolicFriction;
-    use colophony::dsp::instrument::Instrument;
     use colophony::measure::regime::{helmholtz_since, slip_onsets};
     let (note, beta) = (50u8, 0.1);
     let f0 = midi_to_hz(note as f64);
@@ -314,22 +317,9 @@ fn first_slip_after_the_bow_drags_the_string() {
     for force_n in [1.0, 2.0, 3.0, 4.0] {
         let mut row = format!("{force_n:>4}");
         for &a in &accels {
-            let mut cello = Instrument::new(InstrumentKind::Cello, FS);
-            cello.set_friction_model(FrictionModel::Hyperbolic);
-            cello.note_on(note);
-            let probe: Vec<ContactSample> = (0..n)
-                .map(|i| {
-                    if i % 256 == 0 {
-                        cello.update_sleep();
-                    }
-                    let bow = BowControl {
-                        velocity_m_per_s: (a * i as f64 / FS).min(0.1),
-                        force_n,
-                        position_beta: beta,
-                    };
-                    ContactSample::new(&cello.tick(bow), &bow)
-                })
-                .collect();
+            let probe = bare_cello_probe(note, force_n, beta, n, true, |i| {
+                (a * i as f64 / FS).min(0.1)
+            });
             let first = slip_onsets(&probe).first().copied();
             let t1 = (2.0 * mu_s * force_n / (k * a)).sqrt() * 1e3;
             let lasting = helmholtz_since(&probe, FS as f32, f0 as f32);
