@@ -164,6 +164,16 @@ pub fn slip_stats(
     }
 }
 
+/// The n-th partial's amplitude at the bridge of a string pulled aside at `beta` of its
+/// length from the bridge and let go (the pulled triangle's force on the bridge), up to a
+/// common factor: the displacement's `sin(n pi beta) / n^2` times the slope's `n` at the
+/// bridge, times `sinc(n pi w / 2)` for a finger that rounds the kink over `width` of the
+/// length (`width > 0`).
+pub fn plucked_bridge_partial(n: f64, beta: f64, width: f64) -> f64 {
+    let x = n * PI * width / 2.0;
+    ((n * PI * beta).sin() / n * x.sin() / x).abs()
+}
+
 /// Root-mean-square level.
 pub fn rms(x: &[f64]) -> f64 {
     (x.iter().map(|v| v * v).sum::<f64>() / x.len().max(1) as f64).sqrt()

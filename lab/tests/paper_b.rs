@@ -311,7 +311,6 @@ fn lossless_cello_c() -> ThermalString {
 #[test]
 fn a_plucked_thermal_string_holds_the_pulled_strings_energy_and_its_partials() {
     use colophony::analysis::partial_amplitude;
-    use std::f64::consts::PI;
     for (beta, width) in [(0.2, 0.0), (0.25, 0.0), (0.13, 0.05), (0.37, 0.02)] {
         let mut s = lossless_cello_c();
         let fs = s.internal_rate_hz();
@@ -340,10 +339,7 @@ fn a_plucked_thermal_string_holds_the_pulled_strings_energy_and_its_partials() {
             .map(|_| s.tick(lifted).bridge_force_n)
             .collect();
         let w = width.max(1.0 / lines);
-        let theory = |n: f64| {
-            let sinc = (n * PI * w / 2.0).sin() / (n * PI * w / 2.0);
-            ((n * PI * beta).sin() / n * sinc).abs()
-        };
+        let theory = |n: f64| colophony::analysis::plucked_bridge_partial(n, beta, w);
         let measured = |n: f64| partial_amplitude(&force, fs, n * f0);
         for n in 2..=10 {
             let n = n as f64;
