@@ -31,9 +31,13 @@
 //! median). The earlier procedure averaged it in (and smoothed over five semitones),
 //! leaving the notes played at the defaults half that difference out of tune
 //! (docs/playing-space.md, "Tuned at the defaults").
+//!
+//! With `--free` it fits the table's free-ring row for paper B's thermal strings instead
+//! ([`fit_free`]): each note plucked, the pitch of its ring folded in the same way
+//! (docs/articulations.md#pizzicato).
 
 use crate::playing_space::{measure, Bowing, Cell, Model};
-use colophony::dsp::intonation::{IntonationTable, SOFT_EXPRESSIONS};
+use colophony::dsp::intonation::{IntonationTable, SOFT_EXPRESSIONS, THERMAL_FREE_ROW};
 use colophony::dsp::vocabulary::{InstrumentKind, MAX_STOP_SEMITONES, STRINGS};
 use rayon::prelude::*;
 use std::fmt::Write as _;
@@ -315,6 +319,151 @@ fn fit_full(
     Ok((table, report))
 }
 
+/// How long each plucked note rings for the free-pitch fit, and where its pitch is read
+/// from, s: after the pluck's first passes, over tens of periods of the lowest note.
+const FREE_SECONDS: f64 = 0.5;
+const FREE_FROM_S: f64 = 0.05;
+
+/// One thermal note plucked on its string at velocity 0.8 (the player's pluck,
+/// [`colophony::performer::articulation::pluck_for`]) at the plugin's default bow
+/// discretisation, tuned by `table`: how far its ring sounds from equal temperament,
+/// cents (the strongest peak within [`TRUSTED_CENTS`] over 0.05-0.5 s of the output); NaN
+/// if the note is refused, goes to another string, or its peak sits at the search's edge
+/// (another resonance: its neighbours fill it).
+fn free_residual(e: &Entry, table: &'static IntonationTable, rate_hz: f64) -> Result<f64, String> {
+    use colophony::analysis::{cents, peak_frequency_hz};
+    use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
+    use colophony::dsp::vocabulary::{midi_to_hz, BowControl};
+    let bridge = colophony::dsp::bridge_data::shipped_bridge(e.kind);
+    let settings = ThermalSettings {
+        nodes: colophony::quality::GOOD_NODES,
+        width_m: 0.01,
+    };
+    let mut engine = ThermalInstrument::new(e.kind, &bridge.modes, rate_hz, settings)?;
+    engine.set_intonation(Some(table));
+    engine.set_preferred_string(Some(e.string));
+    let pluck = colophony::performer::articulation::pluck_for(e.kind, 0.8);
+    if engine.pluck(e.note(), pluck) != Some(e.string) {
+        return Ok(f64::NAN);
+    }
+    let audio: Vec<f64> = (0..(FREE_SECONDS * rate_hz) as usize)
+        .map(|_| engine.tick(BowControl::default()).audio)
+        .collect();
+    let f = midi_to_hz(e.note() as f64);
+    let heard = peak_frequency_hz(
+        &audio[(FREE_FROM_S * rate_hz) as usize..],
+        rate_hz,
+        f,
+        TRUSTED_CENTS,
+    );
+    let c = cents(heard, f);
+    Ok(if c.is_finite() && c.abs() < TRUSTED_CENTS - 5.0 {
+        c
+    } else {
+        f64::NAN
+    })
+}
+
+/// The thermal strings' free-ring row ([`THERMAL_FREE_ROW`]): `passes` passes over every
+/// note of `kinds` plucked (`free_residual`), starting from the shipped table with that
+/// row at zero (free-decay tuning); each pass plucks with the table so far and adds its
+/// residuals, string by string, gaps filled from their neighbours. A last pass plucks
+/// with the result: where a note then rings further from its pitch than with no
+/// correction (a wolf-like note, two resonances whose strongest changes side, which the
+/// passes do not settle), its correction is dropped.
+pub fn fit_free(
+    kinds: &[InstrumentKind],
+    rate_hz: f64,
+    passes: usize,
+) -> Result<(IntonationTable, String), String> {
+    let entries = entries(&[Model::Thermal], kinds);
+    let mut table = colophony::dsp::intonation::shipped().clone();
+    for e in &entries {
+        table.set(THERMAL_FREE_ROW, e.kind, e.string, e.semitone, 0.0);
+    }
+    let mut report = String::new();
+    let per_string = MAX_STOP_SEMITONES as usize + 1;
+    let pluck_all = |table: &IntonationTable| {
+        let current: &'static IntonationTable = Box::leak(Box::new(table.clone()));
+        let bar = progress(entries.len());
+        let measured = entries
+            .par_iter()
+            .map(|e| {
+                let r = free_residual(e, current, rate_hz);
+                bar.inc(1);
+                r
+            })
+            .collect::<Result<Vec<f64>, String>>();
+        bar.finish_and_clear();
+        measured
+    };
+    let mut untuned = Vec::new();
+    for pass in 0..=passes.max(1) {
+        let measured = pluck_all(&table)?;
+        if pass == 0 {
+            untuned = measured.clone();
+        }
+        if pass == passes.max(1) {
+            let mut dropped = 0;
+            let mut last = Vec::new();
+            for ((e, now), before) in entries.iter().zip(&measured).zip(&untuned) {
+                if now.abs() <= before.abs() {
+                    last.push((e.kind, *now));
+                } else {
+                    table.set(THERMAL_FREE_ROW, e.kind, e.string, e.semitone, 0.0);
+                    dropped += 1;
+                    last.push((e.kind, *before));
+                }
+            }
+            let _ = writeln!(
+                report,
+                "{dropped} of {} corrections dropped (the note rang further from its pitch with it)",
+                entries.len()
+            );
+            for &kind in kinds {
+                let of_kind = || last.iter().filter(move |(k, _)| *k == kind);
+                let within = of_kind().filter(|(_, c)| c.abs() <= 5.0).count();
+                let before = entries
+                    .iter()
+                    .zip(&untuned)
+                    .filter(|(e, c)| e.kind == kind && c.abs() <= 5.0)
+                    .count();
+                let _ = writeln!(
+                    report,
+                    "the table: {kind:?}: {within} of {} notes ring within 5 cents ({before} with no correction)",
+                    of_kind().count()
+                );
+            }
+            break;
+        }
+        for &kind in kinds {
+            let of_kind: Vec<f64> = entries
+                .iter()
+                .zip(&measured)
+                .filter(|(e, _)| e.kind == kind)
+                .map(|(_, c)| *c)
+                .collect();
+            let read = of_kind.iter().filter(|c| c.is_finite()).count();
+            let within = of_kind.iter().filter(|c| c.abs() <= 5.0).count();
+            let _ = writeln!(
+                report,
+                "pass {} (plucked with the table of pass {pass}): {kind:?}: {within} of {} notes ring within 5 cents ({read} read)",
+                pass + 1,
+                of_kind.len()
+            );
+        }
+        for (es, ms) in entries.chunks(per_string).zip(measured.chunks(per_string)) {
+            let mut r = ms.to_vec();
+            fill_gaps(&mut r);
+            for (e, r) in es.iter().zip(r) {
+                let old = table.get(THERMAL_FREE_ROW, e.kind, e.string, e.semitone);
+                table.set(THERMAL_FREE_ROW, e.kind, e.string, e.semitone, old + r);
+            }
+        }
+    }
+    Ok((table, report))
+}
+
 /// `colophony bench intonation --out FILE [--rates HZ] [--models ..] [--instruments ..]`:
 /// fits the table at the first rate given (48 kHz by default) and writes it, with a
 /// header, to `out`.
@@ -325,7 +474,21 @@ pub fn run(
     rate_hz: f64,
     passes: usize,
     dynamics: bool,
+    free: bool,
 ) -> Result<String, String> {
+    if free {
+        let (table, report) = fit_free(kinds, rate_hz, passes)?;
+        let mut merged = colophony::dsp::intonation::shipped().clone();
+        for &kind in kinds {
+            for string in 0..STRINGS {
+                for s in 0..=MAX_STOP_SEMITONES as usize {
+                    let c = table.get(THERMAL_FREE_ROW, kind, string, s);
+                    merged.set(THERMAL_FREE_ROW, kind, string, s, c);
+                }
+            }
+        }
+        return write_table(out, &merged, rate_hz).map(|done| format!("{report}{done}"));
+    }
     let (table, report) = fit(models, kinds, rate_hz, passes, dynamics)?;
     // Models and instruments not fitted keep the shipped entries (and, without
     // `dynamics`, their soft ones).
@@ -347,18 +510,26 @@ pub fn run(
             }
         }
     }
+    write_table(out, &merged, rate_hz).map(|done| format!("{report}{done}"))
+}
+
+/// Writes `table` to `out` with the file's header.
+fn write_table(out: &Path, table: &IntonationTable, rate_hz: f64) -> Result<String, String> {
     let text = format!(
         "# Intonation by the bowed sound (src/dsp/intonation.rs): cents each stopped note is moved\n\
          # from its equal-tempered free-decay pitch so that it sounds in tune bowed at the defaults.\n\
-         # Measured by `colophony bench intonation` at a host rate of {rate_hz} Hz (the point strings\n\
-         # run at {internal} Hz inside, the violin's and viola's strings and the cello's A string at\n\
-         # twice that), {passes} passes. Rows with an expression below 1 hold the correction at that\n\
-         # dynamics level (the Dynamics Guard's bow there), for the point laws.\n{}",
-        merged.to_csv(),
+         # Measured by `colophony bench intonation` at a host rate of {rate_hz} Hz (the point\n\
+         # strings run at {internal} Hz inside, the violin's and viola's strings and the cello's A\n\
+         # string at twice that; the passes: docs/playing-space.md, docs/articulations.md). Rows\n\
+         # with an expression below 1 hold the correction at that dynamics level (the Dynamics\n\
+         # Guard's bow there), for the point laws (`--dynamics`). The rows named thermal-free\n\
+         # move paper B's thermal strings' plucked and struck notes so that they ring at equal\n\
+         # temperament (`--free`).\n{}",
+        table.to_csv(),
         internal = colophony::dsp::vocabulary::INTERNAL_RATE_HZ,
     );
     std::fs::write(out, text).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
-    Ok(format!("{report}wrote {}", out.display()))
+    Ok(format!("wrote {}", out.display()))
 }
 
 #[cfg(test)]

@@ -163,6 +163,10 @@ enum Command {
         /// passes again for each; the shipped table has them).
         #[arg(long)]
         dynamics: bool,
+        /// intonation: fit paper B's thermal strings' plucked notes instead (the table's
+        /// thermal-free rows: each note moved so that it rings in tune).
+        #[arg(long)]
+        free: bool,
         /// peers: seconds each process renders (default 300).
         #[arg(long)]
         seconds: Option<f64>,
@@ -421,6 +425,7 @@ fn main() -> ExitCode {
             instruments,
             passes,
             dynamics,
+            free,
             seconds,
             attack,
         } => report(match what.as_str() {
@@ -452,7 +457,7 @@ fn main() -> ExitCode {
                 Some(file) => colophony_lab::playing_space::Plan::from_options(false, &rates, None, &models, &instruments)
                     .and_then(|plan| {
                         let rate = if rates.is_empty() { 48_000.0 } else { plan.rates_hz[0] };
-                        colophony_lab::intonation_fit::run(&file, &plan.models, &plan.kinds, rate, passes.unwrap_or(2), dynamics)
+                        colophony_lab::intonation_fit::run(&file, &plan.models, &plan.kinds, rate, passes.unwrap_or(2), dynamics, free)
                     }),
                 None => Err("bench intonation needs --out FILE (the shipped one: assets/intonation.csv)".into()),
             },

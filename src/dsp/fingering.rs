@@ -90,9 +90,12 @@ pub struct Fingering {
     intonation_row: usize,
     /// The dynamics' expression the intonation follows (1: full, the defaults).
     dynamics: f64,
-    /// Whether each string was plucked: it sounds its free pitch, which the table (made
-    /// for the bowed sound) does not move.
+    /// Whether each string was plucked (or struck): it sounds its free pitch, which the
+    /// bowed rows of the table do not move.
     plucked: [bool; STRINGS],
+    /// The table's row that tunes a plucked string's free pitch (`None`: its free decay
+    /// is its pitch, [`intonation::THERMAL_FREE_ROW`] for paper B's thermal strings).
+    free_row: Option<usize>,
     /// The partial each string's note sounds: 1 (its fundamental), or more for a harmonic
     /// (the string stopped that many times under the note, a finger touching it).
     partials: [u8; STRINGS],
@@ -118,8 +121,15 @@ impl Fingering {
             intonation_row: intonation_row.unwrap_or(0),
             dynamics: 1.0,
             plucked: [false; STRINGS],
+            free_row: None,
             partials: [1; STRINGS],
         }
+    }
+
+    /// The intonation table's row that tunes plucked and struck notes (`None`: they are
+    /// stopped at their equal-tempered free pitch).
+    pub fn set_free_row(&mut self, row: Option<usize>) {
+        self.free_row = row;
     }
 
     /// Another instrument: every note forgotten (the bend, the reference and the
@@ -374,10 +384,14 @@ impl Fingering {
         if self.partials[s] > 1 {
             return self.harmonic_hz(s, note);
         }
-        let table = self.intonation.filter(|_| !self.plucked[s]);
+        let (table, row) = match (self.plucked[s], self.free_row) {
+            (false, _) => (self.intonation, self.intonation_row),
+            (true, Some(row)) => (self.intonation, row),
+            (true, None) => (None, 0),
+        };
         intonation::tuned_hz(
             table,
-            self.intonation_row,
+            row,
             self.kind,
             string,
             note,
@@ -437,6 +451,35 @@ mod tests {
         assert_eq!(f.tuned_hz(string), full);
         f.set_dynamics(-3.0);
         assert!(f.tuned_hz(string).is_finite());
+    }
+
+    /// A plucked note is stopped by the free-ring row where the strings have one (paper
+    /// B's thermal strings), at its equal-tempered free pitch where they do not, and a
+    /// bowed note by the bowed row either way.
+    #[test]
+    fn a_plucked_note_is_tuned_by_the_free_ring_row_where_the_strings_have_one() {
+        let kind = InstrumentKind::Cello;
+        let mut table = IntonationTable::zero();
+        // F#3 on the D string: bowed row +3 cents, free row -8 cents.
+        table.set(0, kind, 2, 4, 3.0);
+        table.set(intonation::THERMAL_FREE_ROW, kind, 2, 4, -8.0);
+        let table: &'static IntonationTable = Box::leak(Box::new(table));
+        let equal = crate::dsp::vocabulary::midi_to_hz(54.0);
+        let cents_from_equal = |free_row: Option<usize>, plucked: bool| {
+            let mut f = Fingering::new(kind, Some(0));
+            f.set_intonation(Some(table));
+            f.set_free_row(free_row);
+            f.start(2, 54);
+            f.set_plucked(2, plucked);
+            1200.0 * (f.tuned_hz(2) / equal).log2()
+        };
+        // The correction is subtracted: a note that sounds sharp is stopped lower (1e-9:
+        // rounding).
+        let free = Some(intonation::THERMAL_FREE_ROW);
+        assert!((cents_from_equal(free, true) - 8.0).abs() < 1e-9);
+        assert!(cents_from_equal(None, true).abs() < 1e-9);
+        assert!((cents_from_equal(free, false) + 3.0).abs() < 1e-9);
+        assert!((cents_from_equal(None, false) + 3.0).abs() < 1e-9);
     }
 
     /// A glide takes the time asked and retunes about every 1.3 ms at any tick rate: 64

@@ -27,6 +27,12 @@
 //! expression, it is interpolated linearly, and an expression the table does not hold
 //! (paper B's thermal bow) takes the full expression's correction.
 //!
+//! A plucked or struck note sounds its free ring, not the bowed sound. The point-bow
+//! strings ring where they are tuned; paper B's thermal strings, coupled through their
+//! modal bridge, do not always, so the table holds one more row for them,
+//! [`THERMAL_FREE_ROW`]: the cents each note is moved so that it rings in tune, measured
+//! by `colophony bench intonation --free`.
+//!
 //! ```
 //! use colophony::dsp::vocabulary::InstrumentKind;
 //! use colophony::dsp::friction::FrictionModel;
@@ -44,6 +50,26 @@ use std::sync::OnceLock;
 
 /// Semitones per string in the table: 0 (open) ..= [`MAX_STOP_SEMITONES`].
 const SEMITONES: usize = MAX_STOP_SEMITONES as usize + 1;
+
+/// The table's row for paper B's thermal strings ringing free (plucked, or struck with
+/// the stick), after the bowed rows of [`TunedModel`]: the cents each stopped note is
+/// moved so that its free ring sounds at equal temperament. A thermal string is tuned
+/// by the modal bridge's phase delay at its pitch, and where the bridge's modes are
+/// strong against the strings its resonance lands some cents away
+/// (docs/articulations.md#pizzicato); the point-bow strings ring at their tuning and
+/// have no such row.
+pub const THERMAL_FREE_ROW: usize = TunedModel::COUNT;
+/// [`THERMAL_FREE_ROW`]'s name in the table's file.
+pub const THERMAL_FREE_NAME: &str = "thermal-free";
+/// Rows in the table: every [`TunedModel`], then [`THERMAL_FREE_ROW`].
+const ROWS: usize = TunedModel::COUNT + 1;
+
+/// Every row with its name in the file, in row order.
+fn rows() -> impl Iterator<Item = (usize, &'static str)> {
+    TunedModel::all()
+        .map(|m| (m.row(), m.name()))
+        .chain(std::iter::once((THERMAL_FREE_ROW, THERMAL_FREE_NAME)))
+}
 
 /// The expressions below full (1) the table holds corrections for: the dynamics at 0, a
 /// third and two thirds (CC11 0, 42 and 85).
@@ -175,7 +201,7 @@ fn soft_level(expression: f64) -> Option<usize> {
 impl IntonationTable {
     /// A table of zeros: every string tuned by its free decay, at every expression.
     pub fn zero() -> Self {
-        let n = TunedModel::COUNT * InstrumentKind::COUNT * STRINGS * SEMITONES;
+        let n = ROWS * InstrumentKind::COUNT * STRINGS * SEMITONES;
         Self {
             cents: vec![0.0; n],
             soft: vec![f64::NAN; n * SOFT_EXPRESSIONS.len()],
@@ -298,11 +324,7 @@ impl IntonationTable {
         semitones: f64,
         expression: f64,
     ) -> f64 {
-        if model >= TunedModel::COUNT
-            || string >= STRINGS
-            || !semitones.is_finite()
-            || !expression.is_finite()
-        {
+        if model >= ROWS || string >= STRINGS || !semitones.is_finite() || !expression.is_finite() {
             return 0.0;
         }
         let s = semitones.clamp(0.0, (SEMITONES - 1) as f64);
@@ -333,7 +355,7 @@ impl IntonationTable {
             if f.len() != columns {
                 return Err(bad());
             }
-            let model = TunedModel::from_name(f[0]).ok_or_else(bad)?.row();
+            let model = rows().find(|&(_, name)| name == f[0]).ok_or_else(bad)?.0;
             let kind = InstrumentKind::from_name(f[1]).ok_or_else(bad)?;
             let string: usize = f[2].parse().map_err(|_| bad())?;
             let semitone: usize = f[3].parse().map_err(|_| bad())?;
@@ -360,8 +382,7 @@ impl IntonationTable {
     /// every entry at full expression (1), then those it holds at soft expressions.
     pub fn to_csv(&self) -> String {
         let mut s = String::from("model,instrument,string,semitone,expression,cents\n");
-        for model in TunedModel::all() {
-            let (m, name) = (model.row(), model.name());
+        for (m, name) in rows() {
             for kind in InstrumentKind::ALL {
                 for string in 0..STRINGS {
                     for semitone in 0..SEMITONES {
@@ -375,8 +396,7 @@ impl IntonationTable {
             }
         }
         for (level, expression) in SOFT_EXPRESSIONS.iter().enumerate() {
-            for model in TunedModel::all() {
-                let (m, name) = (model.row(), model.name());
+            for (m, name) in rows() {
                 for kind in InstrumentKind::ALL {
                     for string in 0..STRINGS {
                         for semitone in 0..SEMITONES {
@@ -440,6 +460,7 @@ mod tests {
         t.set(2, InstrumentKind::Viola, 3, 17, -4.25);
         t.set(4, InstrumentKind::Cello, 0, 0, 12.5);
         t.set_soft(0, InstrumentKind::Cello, 2, 4, 1, 7.75);
+        t.set(THERMAL_FREE_ROW, InstrumentKind::DoubleBass, 1, 9, 8.5);
         assert_eq!(IntonationTable::parse(&t.to_csv()).unwrap(), t);
         // The table without the expression column is read at full expression.
         let old = "model,instrument,string,semitone,cents\nstatic,violin,1,3,2.5\n";

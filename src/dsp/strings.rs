@@ -76,6 +76,9 @@ pub trait StringBank {
     /// are weighted ([`FourStrings::set_string_weighting`]), kg/s: string `i` is bowed
     /// with the force times its `Z0` over this.
     const WEIGHT_REFERENCE_Z0: f64 = crate::dsp::vocabulary::WEIGHT_REFERENCE_Z0;
+    /// The intonation table's row that tunes a plucked or struck note's free ring
+    /// ([`Fingering::set_free_row`]); `None` where a string rings where it is tuned.
+    const FREE_PITCH_ROW: Option<usize> = None;
     /// The bow force in newtons is divided by this before it reaches the strings (1 for a
     /// point bow; the bow's width for a bow whose force is per metre).
     fn force_divisor(&self) -> f64 {
@@ -448,11 +451,13 @@ impl<B: StringBank> FourStrings<B> {
         intonation_row: usize,
     ) -> Self {
         let internal_rate_hz = bank.internal_rate_hz();
+        let mut fingering = Fingering::new(kind, Some(intonation_row));
+        fingering.set_free_row(B::FREE_PITCH_ROW);
         Self {
             bank,
             kind,
             hands: Hands {
-                fingering: Fingering::new(kind, Some(intonation_row)),
+                fingering,
                 bows: [BowEnvelope::default(); STRINGS],
                 expressive: [false; STRINGS],
                 weights: std::array::from_fn(|i| kind.string_weight_for(i, B::WEIGHT_REFERENCE_Z0)),

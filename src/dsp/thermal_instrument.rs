@@ -312,6 +312,7 @@ impl ThermalBank {
 impl StringBank for ThermalBank {
     type Settings = ThermalSettings;
     const WEIGHT_REFERENCE_Z0: f64 = THERMAL_WEIGHT_REFERENCE_Z0;
+    const FREE_PITCH_ROW: Option<usize> = Some(intonation::THERMAL_FREE_ROW);
 
     fn internal_rate_hz(&self) -> f64 {
         Self::internal_rate(self.kind, &self.wave_speeds, self.settings)
