@@ -128,7 +128,7 @@ enum Command {
     /// candidate constant sets on probe notes across the window; `scenes` times what
     /// skipping silent strings saves; `playing-space --out DIR` maps Helmholtz motion over
     /// the bowing window (see its options); `intonation --out FILE` measures the bowed
-    /// intonation table; `timbre --out DIR [--models ..] [--rates ..] [--instruments ..]`
+    /// intonation table (`--free`: the thermal strings' plucked rows); `timbre --out DIR [--models ..] [--rates ..] [--instruments ..]`
     /// compares each instrument's played notes with a real player's, band by band (default
     /// the hyperbolic law at 48 kHz; STK's Bowed on the same notes where libstk-dev is
     /// installed).
