@@ -397,59 +397,28 @@ pub fn fit_free(
         bar.finish_and_clear();
         measured
     };
-    let mut untuned = Vec::new();
-    for pass in 0..=passes.max(1) {
-        let measured = pluck_all(&table)?;
-        if pass == 0 {
-            untuned = measured.clone();
-        }
-        if pass == passes.max(1) {
-            let mut dropped = 0;
-            let mut last = Vec::new();
-            for ((e, now), before) in entries.iter().zip(&measured).zip(&untuned) {
-                if now.abs() <= before.abs() {
-                    last.push((e.kind, *now));
-                } else {
-                    table.set(THERMAL_FREE_ROW, e.kind, e.string, e.semitone, 0.0);
-                    dropped += 1;
-                    last.push((e.kind, *before));
-                }
-            }
-            let _ = writeln!(
-                report,
-                "{dropped} of {} corrections dropped (the note rang further from its pitch with it)",
-                entries.len()
-            );
-            for &kind in kinds {
-                let of_kind = || last.iter().filter(move |(k, _)| *k == kind);
-                let within = of_kind().filter(|(_, c)| c.abs() <= 5.0).count();
-                let before = entries
-                    .iter()
-                    .zip(&untuned)
-                    .filter(|(e, c)| e.kind == kind && c.abs() <= 5.0)
-                    .count();
-                let _ = writeln!(
-                    report,
-                    "the table: {kind:?}: {within} of {} notes ring within 5 cents ({before} with no correction)",
-                    of_kind().count()
-                );
-            }
-            break;
-        }
-        for &kind in kinds {
-            let of_kind: Vec<f64> = entries
+    // Notes within 5 cents per instrument, of those `values` reads.
+    let within = |kind: InstrumentKind, values: &[f64]| {
+        let of_kind = || {
+            entries
                 .iter()
-                .zip(&measured)
-                .filter(|(e, _)| e.kind == kind)
-                .map(|(_, c)| *c)
-                .collect();
-            let read = of_kind.iter().filter(|c| c.is_finite()).count();
-            let within = of_kind.iter().filter(|c| c.abs() <= 5.0).count();
+                .zip(values)
+                .filter(move |(e, _)| e.kind == kind)
+        };
+        (
+            of_kind().filter(|(_, c)| c.abs() <= 5.0).count(),
+            of_kind().count(),
+        )
+    };
+    let untuned = pluck_all(&table)?;
+    let mut measured = untuned.clone();
+    for pass in 0..passes.max(1) {
+        for &kind in kinds {
+            let (n, of) = within(kind, &measured);
             let _ = writeln!(
                 report,
-                "pass {} (plucked with the table of pass {pass}): {kind:?}: {within} of {} notes ring within 5 cents ({read} read)",
+                "pass {} (plucked with the table of pass {pass}): {kind:?}: {n} of {of} notes ring within 5 cents",
                 pass + 1,
-                of_kind.len()
             );
         }
         for (es, ms) in entries.chunks(per_string).zip(measured.chunks(per_string)) {
@@ -460,6 +429,28 @@ pub fn fit_free(
                 table.set(THERMAL_FREE_ROW, e.kind, e.string, e.semitone, old + r);
             }
         }
+        measured = pluck_all(&table)?;
+    }
+    // Drop the corrections that leave a note further from its pitch than none does.
+    let mut dropped = 0;
+    for ((e, now), before) in entries.iter().zip(measured.iter_mut()).zip(&untuned) {
+        if !(now.abs() <= before.abs()) {
+            table.set(THERMAL_FREE_ROW, e.kind, e.string, e.semitone, 0.0);
+            *now = *before;
+            dropped += 1;
+        }
+    }
+    let _ = writeln!(
+        report,
+        "{dropped} of {} corrections dropped (the note rang further from its pitch with it)",
+        entries.len()
+    );
+    for &kind in kinds {
+        let ((n, of), (before, _)) = (within(kind, &measured), within(kind, &untuned));
+        let _ = writeln!(
+            report,
+            "the table: {kind:?}: {n} of {of} notes ring within 5 cents ({before} with no correction)"
+        );
     }
     Ok((table, report))
 }
@@ -477,17 +468,9 @@ pub fn run(
     free: bool,
 ) -> Result<String, String> {
     if free {
+        // The shipped table with the fitted instruments' free-ring rows.
         let (table, report) = fit_free(kinds, rate_hz, passes)?;
-        let mut merged = colophony::dsp::intonation::shipped().clone();
-        for &kind in kinds {
-            for string in 0..STRINGS {
-                for s in 0..=MAX_STOP_SEMITONES as usize {
-                    let c = table.get(THERMAL_FREE_ROW, kind, string, s);
-                    merged.set(THERMAL_FREE_ROW, kind, string, s, c);
-                }
-            }
-        }
-        return write_table(out, &merged, rate_hz).map(|done| format!("{report}{done}"));
+        return write_table(out, &table, rate_hz).map(|done| format!("{report}{done}"));
     }
     let (table, report) = fit(models, kinds, rate_hz, passes, dynamics)?;
     // Models and instruments not fitted keep the shipped entries (and, without
