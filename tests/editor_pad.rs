@@ -394,6 +394,19 @@ fn the_schelleng_numbers_follow_the_note_the_audio_thread_reports() {
     assert_shows(&h, "C string");
 }
 
+/// Paper B's strings are weighted against their own reference (1 kg/s) and bowed with
+/// its friction coefficients (0.8 cold, 0.5 hot): cello D's `F_max` at 0.1 m/s and beta
+/// 0.1 is `2 x 0.506 x 0.1 / (0.1 x 0.3)` = 3.373 N on the string, bowed with 0.506 times
+/// the force parameter, so the window shows the parameter's 6.667 N.
+#[test]
+fn the_thermal_models_window_is_in_the_force_parameters_units() {
+    let mut f = fixture();
+    play_thermal(&f);
+    let h = harness(&mut f.editor);
+    assert_shows(&h, "0.506 kg/s");
+    assert_shows(&h, "6.667 N");
+}
+
 #[test]
 fn live_views_are_fed_only_while_an_open_editor_shows_them() {
     let mut f = fixture();

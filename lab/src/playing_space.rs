@@ -33,8 +33,9 @@
 //! [`SETTLE_S`]: the map then asks whether the cell's force *holds* Helmholtz motion
 //! (Schelleng's window is a stability limit). With `--attack performer`
 //! ([`Attack::Performer`]) the bow starts as the plugin's performer starts a separate
-//! note: from rest, up to the cell's speed over the stroke's ramp, with its accent. The
-//! measurement is the same.
+//! note: from rest, up to the cell's speed over the stroke's ramp, with its accent, and
+//! with the performer's catch where the cell's force lies lower in the window than the
+//! defaults ([`colophony::performer::catch`]). The measurement is the same.
 
 pub mod figure;
 
@@ -54,6 +55,7 @@ use colophony::dsp::vocabulary::{
 use colophony::measure::contact::ContactSample;
 use colophony::measure::regime::{classify_regime, Regime};
 use colophony::measure::window::SchellengWindow;
+use colophony::performer::catch::{catches, Catch};
 use colophony::performer::stroke::{Stroke, StrokeMode};
 use colophony::performer::{DYNAMICS_DRIFT_EXPONENT, DYNAMICS_RANGE_DB};
 use colophony::quality::{Quality, GOOD_NODES};
@@ -84,13 +86,8 @@ pub use colophony::dsp::intonation::TunedModel as Model;
 /// Static and sliding friction coefficients of `model`: 0.4 / 0.2 for paper A's laws, the
 /// thermal law's cool and hot ends for paper B's.
 pub fn friction_coefficients(model: Model) -> (f64, f64) {
-    match model {
-        Model::Point(_) => (0.4, 0.2),
-        Model::Thermal => {
-            let p = ThermalParams::default();
-            (p.mu_cold, p.mu_hot)
-        }
-    }
+    let (_, mu_s, mu_d) = Catch::model_window(model == Model::Thermal);
+    (mu_s, mu_d)
 }
 
 /// How a cell bows its note.
@@ -186,8 +183,9 @@ pub enum Attack {
     Catch,
     /// The performer's own attack for a separate down-bow note of velocity
     /// [`PERFORMER_VELOCITY`] ([`Stroke`]): the bow starts from rest and reaches the
-    /// cell's speed over the stroke's ramp, with its landing accent on the force; what the
-    /// plugin plays when a note lands.
+    /// cell's speed over the stroke's ramp, with its landing accent on the force and the
+    /// performer's catch ([`Catch`]) where the cell's force is light; what the plugin
+    /// plays when a note lands.
     Performer,
 }
 
@@ -403,8 +401,10 @@ fn play(cell: &Cell, engine: &mut impl Engine) -> (Vec<f64>, Vec<ContactSample>)
 /// The bow of a cell sample by sample ([`Attack`]).
 struct Catcher {
     bow: BowControl,
-    /// [`Attack::Performer`]'s stroke, ticked once a sample.
+    /// [`Attack::Performer`]'s stroke, ticked once a sample, and its catch
+    /// ([`colophony::performer::catch`]) while it presses.
     stroke: Option<Stroke>,
+    performer_catch: Option<Catch>,
     /// The catching force, N (0: no catch).
     catch: f64,
     /// The note's period, host samples.
@@ -431,9 +431,22 @@ impl Catcher {
             stroke
         });
         let period = cell.rate_hz / cell.nominal_hz();
+        // The performer catches a note of velocity above mezzo on the cell's own window.
+        let bow = cell.bow;
+        let velocity = PERFORMER_VELOCITY as f64 / 127.0;
+        let performer_catch = stroke.as_ref().filter(|_| catches(velocity)).and_then(|_| {
+            let (reference, mu_s, mu_d) = Catch::model_window(cell.model == Model::Thermal);
+            Catch::new(
+                cell.f_max_n * bow.position_beta / bow.velocity_m_per_s.abs(),
+                Catch::engage_ratio(reference, mu_s, mu_d),
+                cell.nominal_hz(),
+                cell.rate_hz,
+            )
+        });
         Self {
             bow: cell.bow,
             stroke,
+            performer_catch,
             catch,
             period,
             rate_hz: cell.rate_hz,
@@ -454,9 +467,17 @@ impl Catcher {
     fn bow(&mut self, i: usize) -> BowControl {
         if let Some(stroke) = &mut self.stroke {
             let (speed, force) = stroke.tick();
+            let mut force_n = self.bow.force_n * force;
+            if let Some(catch) = &mut self.performer_catch {
+                let bow = self.bow;
+                match catch.force(bow.force_n, bow.velocity_m_per_s, bow.position_beta) {
+                    Some(f) => force_n = force_n.max(f),
+                    None => self.performer_catch = None,
+                }
+            }
             return BowControl {
                 velocity_m_per_s: self.bow.velocity_m_per_s * speed,
-                force_n: self.bow.force_n * force,
+                force_n,
                 ..self.bow
             };
         }
@@ -481,6 +502,9 @@ impl Catcher {
     /// about the probe's last [`CATCH_PERIODS`] and a half periods; Helmholtz motion there
     /// is caught, and the force starts to fall at the next sample.
     fn observe(&mut self, probe: &[ContactSample]) {
+        if let (Some(catch), Some(last)) = (&mut self.performer_catch, probe.last()) {
+            catch.observe(last);
+        }
         if self.catch <= self.bow.force_n
             || self.fall_from.is_some()
             || probe.len() < self.next_check

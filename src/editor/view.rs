@@ -168,19 +168,16 @@ impl EditorUi {
         let kind: InstrumentKind = self.params.instrument.value().into();
         let beta = self.params.bow_position.value() as f64;
         let string = self.window_string(kind, self.window_note(kind));
-        let window = SchellengWindow::for_string(kind, string, beta);
+        let mut window = SchellengWindow::for_string(kind, string, beta);
         // Paper B's bow: its friction coefficient runs from mu(T) cold to hot (the
         // playing-space map uses the same window).
         if self.params.friction_model.value() == FrictionChoice::Thermal {
             let p = crate::dsp::thermal::ThermalParams::default();
-            return Some(SchellengWindow {
-                mu_s: p.mu_cold,
-                mu_d: p.mu_hot,
-                ..window
-            });
+            window.mu_s = p.mu_cold;
+            window.mu_d = p.mu_hot;
         }
         // Weighted strings: the window in the force parameter's units (the string is
-        // bowed with the parameter times its weight).
+        // bowed with the parameter times its weight, against each model's reference).
         Some(window.seen_through_weight(self.string_weight(kind, string)))
     }
 

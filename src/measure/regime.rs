@@ -1,9 +1,10 @@
-//! The regime the string is in, read from the live contact samples (GUI thread only).
+//! The regime the string is in, read from the live contact samples.
 //!
 //! Schelleng's diagram names what a bowed string does at a given force and velocity;
 //! [`classify_regime`] names what the simulation actually does, from the samples the editor
 //! already copies out of the [`crate::editor::live::Scope`] ring, so the side panel can show it
-//! beside the regime the Schelleng window predicts. Nothing is computed on the audio thread.
+//! beside the regime the Schelleng window predicts. [`SlipWatch`] reads slips the same way
+//! one sample at a time, for the performer's attack on the audio thread.
 //!
 //! **How.** A sample slips where the string moves away from the bow:
 //! `|v_s - v_b| > SLIP_FRACTION_OF_BOW * |v_b|`. A slip starts where a sticking sample is
@@ -205,6 +206,93 @@ pub fn helmholtz_since(samples: &[ContactSample], sample_rate: f32, f0_hz: f32) 
 fn span_tolerance(period: f32, sample_rate: f32) -> f32 {
     let model_sample = (sample_rate / INTERNAL_RATE_HZ as f32).max(1.0);
     (PERIOD_JITTER * period).max(2.0 * model_sample)
+}
+
+/// The slips of a string read as they happen, one contact sample at a time, by the rules
+/// of [`slip_onsets`] and [`classify_regime`]: a slip starts where a sticking sample is
+/// followed by a slipping one and counts once its run reaches [`SLIP_PEAK_OF_BOW`] times
+/// the bow velocity; the string is in Helmholtz motion once the last [`HELMHOLTZ_SPANS`]
+/// spans between slips each lie within [`span_tolerance`] of their median and that median
+/// within [`PERIOD_RANGE`] of the note's period. No allocation: what the performer's
+/// attack listens to on the audio thread (`crate::performer::catch`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SlipWatch {
+    /// The note's period, samples.
+    period: f32,
+    sample_rate: f32,
+    /// Samples seen.
+    now: u32,
+    /// Whether the last sample slipped, and whether its run has counted as a slip.
+    slipping: bool,
+    counted: bool,
+    /// Where the run under way began.
+    run_start: u32,
+    /// The last slip onsets, oldest first, `seen` of them valid (at most the array's).
+    onsets: [u32; HELMHOLTZ_SPANS + 1],
+    seen: usize,
+}
+
+/// Spans between slips [`SlipWatch`] must see agree before it calls the motion Helmholtz:
+/// four, as the playing-space map's catch asks of the classifier (four and a half periods).
+pub const HELMHOLTZ_SPANS: usize = 4;
+
+impl SlipWatch {
+    /// A watch for a note of fundamental `f0_hz` sampled at `sample_rate` Hz (both finite
+    /// and positive; otherwise it never reports Helmholtz motion).
+    pub fn new(sample_rate: f32, f0_hz: f32) -> Self {
+        let period = if sample_rate > 0.0 && f0_hz > 0.0 {
+            sample_rate / f0_hz
+        } else {
+            f32::NAN
+        };
+        Self {
+            period,
+            sample_rate,
+            now: 0,
+            slipping: false,
+            counted: false,
+            run_start: 0,
+            onsets: [0; HELMHOLTZ_SPANS + 1],
+            seen: 0,
+        }
+    }
+
+    /// Reads one contact sample; `true` while the motion is Helmholtz's (see the type).
+    pub fn observe(&mut self, s: &ContactSample) -> bool {
+        let slipping = is_slipping(s, SLIP_FRACTION_OF_BOW);
+        if slipping && !self.slipping {
+            self.run_start = self.now;
+            self.counted = false;
+        }
+        self.slipping = slipping;
+        let mut helmholtz = false;
+        if slipping && !self.counted && is_slipping(s, SLIP_PEAK_OF_BOW) {
+            self.counted = true;
+            if self.seen == self.onsets.len() {
+                self.onsets.copy_within(1.., 0);
+                self.seen -= 1;
+            }
+            self.onsets[self.seen] = self.run_start;
+            self.seen += 1;
+            helmholtz = self.seen == self.onsets.len() && self.spans_agree();
+        }
+        self.now = self.now.saturating_add(1);
+        helmholtz
+    }
+
+    /// Whether the held onsets' spans agree with each other and with the note's period.
+    fn spans_agree(&self) -> bool {
+        let mut spans = [0.0f32; HELMHOLTZ_SPANS];
+        for (k, span) in spans.iter_mut().enumerate() {
+            *span = (self.onsets[k + 1] - self.onsets[k]) as f32;
+        }
+        let mut sorted = spans;
+        sorted.sort_by(f32::total_cmp);
+        let median = sorted[sorted.len() / 2];
+        let tolerance = span_tolerance(median, self.sample_rate);
+        (self.period / PERIOD_RANGE..=self.period * PERIOD_RANGE).contains(&median)
+            && spans.iter().all(|s| (s - median).abs() <= tolerance)
+    }
 }
 
 /// Whether every onset is followed `n` onsets later by one a period later (see the module

@@ -229,7 +229,7 @@ impl Performer {
         } else {
             (1.0, 1.0)
         };
-        let out = if velocity_scale == 1.0 && speed == 1.0 && landing == 1.0 && away == 1.0 {
+        let mut out = if velocity_scale == 1.0 && speed == 1.0 && landing == 1.0 && away == 1.0 {
             bow
         } else {
             BowControl {
@@ -238,6 +238,17 @@ impl Performer {
                 position_beta: (bow.position_beta * away).clamp(MIN_NOTE_BETA, MAX_NOTE_BETA),
             }
         };
+        if let Some(catch) = &mut self.catch {
+            let asked = bow.force_n * force_scale;
+            match catch.force(
+                asked,
+                bow.velocity_m_per_s * velocity_scale,
+                out.position_beta,
+            ) {
+                Some(f) => out.force_n = out.force_n.max(f),
+                None => self.catch = None,
+            }
+        }
         // Steady from here on until a controller, a pressure or a note: the next samples
         // only multiply (the same bits: `speed` is +-1, so the order of the products does
         // not round differently).
@@ -246,7 +257,8 @@ impl Performer {
             && g.vibrato_now == 0.0
             && g.bow_scale == g.target
             && self.direct.is_idle()
-            && self.stroke.is_settled();
+            && self.stroke.is_settled()
+            && self.catch.is_none();
         self.steady = steady.then_some((velocity_scale * speed, force_scale, away));
         // The intonation follows the guard's bow (the table is fitted with it); without
         // the guard it stays at full expression's. Looked at only when that bow's scale

@@ -34,6 +34,7 @@
 
 pub mod articulation;
 mod block;
+pub mod catch;
 pub mod direct;
 mod gesture;
 mod midi;
@@ -134,6 +135,8 @@ pub struct Performer {
     setup: Setup,
     gesture: Gesture,
     stroke: Stroke,
+    /// The attack's catch while it presses the string into Helmholtz motion ([`catch`]).
+    catch: Option<catch::Catch>,
     /// The bow controls MIDI controllers hold (CC21-23).
     direct: DirectBow,
     /// Bridges the player chose for the thermal instrument of each kind.
@@ -182,6 +185,7 @@ impl Performer {
             },
             gesture: Gesture::new(48_000.0),
             stroke: Stroke::new(48_000.0),
+            catch: None,
             direct: DirectBow::new(48_000.0),
             user_bridges: Default::default(),
             others_awake: false,

@@ -24,6 +24,7 @@ impl Performer {
             && g.vibrato_now == 0.0
             && g.bow_scale == g.target
             && self.stroke.is_settled()
+            && self.catch.is_none()
             && self.direct.is_settled();
         let steps = if at_rest { n.min(1) } else { n };
         for _ in 0..steps {
@@ -70,6 +71,7 @@ impl Performer {
         self.bow_now = bow;
         let mut frame = self.instrument.tick(bow);
         if !self.others_awake {
+            self.listen(&frame, &bow);
             return frame;
         }
         for (k, engine) in self.thermal.iter_mut().enumerate() {
@@ -85,7 +87,16 @@ impl Performer {
         if self.rubbed.is_sounding() {
             frame.audio += self.rubbed.tick(&bow);
         }
+        self.listen(&frame, &bow);
         frame
+    }
+
+    /// The attack's catch hears the string just played ([`catch`]).
+    #[inline]
+    fn listen(&mut self, frame: &Frame, bow: &BowControl) {
+        if let Some(catch) = &mut self.catch {
+            catch.observe(&crate::measure::contact::ContactSample::new(frame, bow));
+        }
     }
 
     /// The bow as played while the gesture is steady (see [`Performer::shape`]): the

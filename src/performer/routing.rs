@@ -59,7 +59,36 @@ impl Performer {
             self.stroke.set_spiccato(spiccato, velocity);
             self.stroke
                 .set_sautille(self.sautille_stroke().map(|s| (s, velocity)));
+            self.catch = self.catch_for(note, velocity);
         }
+    }
+
+    /// The attack's catch for a separate note `note` of velocity `velocity` (a
+    /// [`stroke::velocity_step`]): above mezzo, bowed arco on the strings (waveguide or
+    /// thermal), on the string the note took ([`catch`]).
+    fn catch_for(&self, note: u8, velocity: f64) -> Option<catch::Catch> {
+        if !catch::catches(velocity) || self.articulation() != Articulation::Arco {
+            return None;
+        }
+        let kind = self.setup.instrument;
+        let string = self.notes[note as usize & 127].string? as usize;
+        let z0 = kind.strings().get(string)?.z0_kg_per_s;
+        let (reference, mu_s, mu_d) = match self.source {
+            Source::Strings => catch::Catch::model_window(false),
+            Source::Thermal(_) => catch::Catch::model_window(true),
+            Source::Rubbed(_) => return None,
+        };
+        let weight = if self.setup.string_weight {
+            kind.string_weight_for(string, reference)
+        } else {
+            1.0
+        };
+        catch::Catch::new(
+            catch::Catch::window_of(z0, weight, mu_s, mu_d),
+            catch::Catch::engage_ratio(reference, mu_s, mu_d),
+            midi_to_hz(note as f64),
+            self.sample_rate_hz,
+        )
     }
 
     /// The note reaches the source (no new stroke); with `glide` (seconds), the strings

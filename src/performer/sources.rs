@@ -68,6 +68,7 @@ impl Performer {
         self.tail = None;
         self.gesture = Gesture::new(fs);
         self.stroke = Stroke::new(fs);
+        self.catch = None;
         self.direct = DirectBow::new(fs);
         self.steady = None;
         self.configured = false;

@@ -25,6 +25,8 @@
 //! at 48 and 192 kHz) no pair settles in under about 50 ms, and the settling time jumps
 //! between neighbouring pairs: the diagram has no clean region to aim at here, so the
 //! velocity maps to the acceleration by feel, harder is faster (docs/playing-space.md).
+//! Above mezzo a bow asked lighter than the defaults sit in Schelleng's window also
+//! catches the string first ([`super::catch`]).
 //!
 //! ```
 //! use colophony::performer::stroke::{Stroke, StrokeMode};

@@ -1,0 +1,256 @@
+//! The catch: a separate note asked for in the lower half of Schelleng's window lands
+//! pressed into its upper half until the string is caught in Helmholtz motion, then eases
+//! to the asked force.
+//!
+//! **Why.** Below the window's middle Helmholtz motion is stable once it is there, but an
+//! attack rarely finds it: the string falls into double or irregular slipping, which the
+//! light force holds as well. On the playing-space map (docs/playing-space.md), bowed at
+//! `F_max / 2` until the slips come once a period and then lowered, two thirds to three
+//! quarters of the point laws' `2 F_min` cells keep one slip a period, where a landing at
+//! those forces finds it in none. A player does the same: the bow bites the string at the
+//! start of a note and the arm then lightens it (the pre-pressure of a forte attack,
+//! Guettler and Askenfelt's attacks, literature-values.md §1.6).
+//!
+//! **What.** For a separate note of velocity above mezzo (where the landing accent starts,
+//! [`super::stroke`]) whose asked force sits lower in the window (against `F_max` at the
+//! asked bow speed and position) than [`CATCH_BELOW_DEFAULTS`] of where the model's
+//! defaults sit, the force is raised to [`CATCH_LEVEL`] of `F_max`
+//! and held there until [`SlipWatch`] hears [`crate::measure::regime::HELMHOLTZ_SPANS`]
+//! spans of one slip a period (or for [`CATCH_HOLD_MAX_S`] at most), then falls
+//! geometrically to the asked force over [`CATCH_FALL_S`]. The window is the one the
+//! editor draws, in the force parameter's units: `F_max = 2 Z v_b / (beta (mu_s - mu_d))`
+//! with the string's `Z0` (over its String Weight when that is on) and the model's
+//! friction coefficients. At the defaults nothing changes. Helmholtz motion's amplitude is
+//! `v_b / beta`, whatever the force, so the catch brightens the attack and does not make
+//! it louder.
+
+use crate::measure::contact::ContactSample;
+use crate::measure::regime::SlipWatch;
+
+/// Whether a separate note of velocity `velocity` (0..=1, a
+/// [`super::stroke::velocity_step`]) is caught: above mezzo, where the landing accent
+/// starts.
+pub fn catches(velocity: f64) -> bool {
+    velocity > 64.0 / 127.0
+}
+
+/// The force the catch presses with, a fraction of the window's `F_max`: the map's catch.
+pub const CATCH_LEVEL: f64 = 0.5;
+/// A note is caught where its asked force lies lower in the window than this share of
+/// where the model's defaults sit (the default bow with String Weight on: `F_max / 2` for
+/// paper A's laws, `F_max / 6.7` for paper B's, [`Catch::engage_ratio`]): the defaults
+/// themselves are not caught, and a caught note gets at least 11 % more force than asked.
+pub const CATCH_BELOW_DEFAULTS: f64 = 0.9;
+/// The longest the catching force is held, s (the map's).
+pub const CATCH_HOLD_MAX_S: f64 = 0.24;
+/// How long the force takes to fall to the asked one once caught, s (the map's).
+pub const CATCH_FALL_S: f64 = 0.06;
+
+/// A catch in progress (see the module documentation).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Catch {
+    /// `F_max` per unit of `|v_b| / beta`: `2 Z / (mu_s - mu_d)`, kg/s.
+    window_kg_per_s: f64,
+    /// The asked force over `F_max` below which the note is caught.
+    engage_ratio: f64,
+    watch: SlipWatch,
+    /// Samples of holding left; once 0 the force falls.
+    hold_left: u32,
+    /// How far the fall has gone (0..=1), and its step per sample.
+    fall: f64,
+    fall_step: f64,
+    /// Whether the first bow has been looked at (a note already near the window's top is
+    /// not caught at all).
+    engaged: bool,
+}
+
+impl Catch {
+    /// A catch for a note of fundamental `f0_hz` at `sample_rate_hz` on a string whose
+    /// window has `F_max = window_kg_per_s |v_b| / beta`, engaged below `engage_ratio`
+    /// of `F_max`; `None` for values that are not finite and positive.
+    pub fn new(
+        window_kg_per_s: f64,
+        engage_ratio: f64,
+        f0_hz: f64,
+        sample_rate_hz: f64,
+    ) -> Option<Self> {
+        let usable = |x: f64| x.is_finite() && x > 0.0;
+        if !(usable(window_kg_per_s)
+            && usable(engage_ratio)
+            && usable(f0_hz)
+            && usable(sample_rate_hz))
+        {
+            return None;
+        }
+        Some(Self {
+            window_kg_per_s,
+            engage_ratio,
+            watch: SlipWatch::new(sample_rate_hz as f32, f0_hz as f32),
+            hold_left: (CATCH_HOLD_MAX_S * sample_rate_hz).round() as u32,
+            fall: 0.0,
+            fall_step: 1.0 / (CATCH_FALL_S * sample_rate_hz).max(1.0),
+            engaged: false,
+        })
+    }
+
+    /// The window of string `z0_kg_per_s` bowed with `weight` times the force parameter,
+    /// with friction coefficients `mu_s` and `mu_d`: `2 (Z0 / weight) / (mu_s - mu_d)`.
+    pub fn window_of(z0_kg_per_s: f64, weight: f64, mu_s: f64, mu_d: f64) -> f64 {
+        2.0 * z0_kg_per_s / weight / (mu_s - mu_d)
+    }
+
+    /// The String Weight reference and friction coefficients (`mu_s`, `mu_d`) of the
+    /// window of paper B's thermal model (`thermal`) or of paper A's laws: what the editor
+    /// draws and the playing-space map measures against.
+    pub fn model_window(thermal: bool) -> (f64, f64, f64) {
+        if thermal {
+            let p = crate::dsp::thermal::ThermalParams::default();
+            (
+                crate::dsp::thermal_instrument::THERMAL_WEIGHT_REFERENCE_Z0,
+                p.mu_cold,
+                p.mu_hot,
+            )
+        } else {
+            (
+                crate::dsp::vocabulary::WEIGHT_REFERENCE_Z0,
+                crate::measure::window::MU_S,
+                crate::measure::window::MU_D,
+            )
+        }
+    }
+
+    /// Where the default bow sits in the window of a model whose strings are weighted
+    /// against `reference_z0` with friction coefficients `mu_s` and `mu_d`, as a share of
+    /// `F_max` (the same on every string: both scale with `Z0`), times
+    /// [`CATCH_BELOW_DEFAULTS`]: the `engage_ratio` of [`Catch::new`].
+    pub fn engage_ratio(reference_z0: f64, mu_s: f64, mu_d: f64) -> f64 {
+        let bow = crate::dsp::vocabulary::BowControl::default();
+        let f_max = Self::window_of(reference_z0, 1.0, mu_s, mu_d) * bow.velocity_m_per_s.abs()
+            / bow.position_beta;
+        CATCH_BELOW_DEFAULTS * bow.force_n / f_max
+    }
+
+    /// The force to play this sample for an asked force `force_n` with the bow at
+    /// `speed_m_per_s` and `beta` (the asked bow, not its attack's ramp), or `None` once
+    /// the catch is over (then it stays over).
+    #[inline]
+    pub fn force(&mut self, force_n: f64, speed_m_per_s: f64, beta: f64) -> Option<f64> {
+        let top = CATCH_LEVEL * self.window_kg_per_s * speed_m_per_s.abs() / beta;
+        if !self.engaged {
+            self.engaged = true;
+            if !(top.is_finite() && force_n < self.engage_ratio / CATCH_LEVEL * top) {
+                self.hold_left = 0;
+                self.fall = 1.0;
+                return None;
+            }
+        }
+        if self.hold_left > 0 {
+            self.hold_left -= 1;
+            return Some(top.max(force_n));
+        }
+        self.fall += self.fall_step;
+        if self.fall >= 1.0 || !(top > force_n && force_n > 0.0) {
+            return None;
+        }
+        Some(top * (force_n / top).powf(self.fall))
+    }
+
+    /// Listens to the string (the contact probe of the sample just played, with the bow
+    /// that played it): once the slips come once a period the hold ends.
+    #[inline]
+    pub fn observe(&mut self, contact: &ContactSample) {
+        if self.hold_left > 0 && self.watch.observe(contact) {
+            self.hold_left = 0;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const FS: f64 = 48_000.0;
+
+    /// A contact sample of a bow at 0.1 m/s: sticking, or slipping at `v` m/s.
+    fn sample(v: Option<f64>) -> ContactSample {
+        let s = v.unwrap_or(0.1) as f32;
+        ContactSample {
+            string_velocity: s,
+            relative_velocity: s - 0.1,
+            mu: 0.3,
+        }
+    }
+
+    /// A window of `F_max` 5 N at 0.1 m/s and beta 0.1 (cello D3's), paper A's laws.
+    fn catch() -> Catch {
+        Catch::new(5.0, Catch::engage_ratio(0.2, 0.4, 0.2), 146.83, FS).unwrap()
+    }
+
+    /// The defaults sit at `F_max / 2` of paper A's laws (String Weight against 0.2
+    /// kg/s, `mu_s - mu_d` 0.2) and at `F_max / 6.7` of paper B's (1 kg/s, 0.3).
+    #[test]
+    fn the_defaults_sit_where_the_models_weighting_puts_them() {
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-12;
+        assert!(close(Catch::engage_ratio(0.2, 0.4, 0.2), 0.9 * 0.5));
+        assert!(close(Catch::engage_ratio(1.0, 0.8, 0.5), 0.9 * 0.15));
+    }
+
+    #[test]
+    fn a_note_near_the_windows_top_is_not_caught() {
+        let mut c = catch();
+        assert_eq!(c.force(0.46 * 5.0, 0.1, 0.1), None);
+        assert_eq!(c.force(0.1, 0.1, 0.1), None, "once over, it stays over");
+    }
+
+    /// A light note is pressed at `F_max / 2` until one slip a period has repeated four
+    /// times, then falls to the asked force in [`CATCH_FALL_S`], never below it.
+    #[test]
+    fn a_light_note_is_held_at_half_the_windows_top_until_helmholtz_motion_then_eased() {
+        let mut c = catch();
+        let period = (FS / 146.83).round() as usize;
+        let mut forces = Vec::new();
+        // Slips a period apart, each of a tenth of the period: the fifth (four spans)
+        // begins at sample 4 periods.
+        for i in 0..=4 * period {
+            forces.push(c.force(0.2, 0.1, 0.1).unwrap());
+            let slipping = i % period < period / 10;
+            c.observe(&sample(slipping.then_some(-0.9)));
+        }
+        assert!(forces.iter().all(|&f| f == 2.5), "held at F_max / 2");
+        let fall = (CATCH_FALL_S * FS) as usize;
+        let rest: Vec<f64> = (0..2 * fall)
+            .map_while(|_| c.force(0.2, 0.1, 0.1))
+            .collect();
+        assert!(
+            rest.len() + 1 >= fall && rest.len() <= fall,
+            "{}",
+            rest.len()
+        );
+        assert!(rest.windows(2).all(|w| w[1] < w[0] && w[1] > 0.2));
+    }
+
+    /// A string that never settles is let go after [`CATCH_HOLD_MAX_S`].
+    #[test]
+    fn a_string_that_never_settles_is_let_go_after_the_longest_hold() {
+        let mut c = catch();
+        let period = (FS / 146.83).round() as usize;
+        let hold = (CATCH_HOLD_MAX_S * FS) as usize;
+        for i in 0..hold {
+            assert_eq!(c.force(0.2, 0.1, 0.1), Some(2.5), "sample {i}");
+            // Two slips a period.
+            let slipping = i % (period / 2) < period / 20;
+            c.observe(&sample(slipping.then_some(-0.9)));
+        }
+        assert!(c.force(0.2, 0.1, 0.1).unwrap() < 2.5);
+    }
+
+    #[test]
+    fn bad_values_make_no_catch() {
+        assert!(Catch::new(f64::NAN, 0.45, 100.0, FS).is_none());
+        assert!(Catch::new(5.0, 0.45, 0.0, FS).is_none());
+        assert!(Catch::new(5.0, 0.45, 100.0, -1.0).is_none());
+        assert!(Catch::new(5.0, f64::INFINITY, 100.0, FS).is_none());
+        let mut c = catch();
+        assert_eq!(c.force(0.2, 0.1, 0.0), None, "beta 0: no window to aim at");
+    }
+}
