@@ -53,7 +53,7 @@ use colophony::dsp::vocabulary::{
     midi_to_hz, BowControl, InstrumentKind, MAX_NOTE_BETA, MIN_NOTE_BETA, STRINGS,
 };
 use colophony::measure::contact::ContactSample;
-use colophony::measure::regime::{classify_regime, Regime};
+use colophony::measure::regime::{classify_regime, helmholtz_since, Regime};
 use colophony::measure::window::SchellengWindow;
 use colophony::performer::catch::{catches, Catch};
 use colophony::performer::stroke::{Stroke, StrokeMode};
@@ -339,6 +339,9 @@ pub struct Measured {
     pub helmholtz: bool,
     /// Peak output sample (the plugin's scale).
     pub peak: f64,
+    /// When the note spoke, ms from its start: the first slip of the one-slip-a-period
+    /// motion that lasts to the cell's end ([`helmholtz_since`]), `None` if it never does.
+    pub speaks_ms: Option<f64>,
 }
 
 /// Renders `cell` through the engine the plugin plays and returns (audio, probe), both at
@@ -542,6 +545,7 @@ pub fn measure(cell: &Cell) -> Result<Measured, String> {
     let helmholtz = regime == Some(Regime::Helmholtz)
         && (stats.slip_fraction - beta).abs() <= SLIP_FRACTION_TOLERANCE * beta
         && (stats.stick_velocity_m_per_s - v_b).abs() <= STICK_TOLERANCE * v_b.abs();
+    let speaks_ms = helmholtz_since(&probe, fs as f32, f0 as f32).map(|k| k as f64 / fs * 1e3);
     Ok(Measured {
         regime: if peak > 0.0 { regime } else { None },
         slips_per_period: stats.slips_per_period,
@@ -550,6 +554,7 @@ pub fn measure(cell: &Cell) -> Result<Measured, String> {
         cents: cents(bowed, f0),
         helmholtz,
         peak,
+        speaks_ms,
     })
 }
 
@@ -730,12 +735,17 @@ pub struct Shares {
     pub window_helmholtz: usize,
     /// Nominal cells' median bowed pitch, cents (Helmholtz cells only).
     pub nominal_median_cents: f64,
+    /// When the window cells in Helmholtz motion spoke ([`Measured::speaks_ms`]), ms:
+    /// the 90th percentile and the latest (NaN if none is).
+    pub speaks_p90_ms: f64,
+    pub speaks_worst_ms: f64,
 }
 
 impl Shares {
     pub fn of(results: &[(Cell, Measured)], model: Model, rate_hz: f64) -> Self {
         let mut s = Shares::default();
         let mut nominal_cents = Vec::new();
+        let mut speaks = Vec::new();
         for (c, m) in results
             .iter()
             .filter(|(c, _)| c.model == model && c.rate_hz == rate_hz)
@@ -752,6 +762,9 @@ impl Shares {
                 s.window_cells += 1;
                 if m.helmholtz {
                     s.window_helmholtz += 1;
+                    // A cell in Helmholtz motion whose run began after the cell's end is
+                    // impossible; one the watch could not time counts as the latest.
+                    speaks.push(m.speaks_ms.unwrap_or(f64::INFINITY));
                     if m.cents.abs() <= WINDOW_CENTS {
                         s.window_in_tune += 1;
                     }
@@ -763,6 +776,12 @@ impl Shares {
             .get(nominal_cents.len() / 2)
             .copied()
             .unwrap_or(f64::NAN);
+        speaks.sort_by(f64::total_cmp);
+        s.speaks_p90_ms = speaks
+            .get((speaks.len() * 9).div_ceil(10).saturating_sub(1))
+            .copied()
+            .unwrap_or(f64::NAN);
+        s.speaks_worst_ms = speaks.last().copied().unwrap_or(f64::NAN);
         s
     }
 }
@@ -774,12 +793,12 @@ fn percent(part: usize, whole: usize) -> f64 {
 /// The CSV of every cell.
 pub fn csv(results: &[(Cell, Measured)]) -> String {
     let mut s = String::from(
-        "model,instrument,note,rate_hz,bowing,velocity_m_per_s,force_n,beta,f_min_n,f_max_n,regime,slips_per_period,slip_fraction,stick_velocity_m_per_s,cents,helmholtz,peak,attack\n",
+        "model,instrument,note,rate_hz,bowing,velocity_m_per_s,force_n,beta,f_min_n,f_max_n,regime,slips_per_period,slip_fraction,stick_velocity_m_per_s,cents,helmholtz,peak,attack,speaks_ms\n",
     );
     for (c, m) in results {
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{:.4},{:.5},{},{:.5},{:.5},{},{:.3},{:.4},{:.4},{:.2},{},{:.4},{}",
+            "{},{},{},{},{},{:.4},{:.5},{},{:.5},{:.5},{},{:.3},{:.4},{:.4},{:.2},{},{:.4},{},{}",
             c.model.name(),
             c.kind.name(),
             c.note,
@@ -797,7 +816,8 @@ pub fn csv(results: &[(Cell, Measured)]) -> String {
             m.cents,
             m.helmholtz,
             m.peak,
-            c.attack.name()
+            c.attack.name(),
+            m.speaks_ms.map_or(String::new(), |t| format!("{t:.1}"))
         );
     }
     s
@@ -817,14 +837,14 @@ pub fn regime_name(r: Option<Regime>) -> String {
 /// The summary table (markdown): per model and rate, the shares.
 pub fn summary(plan: &Plan, results: &[(Cell, Measured)]) -> String {
     let mut s = String::from(
-        "| model | rate (kHz) | nominal in tune (±3 c) | nominal median (c) | window in tune (±10 c) | window Helmholtz |\n|---|---|---|---|---|---|\n",
+        "| model | rate (kHz) | nominal in tune (±3 c) | nominal median (c) | window in tune (±10 c) | window Helmholtz | spoke by (ms): p90, latest |\n|---|---|---|---|---|---|---|\n",
     );
     for &model in &plan.models {
         for &rate in &plan.rates_hz {
             let sh = Shares::of(results, model, rate);
             let _ = writeln!(
                 s,
-                "| {} | {} | {:.0} % ({}/{}) | {} | {:.0} % ({}/{}) | {:.0} % ({}/{}) |",
+                "| {} | {} | {:.0} % ({}/{}) | {} | {:.0} % ({}/{}) | {:.0} % ({}/{}) | {:.0}, {:.0} |",
                 model.name(),
                 rate / 1000.0,
                 percent(sh.nominal_in_tune, sh.nominal_cells),
@@ -842,6 +862,8 @@ pub fn summary(plan: &Plan, results: &[(Cell, Measured)]) -> String {
                 percent(sh.window_helmholtz, sh.window_cells),
                 sh.window_helmholtz,
                 sh.window_cells,
+                sh.speaks_p90_ms,
+                sh.speaks_worst_ms,
             );
         }
     }
