@@ -14,7 +14,7 @@
 //! **What.** For a separate note of velocity above mezzo (where the landing accent starts,
 //! [`super::stroke`]) whose asked force sits lower in the window (against `F_max` at the
 //! asked bow speed and position) than [`CATCH_BELOW_DEFAULTS`] of where the model's
-//! defaults sit, the force is raised to [`CATCH_LEVEL`] of `F_max`
+//! defaults sit, the force is raised to [`CATCH_LEVEL`] of `F_max` (at most the force parameter's top)
 //! and held there until [`SlipWatch`] hears [`crate::measure::regime::HELMHOLTZ_SPANS`]
 //! spans of one slip a period (or for [`CATCH_HOLD_MAX_S`] at most), then falls
 //! geometrically to the asked force over [`CATCH_FALL_S`]. The window is the one the
@@ -24,6 +24,7 @@
 //! `v_b / beta`, whatever the force, so the catch brightens the attack and does not make
 //! it louder.
 
+use crate::dsp::vocabulary::MAX_WEIGHTED_FORCE_N;
 use crate::measure::contact::ContactSample;
 use crate::measure::regime::SlipWatch;
 
@@ -135,10 +136,12 @@ impl Catch {
     /// the catch is over (then it stays over).
     #[inline]
     pub fn force(&mut self, force_n: f64, speed_m_per_s: f64, beta: f64) -> Option<f64> {
-        let top = CATCH_LEVEL * self.window_kg_per_s * speed_m_per_s.abs() / beta;
+        let level = CATCH_LEVEL * self.window_kg_per_s * speed_m_per_s.abs() / beta;
+        // Never more than the force parameter's top, as String Weight never bows harder.
+        let top = level.min(MAX_WEIGHTED_FORCE_N);
         if !self.engaged {
             self.engaged = true;
-            if !(top.is_finite() && force_n < self.engage_ratio / CATCH_LEVEL * top) {
+            if !(level.is_finite() && force_n < self.engage_ratio / CATCH_LEVEL * level) {
                 self.hold_left = 0;
                 self.fall = 1.0;
                 return None;
@@ -242,6 +245,14 @@ mod tests {
             c.observe(&sample(slipping.then_some(-0.9)));
         }
         assert!(c.force(0.2, 0.1, 0.1).unwrap() < 2.5);
+    }
+
+    /// A window whose `F_max / 2` lies above the force parameter's top (paper B's Figure
+    /// 6 bow, unweighted on the cello's C string: 13.6 N) catches at the top, 10 N.
+    #[test]
+    fn the_catch_never_presses_harder_than_the_force_parameters_top() {
+        let mut c = Catch::new(27.3 * 0.07 / 0.15, 0.135, 65.4, FS).unwrap();
+        assert_eq!(c.force(3.0, 0.15, 0.07), Some(MAX_WEIGHTED_FORCE_N));
     }
 
     #[test]
