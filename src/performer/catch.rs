@@ -36,6 +36,8 @@ pub fn catches(velocity: f64) -> bool {
 }
 
 /// The force the catch presses with, a fraction of the window's `F_max`: the map's catch.
+/// Of 0.35, 0.5 and 0.7 it catches the most notes in one slip a period (the hyperbolic and
+/// static laws on the violin and cello, docs/playing-space.md, "The performer's catch").
 pub const CATCH_LEVEL: f64 = 0.5;
 /// A note is caught where its asked force lies lower in the window than this share of
 /// where the model's defaults sit (the default bow with String Weight on: `F_max / 2` for
