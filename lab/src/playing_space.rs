@@ -13,7 +13,7 @@
 //!   `F_max / 2`.
 //!
 //! The window is [`SchellengWindow`] for the string that plays the note, with the model's
-//! own static and sliding friction coefficients ([`friction_coefficients`]). The bow
+//! own static and sliding friction coefficients ([`model_coefficients`]). The bow
 //! velocity is 0.1 m/s, lowered (not below 0.05 m/s) where `F_max / 2` would exceed the
 //! plugin's 10 N.
 //!
@@ -46,15 +46,13 @@ use colophony::dsp::friction::FrictionModel;
 use colophony::dsp::instrument::Instrument;
 use colophony::dsp::intonation::{self, IntonationTable};
 use colophony::dsp::thermal::ThermalParams;
-use colophony::dsp::thermal_instrument::{
-    ThermalInstrument, ThermalSettings, THERMAL_WEIGHT_REFERENCE_Z0,
-};
+use colophony::dsp::thermal_instrument::{ThermalInstrument, ThermalSettings};
 use colophony::dsp::vocabulary::{
     midi_to_hz, BowControl, InstrumentKind, MAX_NOTE_BETA, MIN_NOTE_BETA, STRINGS,
 };
 use colophony::measure::contact::ContactSample;
 use colophony::measure::regime::{classify_regime, helmholtz_since, Regime};
-use colophony::measure::window::SchellengWindow;
+use colophony::measure::window::{model_coefficients, SchellengWindow};
 use colophony::performer::catch::{catches, Catch};
 use colophony::performer::stroke::{Stroke, StrokeMode};
 use colophony::performer::{DYNAMICS_DRIFT_EXPONENT, DYNAMICS_RANGE_DB};
@@ -83,11 +81,18 @@ const MAX_FORCE_N: f64 = 10.0;
 /// A friction model as the plugin offers it: the registry the intonation table keys on.
 pub use colophony::dsp::intonation::TunedModel as Model;
 
-/// Static and sliding friction coefficients of `model`: 0.4 / 0.2 for paper A's laws, the
-/// thermal law's cool and hot ends for paper B's.
-pub fn friction_coefficients(model: Model) -> (f64, f64) {
-    let (_, mu_s, mu_d) = Catch::model_window(model == Model::Thermal);
-    (mu_s, mu_d)
+/// The window of the string that plays `note` (asked onto `string`) of `kind` at `beta`,
+/// with `model`'s friction coefficients, in the string's own force (the map bows each
+/// string with its force as given, the weight already in it).
+fn cell_window(
+    model: Model,
+    kind: InstrumentKind,
+    note: u8,
+    string: Option<usize>,
+    beta: f64,
+) -> SchellengWindow {
+    let index = kind.string_for_note_on(note, string).unwrap_or(0);
+    SchellengWindow::for_model(kind, index, beta, model == Model::Thermal, false)
 }
 
 /// How a cell bows its note.
@@ -243,13 +248,7 @@ impl Cell {
             Bowing::Defaults | Bowing::Middle => 0.1,
             Bowing::TwiceMin(b) | Bowing::Centre(b) | Bowing::HalfMax(b) => b,
         };
-        let (mu_s, mu_d) = friction_coefficients(model);
-        let index = kind.string_for_note_on(note, string).unwrap_or(0);
-        let window = SchellengWindow {
-            mu_s,
-            mu_d,
-            ..SchellengWindow::for_string(kind, index, beta)
-        };
+        let window = cell_window(model, kind, note, string, beta);
         let mut v = 0.1;
         if !matches!(bowing, Bowing::Defaults) {
             let half_max = 0.5 * window.max_force_n(v);
@@ -261,10 +260,11 @@ impl Cell {
         let force = match bowing {
             // The plugin weights the strings by default (String Weight), each model against
             // its own reference.
-            Bowing::Defaults => match model {
-                Model::Point(_) => kind.string_weight(index),
-                Model::Thermal => kind.string_weight_for(index, THERMAL_WEIGHT_REFERENCE_Z0),
-            },
+            Bowing::Defaults => {
+                let (reference, _, _) = model_coefficients(model == Model::Thermal);
+                let index = kind.string_for_note_on(note, string).unwrap_or(0);
+                kind.string_weight_for(index, reference)
+            }
             Bowing::Middle | Bowing::Centre(_) => (f_min * f_max).sqrt(),
             Bowing::TwiceMin(_) => 2.0 * f_min,
             Bowing::HalfMax(_) => 0.5 * f_max,
@@ -438,10 +438,16 @@ impl Catcher {
         let bow = cell.bow;
         let velocity = PERFORMER_VELOCITY as f64 / 127.0;
         let performer_catch = stroke.as_ref().filter(|_| catches(velocity)).and_then(|_| {
-            let (reference, mu_s, mu_d) = Catch::model_window(cell.model == Model::Thermal);
+            let thermal = cell.model == Model::Thermal;
             Catch::new(
-                cell.f_max_n * bow.position_beta / bow.velocity_m_per_s.abs(),
-                Catch::engage_ratio(reference, mu_s, mu_d),
+                cell_window(
+                    cell.model,
+                    cell.kind,
+                    cell.note,
+                    cell.string,
+                    bow.position_beta,
+                ),
+                Catch::engage_ratio(thermal),
                 cell.nominal_hz(),
                 cell.rate_hz,
             )

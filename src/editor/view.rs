@@ -10,11 +10,10 @@ use super::nodes::{paint_slip_image, paint_temperature_profile, NodeRecord, RING
 use super::pad::{format_force, format_velocity, XyPad, MAX_FORCE_COLOUR, MIN_FORCE_COLOUR};
 use super::presets::PresetBar;
 use super::{EditorLink, EditorSize};
-use crate::dsp::thermal_instrument::THERMAL_WEIGHT_REFERENCE_Z0;
 use crate::dsp::vocabulary::{midi_to_hz, InstrumentKind};
 use crate::measure::contact::ContactSample;
 use crate::measure::regime::{classify_regime, Regime};
-use crate::measure::window::SchellengWindow;
+use crate::measure::window::{model_coefficients, SchellengWindow};
 use crate::params::{ColophonyParams, FrictionChoice, QualityChoice, ResonatorChoice};
 use egui::{vec2, Color32, Layout, RichText, Ui};
 use nice_plug::context::gui::GuiContext;
@@ -149,14 +148,16 @@ impl EditorUi {
     /// What the strings multiply the force parameter by on `string` (String Weight; 1
     /// when it is off): the string's impedance over the model's reference.
     fn string_weight(&self, kind: InstrumentKind, string: usize) -> f64 {
-        let thermal = self.params.friction_model.value() == FrictionChoice::Thermal;
         if !self.params.string_weight.value() {
-            1.0
-        } else if thermal {
-            kind.string_weight_for(string, THERMAL_WEIGHT_REFERENCE_Z0)
-        } else {
-            kind.string_weight(string)
+            return 1.0;
         }
+        let (reference, _, _) = model_coefficients(self.thermal());
+        kind.string_weight_for(string, reference)
+    }
+
+    /// Whether the friction model is paper B's thermal bow.
+    fn thermal(&self) -> bool {
+        self.params.friction_model.value() == FrictionChoice::Thermal
     }
 
     /// The Schelleng window for the current note and bow position, `None` while the bow
@@ -168,17 +169,15 @@ impl EditorUi {
         let kind: InstrumentKind = self.params.instrument.value().into();
         let beta = self.params.bow_position.value() as f64;
         let string = self.window_string(kind, self.window_note(kind));
-        let mut window = SchellengWindow::for_string(kind, string, beta);
-        // Paper B's bow: its friction coefficient runs from mu(T) cold to hot (the
-        // playing-space map uses the same window).
-        if self.params.friction_model.value() == FrictionChoice::Thermal {
-            let p = crate::dsp::thermal::ThermalParams::default();
-            window.mu_s = p.mu_cold;
-            window.mu_d = p.mu_hot;
-        }
         // Weighted strings: the window in the force parameter's units (the string is
         // bowed with the parameter times its weight, against each model's reference).
-        Some(window.seen_through_weight(self.string_weight(kind, string)))
+        Some(SchellengWindow::for_model(
+            kind,
+            string,
+            beta,
+            self.thermal(),
+            self.params.string_weight.value(),
+        ))
     }
 
     /// Draws one frame.
@@ -301,9 +300,7 @@ impl EditorUi {
     /// Whether the thermal bow's views are shown: live views on, the thermal model chosen
     /// and the bow on the strings.
     pub fn thermal_shown(&self) -> bool {
-        self.live
-            && self.params.friction_model.value() == FrictionChoice::Thermal
-            && self.params.resonator.value() == ResonatorChoice::Strings
+        self.live && self.thermal() && self.params.resonator.value() == ResonatorChoice::Strings
     }
 
     /// Two plot areas side by side in `rect`, with room for the axis labels.

@@ -34,6 +34,22 @@ pub fn bridge_resistance(z0_kg_per_s: f64, q1: f64) -> f64 {
     2.0 * q1 * z0_kg_per_s / PI
 }
 
+/// The String Weight reference (kg/s) and the friction coefficients (`mu_s`, `mu_d`) of the
+/// window a model plays: paper A's laws (0.2 kg/s, [`MU_S`], [`MU_D`]) or paper B's thermal
+/// bow (`thermal`: 1 kg/s, the cold and hot ends of its `mu(T)`).
+pub fn model_coefficients(thermal: bool) -> (f64, f64, f64) {
+    if thermal {
+        let p = crate::dsp::thermal::ThermalParams::default();
+        (
+            crate::dsp::thermal_instrument::THERMAL_WEIGHT_REFERENCE_Z0,
+            p.mu_cold,
+            p.mu_hot,
+        )
+    } else {
+        (crate::dsp::vocabulary::WEIGHT_REFERENCE_Z0, MU_S, MU_D)
+    }
+}
+
 /// Schelleng's bow-force limits for one string and bow position. Velocities may be signed:
 /// the limits depend on the bow speed `|v_b|`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -66,6 +82,31 @@ impl SchellengWindow {
             beta,
             mu_s: MU_S,
             mu_d: MU_D,
+        }
+    }
+
+    /// The window of string `string` of `kind` at `beta` as the plugin bows it: with the
+    /// friction coefficients of paper A's laws or of paper B's thermal bow (`thermal`,
+    /// [`model_coefficients`]) and, with String Weight on (`weighted`), in the force
+    /// parameter's units. What the editor draws, the playing-space map measures against
+    /// and the performer's catch aims at.
+    pub fn for_model(
+        kind: InstrumentKind,
+        string: usize,
+        beta: f64,
+        thermal: bool,
+        weighted: bool,
+    ) -> Self {
+        let (reference, mu_s, mu_d) = model_coefficients(thermal);
+        let window = Self {
+            mu_s,
+            mu_d,
+            ..Self::for_string(kind, string, beta)
+        };
+        if weighted {
+            window.seen_through_weight(kind.string_weight_for(string, reference))
+        } else {
+            window
         }
     }
 

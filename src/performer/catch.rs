@@ -18,15 +18,16 @@
 //! and held there until [`SlipWatch`] hears [`crate::measure::regime::HELMHOLTZ_SPANS`]
 //! spans of one slip a period (or for [`CATCH_HOLD_MAX_S`] at most), then falls
 //! geometrically to the asked force over [`CATCH_FALL_S`]. The window is the one the
-//! editor draws, in the force parameter's units: `F_max = 2 Z v_b / (beta (mu_s - mu_d))`
-//! with the string's `Z0` (over its String Weight when that is on) and the model's
-//! friction coefficients. At the defaults nothing changes. Helmholtz motion's amplitude is
+//! editor draws ([`SchellengWindow::for_model`]), in the force parameter's units:
+//! `F_max = 2 Z v_b / (beta (mu_s - mu_d))` with the string's `Z0` (over its String Weight
+//! when that is on) and the model's friction coefficients. At the defaults nothing changes. Helmholtz motion's amplitude is
 //! `v_b / beta`, whatever the force, so the catch brightens the attack and does not make
 //! it louder.
 
-use crate::dsp::vocabulary::MAX_WEIGHTED_FORCE_N;
+use crate::dsp::vocabulary::{BowControl, InstrumentKind, MAX_WEIGHTED_FORCE_N};
 use crate::measure::contact::ContactSample;
 use crate::measure::regime::SlipWatch;
+use crate::measure::window::SchellengWindow;
 
 /// Whether a separate note of velocity `velocity` (0..=1, a
 /// [`super::stroke::velocity_step`]) is caught: above mezzo, where the landing accent
@@ -52,8 +53,8 @@ pub const CATCH_FALL_S: f64 = 0.06;
 /// A catch in progress (see the module documentation).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Catch {
-    /// `F_max` per unit of `|v_b| / beta`: `2 Z / (mu_s - mu_d)`, kg/s.
-    window_kg_per_s: f64,
+    /// The note's window as the plugin bows it (its `beta` is the bow's, sample by sample).
+    window: SchellengWindow,
     /// The asked force over `F_max` below which the note is caught.
     engage_ratio: f64,
     watch: SlipWatch,
@@ -68,17 +69,17 @@ pub struct Catch {
 }
 
 impl Catch {
-    /// A catch for a note of fundamental `f0_hz` at `sample_rate_hz` on a string whose
-    /// window has `F_max = window_kg_per_s |v_b| / beta`, engaged below `engage_ratio`
-    /// of `F_max`; `None` for values that are not finite and positive.
+    /// A catch for a note of fundamental `f0_hz` at `sample_rate_hz` in `window`
+    /// ([`SchellengWindow::for_model`]), engaged below `engage_ratio` of its `F_max`;
+    /// `None` for values that are not finite and positive.
     pub fn new(
-        window_kg_per_s: f64,
+        window: SchellengWindow,
         engage_ratio: f64,
         f0_hz: f64,
         sample_rate_hz: f64,
     ) -> Option<Self> {
         let usable = |x: f64| x.is_finite() && x > 0.0;
-        if !(usable(window_kg_per_s)
+        if !(usable(window.max_force_n(1.0))
             && usable(engage_ratio)
             && usable(f0_hz)
             && usable(sample_rate_hz))
@@ -86,7 +87,7 @@ impl Catch {
             return None;
         }
         Some(Self {
-            window_kg_per_s,
+            window,
             engage_ratio,
             watch: SlipWatch::new(sample_rate_hz as f32, f0_hz as f32),
             hold_left: (CATCH_HOLD_MAX_S * sample_rate_hz).round() as u32,
@@ -96,41 +97,15 @@ impl Catch {
         })
     }
 
-    /// The window of string `z0_kg_per_s` bowed with `weight` times the force parameter,
-    /// with friction coefficients `mu_s` and `mu_d`: `2 (Z0 / weight) / (mu_s - mu_d)`.
-    pub fn window_of(z0_kg_per_s: f64, weight: f64, mu_s: f64, mu_d: f64) -> f64 {
-        2.0 * z0_kg_per_s / weight / (mu_s - mu_d)
-    }
-
-    /// The String Weight reference and friction coefficients (`mu_s`, `mu_d`) of the
-    /// window of paper B's thermal model (`thermal`) or of paper A's laws: what the editor
-    /// draws and the playing-space map measures against.
-    pub fn model_window(thermal: bool) -> (f64, f64, f64) {
-        if thermal {
-            let p = crate::dsp::thermal::ThermalParams::default();
-            (
-                crate::dsp::thermal_instrument::THERMAL_WEIGHT_REFERENCE_Z0,
-                p.mu_cold,
-                p.mu_hot,
-            )
-        } else {
-            (
-                crate::dsp::vocabulary::WEIGHT_REFERENCE_Z0,
-                crate::measure::window::MU_S,
-                crate::measure::window::MU_D,
-            )
-        }
-    }
-
-    /// Where the default bow sits in the window of a model whose strings are weighted
-    /// against `reference_z0` with friction coefficients `mu_s` and `mu_d`, as a share of
-    /// `F_max` (the same on every string: both scale with `Z0`), times
-    /// [`CATCH_BELOW_DEFAULTS`]: the `engage_ratio` of [`Catch::new`].
-    pub fn engage_ratio(reference_z0: f64, mu_s: f64, mu_d: f64) -> f64 {
-        let bow = crate::dsp::vocabulary::BowControl::default();
-        let f_max = Self::window_of(reference_z0, 1.0, mu_s, mu_d) * bow.velocity_m_per_s.abs()
-            / bow.position_beta;
-        CATCH_BELOW_DEFAULTS * bow.force_n / f_max
+    /// Where the default bow sits in the window of paper A's laws or paper B's thermal bow
+    /// (`thermal`) with String Weight on, as a share of `F_max` (the same on every
+    /// string: both scale with `Z0`), times [`CATCH_BELOW_DEFAULTS`]: the `engage_ratio`
+    /// of [`Catch::new`].
+    pub fn engage_ratio(thermal: bool) -> f64 {
+        let bow = BowControl::default();
+        let window =
+            SchellengWindow::for_model(InstrumentKind::Violin, 0, bow.position_beta, thermal, true);
+        CATCH_BELOW_DEFAULTS * bow.force_n / window.max_force_n(bow.velocity_m_per_s)
     }
 
     /// The force to play this sample for an asked force `force_n` with the bow at
@@ -138,7 +113,12 @@ impl Catch {
     /// the catch is over (then it stays over).
     #[inline]
     pub fn force(&mut self, force_n: f64, speed_m_per_s: f64, beta: f64) -> Option<f64> {
-        let level = CATCH_LEVEL * self.window_kg_per_s * speed_m_per_s.abs() / beta;
+        let level = CATCH_LEVEL
+            * SchellengWindow {
+                beta,
+                ..self.window
+            }
+            .max_force_n(speed_m_per_s);
         // Never more than the force parameter's top, as String Weight never bows harder.
         let top = level.min(MAX_WEIGHTED_FORCE_N);
         if !self.engaged {
@@ -186,9 +166,19 @@ mod tests {
         }
     }
 
-    /// A window of `F_max` 5 N at 0.1 m/s and beta 0.1 (cello D3's), paper A's laws.
+    /// Cello D's window for paper A's laws, unweighted: `F_max` 5.06 N at 0.1 m/s and beta
+    /// 0.1.
+    fn d3() -> SchellengWindow {
+        SchellengWindow::for_model(InstrumentKind::Cello, 2, 0.1, false, false)
+    }
+
     fn catch() -> Catch {
-        Catch::new(5.0, Catch::engage_ratio(0.2, 0.4, 0.2), 146.83, FS).unwrap()
+        Catch::new(d3(), Catch::engage_ratio(false), 146.83, FS).unwrap()
+    }
+
+    /// `F_max / 2` at 0.1 m/s and beta 0.1.
+    fn half() -> f64 {
+        0.5 * d3().max_force_n(0.1)
     }
 
     /// The defaults sit at `F_max / 2` of paper A's laws (String Weight against 0.2
@@ -196,14 +186,14 @@ mod tests {
     #[test]
     fn the_defaults_sit_where_the_models_weighting_puts_them() {
         let close = |a: f64, b: f64| (a - b).abs() < 1e-12;
-        assert!(close(Catch::engage_ratio(0.2, 0.4, 0.2), 0.9 * 0.5));
-        assert!(close(Catch::engage_ratio(1.0, 0.8, 0.5), 0.9 * 0.15));
+        assert!(close(Catch::engage_ratio(false), 0.9 * 0.5));
+        assert!(close(Catch::engage_ratio(true), 0.9 * 0.15));
     }
 
     #[test]
     fn a_note_near_the_windows_top_is_not_caught() {
         let mut c = catch();
-        assert_eq!(c.force(0.46 * 5.0, 0.1, 0.1), None);
+        assert_eq!(c.force(0.46 * 2.0 * half(), 0.1, 0.1), None);
         assert_eq!(c.force(0.1, 0.1, 0.1), None, "once over, it stays over");
     }
 
@@ -221,7 +211,7 @@ mod tests {
             let slipping = i % period < period / 10;
             c.observe(&sample(slipping.then_some(-0.9)));
         }
-        assert!(forces.iter().all(|&f| f == 2.5), "held at F_max / 2");
+        assert!(forces.iter().all(|&f| f == half()), "held at F_max / 2");
         let fall = (CATCH_FALL_S * FS) as usize;
         let rest: Vec<f64> = (0..2 * fall)
             .map_while(|_| c.force(0.2, 0.1, 0.1))
@@ -241,28 +231,33 @@ mod tests {
         let period = (FS / 146.83).round() as usize;
         let hold = (CATCH_HOLD_MAX_S * FS) as usize;
         for i in 0..hold {
-            assert_eq!(c.force(0.2, 0.1, 0.1), Some(2.5), "sample {i}");
+            assert_eq!(c.force(0.2, 0.1, 0.1), Some(half()), "sample {i}");
             // Two slips a period.
             let slipping = i % (period / 2) < period / 20;
             c.observe(&sample(slipping.then_some(-0.9)));
         }
-        assert!(c.force(0.2, 0.1, 0.1).unwrap() < 2.5);
+        assert!(c.force(0.2, 0.1, 0.1).unwrap() < half());
     }
 
     /// A window whose `F_max / 2` lies above the force parameter's top (paper B's Figure
     /// 6 bow, unweighted on the cello's C string: 13.6 N) catches at the top, 10 N.
     #[test]
     fn the_catch_never_presses_harder_than_the_force_parameters_top() {
-        let mut c = Catch::new(27.3 * 0.07 / 0.15, 0.135, 65.4, FS).unwrap();
+        let fig6 = SchellengWindow::for_model(InstrumentKind::Cello, 0, 0.07, true, false);
+        let mut c = Catch::new(fig6, Catch::engage_ratio(true), 65.4, FS).unwrap();
         assert_eq!(c.force(3.0, 0.15, 0.07), Some(MAX_WEIGHTED_FORCE_N));
     }
 
     #[test]
     fn bad_values_make_no_catch() {
-        assert!(Catch::new(f64::NAN, 0.45, 100.0, FS).is_none());
-        assert!(Catch::new(5.0, 0.45, 0.0, FS).is_none());
-        assert!(Catch::new(5.0, 0.45, 100.0, -1.0).is_none());
-        assert!(Catch::new(5.0, f64::INFINITY, 100.0, FS).is_none());
+        let nan = SchellengWindow {
+            z0_kg_per_s: f64::NAN,
+            ..d3()
+        };
+        assert!(Catch::new(nan, 0.45, 100.0, FS).is_none());
+        assert!(Catch::new(d3(), 0.45, 0.0, FS).is_none());
+        assert!(Catch::new(d3(), 0.45, 100.0, -1.0).is_none());
+        assert!(Catch::new(d3(), f64::INFINITY, 100.0, FS).is_none());
         let mut c = catch();
         assert_eq!(c.force(0.2, 0.1, 0.0), None, "beta 0: no window to aim at");
     }

@@ -70,22 +70,23 @@ impl Performer {
         if !catch::catches(velocity) || self.articulation() != Articulation::Arco {
             return None;
         }
-        let kind = self.setup.instrument;
-        let string = self.notes[note as usize & 127].string? as usize;
-        let z0 = kind.strings().get(string)?.z0_kg_per_s;
-        let (reference, mu_s, mu_d) = match self.source {
-            Source::Strings => catch::Catch::model_window(false),
-            Source::Thermal(_) => catch::Catch::model_window(true),
+        let thermal = match self.source {
+            Source::Strings => false,
+            Source::Thermal(_) => true,
             Source::Rubbed(_) => return None,
         };
-        let weight = if self.setup.string_weight {
-            kind.string_weight_for(string, reference)
-        } else {
-            1.0
-        };
+        let string = self.notes[note as usize & 127].string? as usize;
+        // The bow position is the bow's own, sample by sample.
+        let window = crate::measure::window::SchellengWindow::for_model(
+            self.setup.instrument,
+            string,
+            MIN_NOTE_BETA,
+            thermal,
+            self.setup.string_weight,
+        );
         catch::Catch::new(
-            catch::Catch::window_of(z0, weight, mu_s, mu_d),
-            catch::Catch::engage_ratio(reference, mu_s, mu_d),
+            window,
+            catch::Catch::engage_ratio(thermal),
             midi_to_hz(note as f64),
             self.sample_rate_hz,
         )
