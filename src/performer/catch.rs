@@ -20,9 +20,9 @@
 //! geometrically to the asked force over [`CATCH_FALL_S`]. The window is the one the
 //! editor draws ([`SchellengWindow::for_model`]), in the force parameter's units:
 //! `F_max = 2 Z v_b / (beta (mu_s - mu_d))` with the string's `Z0` (over its String Weight
-//! when that is on) and the model's friction coefficients. At the defaults nothing changes. Helmholtz motion's amplitude is
-//! `v_b / beta`, whatever the force, so the catch brightens the attack and does not make
-//! it louder.
+//! when that is on) and the model's friction coefficients. At the defaults nothing
+//! changes. Helmholtz motion's amplitude is `v_b / beta` whatever the force, so a note the
+//! catch brings into that motion sounds as loud as one that found it alone.
 
 use crate::dsp::vocabulary::{BowControl, InstrumentKind, MAX_WEIGHTED_FORCE_N};
 use crate::measure::contact::ContactSample;
