@@ -531,6 +531,11 @@ impl Instrument {
         &self.bank.voices[index].string
     }
 
+    /// The friction contact of the string `index` (for tests and tools).
+    pub fn contact(&self, index: usize) -> &AnyFriction {
+        &self.bank.voices[index].contact
+    }
+
     /// Strings computed on the next sample.
     pub fn awake_strings(&self) -> usize {
         self.bank.voices.iter().filter(|v| v.awake).count()

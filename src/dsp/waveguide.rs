@@ -359,6 +359,27 @@ impl WaveguideString {
         self.loop_samples
     }
 
+    /// What one trip round the loop does to a wave's shape: the impulse response of the
+    /// nut's reflection filters (fractional delay, stiffness dispersion, loss) over `len`
+    /// samples, normalised to unit sum (its height aside; the rigid bridge and the delay
+    /// lines leave the shape alone). Allocates: for measurement, not the audio thread.
+    pub fn loop_kernel(&self, len: usize) -> Vec<f64> {
+        let (mut fraction, mut dispersion, mut loss) = (self.fraction, self.dispersion, self.loss);
+        fraction.reset();
+        dispersion.reset();
+        loss.reset();
+        let mut kernel: Vec<f64> = (0..len)
+            .map(|i| loss.tick(dispersion.tick(fraction.tick(if i == 0 { 1.0 } else { 0.0 }))))
+            .collect();
+        let sum: f64 = kernel.iter().sum();
+        if sum.abs() > 0.0 {
+            for k in &mut kernel {
+                *k /= sum;
+            }
+        }
+        kernel
+    }
+
     /// The bow position actually used, rounded to the spatial grid: the bridge-side round
     /// trip `2 k_b + 1` over the loop length.
     pub fn effective_beta(&self) -> f64 {

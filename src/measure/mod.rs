@@ -4,5 +4,6 @@
 //! playing-space map measure with them.
 
 pub mod contact;
+pub mod corner;
 pub mod regime;
 pub mod window;
