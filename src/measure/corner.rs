@@ -154,18 +154,14 @@ fn predict(
             shape[k as usize]
         }
     };
-    let mut v = Vec::with_capacity(4 * period);
+    let mut v = Vec::with_capacity(period);
     for t in 0..period as isize {
         let fall = at(&r, t - start as isize + (w / 2) as isize);
         let rise = at(&q, t - (start + bridge_trip) as isize + (w / 2) as isize);
         let slipping = fall.min(1.0 - rise).max(0.0);
         v.push(v_b - d * slipping);
     }
-    let one = v.clone();
-    for _ in 0..3 {
-        v.extend_from_slice(&one);
-    }
-    let stats = slip_stats(&v, v_b, 1.0, 1.0 / period as f64, 0.05 * v_b);
+    let stats = slip_stats(&v.repeat(4), v_b, 1.0, 1.0 / period as f64, 0.05 * v_b);
     Some(stats.slip_fraction)
 }
 
@@ -300,16 +296,13 @@ fn recentre(c: &mut [f64]) {
         return;
     }
     let shift = off.round() as isize;
-    let old = c.to_vec();
-    for (i, y) in c.iter_mut().enumerate() {
-        let k = i as isize + shift;
-        *y = if k < 0 {
-            0.0
-        } else if k as usize >= w {
-            1.0
-        } else {
-            old[k as usize]
-        };
+    let k = shift.unsigned_abs().min(w);
+    if shift > 0 {
+        c.copy_within(k.., 0);
+        c[w - k..].fill(1.0);
+    } else {
+        c.copy_within(..w - k, k);
+        c[..k].fill(0.0);
     }
 }
 
