@@ -407,9 +407,12 @@ fn play(cell: &Cell, engine: &mut impl Engine) -> (Vec<f64>, Vec<ContactSample>)
         if i % BLOCK == 0 {
             engine.update_sleep();
         }
-        let frame = engine.tick(catcher.bow(i));
+        // The probe reads the contact against the bow as played (the stroke's ramp and the
+        // catch's force), as the plugin's catch hears it.
+        let bow = catcher.bow(i);
+        let frame = engine.tick(bow);
         audio.push(frame.audio);
-        probe.push(ContactSample::new(&frame, &cell.bow));
+        probe.push(ContactSample::new(&frame, &bow));
         catcher.observe(&probe);
     }
     (audio, probe)

@@ -343,3 +343,80 @@ fn first_slip_after_the_bow_drags_the_string() {
     }
     println!("3 N at 2 m/s^2, spans between slips up to the lasting motion (periods): {spans}");
 }
+
+/// The slip against the bow position, landed: the violin's open D string (D4) on the bare
+/// instrument (no performer), 0.1 m/s and 0.84 N (`F_max / 2` at beta 0.18), 1.2 s at
+/// 48 kHz; the slip fraction (the map's `slip_stats`, over the last 0.6 s) and its ratio
+/// to beta, for the hyperbolic law with and without torsion and hair, for the static
+/// (Stribeck) law, and for the string alone (one `WaveguideString` with the hyperbolic
+/// law: no body, fingers or resampler). Printed, not asserted: which limit cycle a landing falls into is read
+/// as a table. `cargo test --release -p colophony-lab --test attack_survey short_slip --
+/// --ignored --nocapture`.
+#[test]
+#[ignore]
+fn short_slip_against_the_bow_position_survey() {
+    use colophony::analysis::slip_stats;
+    use colophony::dsp::instrument::Instrument;
+    let (note, force_n, v_b) = (62u8, 0.84, 0.1);
+    let f0 = midi_to_hz(note as f64);
+    let n = (1.2 * FS) as usize;
+    let slip = |law: FrictionModel, extras: bool, beta: f64| {
+        let mut violin = Instrument::new(InstrumentKind::Violin, FS);
+        violin.set_friction_model(law);
+        violin.set_torsion(extras);
+        violin.set_bow_hair(extras);
+        violin.note_on(note);
+        let bow = BowControl {
+            velocity_m_per_s: v_b,
+            force_n,
+            position_beta: beta,
+        };
+        let v: Vec<f64> = (0..n)
+            .map(|i| {
+                if i % 256 == 0 {
+                    violin.update_sleep();
+                }
+                violin.tick(bow).bow_point_velocity_m_per_s
+            })
+            .collect();
+        slip_stats(&v[n / 2..], v_b, FS, f0, 0.05 * v_b).slip_fraction
+    };
+    // The string alone: one `WaveguideString` (no body, no fingers, no resampling), the
+    // hyperbolic law, at the bank's 96 kHz.
+    let bare = |beta: f64| {
+        use colophony::dsp::friction::{BowInput, HyperbolicFriction};
+        use colophony::dsp::waveguide::WaveguideString;
+        let fs = 2.0 * FS;
+        let spec = InstrumentKind::Violin.strings()[1];
+        let mut string = WaveguideString::new(spec, fs, 60.0);
+        string.stop_at(spec.open_hz);
+        string.set_bow_position(beta);
+        let mut contact = HyperbolicFriction::default();
+        let bow = BowInput {
+            velocity_m_per_s: v_b,
+            normal_force_n: force_n,
+        };
+        let m = (1.2 * fs) as usize;
+        let v: Vec<f64> = (0..m)
+            .map(|_| string.tick(&mut contact, bow).bow_point_velocity_m_per_s)
+            .collect();
+        slip_stats(&v[m / 2..], v_b, fs, spec.open_hz, 0.05 * v_b).slip_fraction
+    };
+    println!("violin D4 landed at {force_n} N, {v_b} m/s: slip fraction (over beta)");
+    println!(
+        "  beta  hyperbolic     no torsion or hair  static (Stribeck)  the bare string, hyperbolic"
+    );
+    for beta in [0.1, 0.12, 0.15, 0.165, 0.18, 0.2, 0.21, 0.25, 0.3, 0.35] {
+        let cells = [
+            slip(FrictionModel::Hyperbolic, true, beta),
+            slip(FrictionModel::Hyperbolic, false, beta),
+            slip(FrictionModel::Stribeck, true, beta),
+            bare(beta),
+        ];
+        let row: Vec<String> = cells
+            .iter()
+            .map(|s| format!("{s:.3} ({:.2})", s / beta))
+            .collect();
+        println!("  {beta:<5} {}", row.join("   "));
+    }
+}
