@@ -619,7 +619,7 @@ enum PeerMeasure {
 
 /// One whole process [`peers`] times: a command for `seconds` of audio.
 struct PeerRow {
-    name: &'static str,
+    name: String,
     /// Seconds of audio the timed process renders.
     seconds: f64,
     measure: PeerMeasure,
@@ -634,8 +634,9 @@ struct PeerRow {
 /// `stk::Bowed` at 146.8 Hz (`assets/peers/stk_bowed.cpp`, built with g++ -O2 against
 /// libstk-dev: `scripts/install-peers.sh` installs it), this binary's `render` with the
 /// hyperbolic string (the default) and with the elasto-plastic string at the plugin's
-/// tolerance (the good preset's) and at the reference's, and paper B's cello and a quartet
-/// of thermal instruments. User + system CPU of each process, `PEER_ROUNDS` rounds with
+/// tolerance (the good preset's) and at the reference's, paper B's cello (its Figure 6
+/// bow) at the plugin's default quality (the good preset's node count) and at the exact
+/// `N_B` 60 of the reference quality, and a quartet of thermal instruments. User + system CPU of each process, `PEER_ROUNDS` rounds with
 /// the rows interleaved in each, so load on a shared machine hits them alike; the best,
 /// the spread (worst over best) and, against STK, the ratio of the bests and its range
 /// over the rounds. Where valgrind is installed, instructions per output sample beside
@@ -654,30 +655,28 @@ pub fn peers(seconds: f64, dir: &std::path::Path) -> Result<String, String> {
     })?;
     let me = std::env::current_exe().map_err(|e| e.to_string())?;
     let d3_hz = format!("{}", colophony::dsp::vocabulary::midi_to_hz(50.0));
-    let render_row =
-        |name: &'static str, friction: &'static str, quality: Option<&'static str>, goal| {
-            let (me, dir) = (me.clone(), dir.to_path_buf());
-            PeerRow {
-                name,
-                seconds,
-                measure: PeerMeasure::TimesStk,
-                goal,
-                command: Box::new(move |secs: f64| {
-                    let mut c = std::process::Command::new(&me);
-                    c.args(["render", "--note", "D3", "--friction", friction, "--timing"])
-                        .args(["--seconds", &format!("{secs}")]);
-                    if let Some(q) = quality {
-                        c.args(["--quality", q]);
-                    }
-                    c.arg("--out").arg(
-                        dir.join(format!("{friction}-{}.wav", quality.unwrap_or("reference"))),
-                    );
-                    c
-                }),
-            }
-        };
+    let render_row = |name: &str, friction: &'static str, quality: Option<&'static str>, goal| {
+        let (me, dir) = (me.clone(), dir.to_path_buf());
+        PeerRow {
+            name: name.into(),
+            seconds,
+            measure: PeerMeasure::TimesStk,
+            goal,
+            command: Box::new(move |secs: f64| {
+                let mut c = std::process::Command::new(&me);
+                c.args(["render", "--note", "D3", "--friction", friction, "--timing"])
+                    .args(["--seconds", &format!("{secs}")]);
+                if let Some(q) = quality {
+                    c.args(["--quality", q]);
+                }
+                c.arg("--out")
+                    .arg(dir.join(format!("{friction}-{}.wav", quality.unwrap_or("reference"))));
+                c
+            }),
+        }
+    };
     // Paper B's scenes cost tens of times a point-bow string: a tenth of the audio.
-    let scene_row = |name: &'static str, scene: &'static str, goal| {
+    let scene_row = |name: String, scene: String, goal| {
         let me = me.clone();
         PeerRow {
             name,
@@ -692,9 +691,12 @@ pub fn peers(seconds: f64, dir: &std::path::Path) -> Result<String, String> {
             }),
         }
     };
+    let good = colophony::quality::Quality::Good
+        .fixed_thermal_nodes()
+        .expect("the good preset fixes its node count");
     let rows = vec![
         PeerRow {
-            name: "STK Bowed",
+            name: "STK Bowed".into(),
             seconds,
             measure: PeerMeasure::TimesStk,
             goal: None,
@@ -724,16 +726,41 @@ pub fn peers(seconds: f64, dir: &std::path::Path) -> Result<String, String> {
             None,
             None,
         ),
-        scene_row("thermal cello N_B 60, C bowed", "cello-c", Some(3.0)),
-        scene_row("thermal cello N_B 60, C+G", "cello-cg", Some(5.0)),
-        scene_row("thermal quartet, plugin quality", "quartet", Some(15.0)),
+        // Paper B's cello (its Figure 6 bow, 1 cm) at the plugin's default quality: the
+        // good preset's node count, whose error against the exact N_B 60 the precision
+        // bench gives (docs/precision.md); the exact N_B 60 (the reference quality) beside.
+        scene_row(
+            format!("thermal cello, plugin quality (N_B {good}), C bowed"),
+            format!("cello-c@{good}"),
+            Some(3.0),
+        ),
+        scene_row(
+            format!("thermal cello, plugin quality (N_B {good}), C+G"),
+            format!("cello-cg@{good}"),
+            Some(5.0),
+        ),
+        scene_row(
+            "thermal cello N_B 60 (reference quality), C bowed".into(),
+            "cello-c".into(),
+            None,
+        ),
+        scene_row(
+            "thermal cello N_B 60 (reference quality), C+G".into(),
+            "cello-cg".into(),
+            None,
+        ),
+        scene_row(
+            "thermal quartet, plugin quality".into(),
+            "quartet".into(),
+            Some(15.0),
+        ),
     ];
     let mut cpu = vec![Vec::with_capacity(PEER_ROUNDS); rows.len()];
     // Each row's timing floor over the rounds, ns a 48 kHz sample.
     let mut floors = vec![f64::INFINITY; rows.len()];
     for _round in 0..PEER_ROUNDS {
         for ((row, times), floor) in rows.iter().zip(&mut cpu).zip(&mut floors) {
-            let (t, f) = child_cpu_and_floor(&mut (row.command)(row.seconds), row.name)?;
+            let (t, f) = child_cpu_and_floor(&mut (row.command)(row.seconds), &row.name)?;
             times.push(t);
             *floor = floor.min(f.unwrap_or(f64::INFINITY));
         }
@@ -748,7 +775,7 @@ pub fn peers(seconds: f64, dir: &std::path::Path) -> Result<String, String> {
                     PeerMeasure::TimesStk => 2.0,
                     PeerMeasure::PercentOfCore => 0.25,
                 });
-                instructions_per_sample(&*row.command, short, 2.0 * short, row.name).ok()
+                instructions_per_sample(&*row.command, short, 2.0 * short, &row.name).ok()
             })
             .collect()
     } else {

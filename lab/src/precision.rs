@@ -444,6 +444,12 @@ fn violin_a(law: FrictionModel) -> (Scenario, RenderSettings) {
 
 const FIG6: &str = "cello C2, paper B Fig. 6 (beta 0.07)";
 const FIG6_BETA_01: &str = "cello C2, Fig. 6 bow at beta 0.1";
+/// The same two scenes, the plugin's draft and good node counts against the exact `N_B` of
+/// the reference quality (what `bench peers` times the good preset against).
+const FIG6_AGAINST_REFERENCE: &str =
+    "cello C2, paper B Fig. 6 (beta 0.07), against the reference quality's N_B";
+const FIG6_BETA_01_AGAINST_REFERENCE: &str =
+    "cello C2, Fig. 6 bow at beta 0.1, against the reference quality's N_B";
 
 impl Plan {
     /// Every scenario, every refinement (about four minutes of a release build on one core).
@@ -473,6 +479,17 @@ impl Plan {
         }
         groups.push(thermal_group(FIG6, 0.07, &NODES, REFERENCE_NODES));
         groups.push(thermal_group(FIG6_BETA_01, 0.1, &NODES, REFERENCE_NODES));
+        {
+            use colophony::quality::{DRAFT_NODES, GOOD_NODES, REFERENCE_NODES as EXACT};
+            let presets = [DRAFT_NODES, GOOD_NODES];
+            groups.push(thermal_group(FIG6_AGAINST_REFERENCE, 0.07, &presets, EXACT));
+            groups.push(thermal_group(
+                FIG6_BETA_01_AGAINST_REFERENCE,
+                0.1,
+                &presets,
+                EXACT,
+            ));
+        }
         groups.push(rubbed_group(
             RubbedPreset::WineGlass,
             &RATES_HZ,
