@@ -636,7 +636,8 @@ struct PeerRow {
 /// hyperbolic string (the default) and with the elasto-plastic string at the plugin's
 /// tolerance (the good preset's) and at the reference's, paper B's cello (its Figure 6
 /// bow) at the plugin's default quality (the good preset's node count) and at the exact
-/// `N_B` 60 of the reference quality, and a quartet of thermal instruments. User + system CPU of each process, `PEER_ROUNDS` rounds with
+/// `N_B` of the reference quality, and a quartet of thermal instruments. User + system
+/// CPU of each process, `PEER_ROUNDS` rounds with
 /// the rows interleaved in each, so load on a shared machine hits them alike; the best,
 /// the spread (worst over best) and, against STK, the ratio of the bests and its range
 /// over the rounds. Where valgrind is installed, instructions per output sample beside
@@ -691,9 +692,12 @@ pub fn peers(seconds: f64, dir: &std::path::Path) -> Result<String, String> {
             }),
         }
     };
-    let good = colophony::quality::Quality::Good
-        .fixed_thermal_nodes()
-        .expect("the good preset fixes its node count");
+    let node_count = |q: colophony::quality::Quality| {
+        q.fixed_thermal_nodes()
+            .expect("the good and reference presets fix their node counts")
+    };
+    let good = node_count(colophony::quality::Quality::Good);
+    let exact = node_count(colophony::quality::Quality::Reference);
     let rows = vec![
         PeerRow {
             name: "STK Bowed".into(),
@@ -727,8 +731,8 @@ pub fn peers(seconds: f64, dir: &std::path::Path) -> Result<String, String> {
             None,
         ),
         // Paper B's cello (its Figure 6 bow, 1 cm) at the plugin's default quality: the
-        // good preset's node count, whose error against the exact N_B 60 the precision
-        // bench gives (docs/precision.md); the exact N_B 60 (the reference quality) beside.
+        // good preset's node count, whose error against the reference quality's exact
+        // N_B the precision bench gives (docs/precision.md); the exact N_B beside it.
         scene_row(
             format!("thermal cello, plugin quality (N_B {good}), C bowed"),
             format!("cello-c@{good}"),
@@ -740,13 +744,13 @@ pub fn peers(seconds: f64, dir: &std::path::Path) -> Result<String, String> {
             Some(5.0),
         ),
         scene_row(
-            "thermal cello N_B 60 (reference quality), C bowed".into(),
-            "cello-c".into(),
+            format!("thermal cello N_B {exact} (reference quality), C bowed"),
+            format!("cello-c@{exact}"),
             None,
         ),
         scene_row(
-            "thermal cello N_B 60 (reference quality), C+G".into(),
-            "cello-cg".into(),
+            format!("thermal cello N_B {exact} (reference quality), C+G"),
+            format!("cello-cg@{exact}"),
             None,
         ),
         scene_row(
@@ -940,7 +944,7 @@ pub fn peer_scene(name: &str, seconds: f64) -> Result<String, String> {
                 "peer scene '{name}': the quartet takes no node count"
             ))
         }
-        None => (name, 60),
+        None => (name, colophony::quality::REFERENCE_NODES),
     };
     let (mut players, bow) = match scene {
         "cello-c" => (

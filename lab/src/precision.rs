@@ -445,7 +445,7 @@ fn violin_a(law: FrictionModel) -> (Scenario, RenderSettings) {
 const FIG6: &str = "cello C2, paper B Fig. 6 (beta 0.07)";
 const FIG6_BETA_01: &str = "cello C2, Fig. 6 bow at beta 0.1";
 /// The same two scenes, the plugin's draft and good node counts against the exact `N_B` of
-/// the reference quality (what `bench peers` times the good preset against).
+/// the reference quality (which `bench peers` times beside the good preset).
 const FIG6_AGAINST_REFERENCE: &str =
     "cello C2, paper B Fig. 6 (beta 0.07), against the reference quality's N_B";
 const FIG6_BETA_01_AGAINST_REFERENCE: &str =

@@ -349,9 +349,9 @@ fn first_slip_after_the_bow_drags_the_string() {
 /// 48 kHz; the slip fraction (the map's `slip_stats`, over the last 0.6 s) and its ratio
 /// to beta, for the hyperbolic law with and without torsion and hair, for the static
 /// (Stribeck) law, and for the string alone (one `WaveguideString` with the hyperbolic
-/// law: no body, fingers or resampler). Printed, not asserted: which limit cycle a landing falls into is read
-/// as a table. `cargo test --release -p colophony-lab --test attack_survey short_slip --
-/// --ignored --nocapture`.
+/// law: no body, fingers or resampler). Printed, not asserted: which limit cycle a
+/// landing falls into is read as a table. `cargo test --release -p colophony-lab --test
+/// attack_survey short_slip -- --ignored --nocapture`.
 #[test]
 #[ignore]
 fn short_slip_against_the_bow_position_survey() {
