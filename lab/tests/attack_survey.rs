@@ -420,3 +420,84 @@ fn short_slip_against_the_bow_position_survey() {
         println!("  {beta:<5} {}", row.join("   "));
     }
 }
+
+/// Attacks on the bare string against the friction curve's shape: one `WaveguideString`
+/// (torsion and hair on, no body, fingers or resampler) at 48 kHz, the cello's D string at
+/// beta 0.1 and 0.07, its G at 0.1, its C at 0.12 and its A at 0.1; the hyperbolic law
+/// with the plugin's curve (`mu_s` 0.4, `mu_d` 0.2, `v0` 0.1 m/s), a sharper one, a higher
+/// one, and the levels of the exponential steady-sliding fit to rosin (1.2 at rest, 0.35
+/// fast; docs/literature-values.md §1.2) with a fall over 0.03 or 0.01 m/s; forces
+/// 0.1-0.7 of each curve's `F_max`, the bow from rest at
+/// 1-20 m/s^2 or landing at 0.1 m/s. Printed per curve: attacks in Helmholtz motion that
+/// lasts to 0.5 s, those that speak within 50 ms, and the median speaking time.
+/// `cargo test --release -p colophony-lab --test attack_survey friction_curve --
+/// --ignored --nocapture`.
+#[test]
+#[ignore]
+fn attacks_against_the_friction_curve_survey() {
+    use colophony::dsp::friction::{BowInput, HyperbolicFriction};
+    use colophony::dsp::waveguide::WaveguideString;
+    use colophony::measure::regime::helmholtz_since;
+    let v_b = 0.1;
+    let n = (0.5 * FS) as usize;
+    let places = [(2usize, 0.1), (2, 0.07), (1, 0.1), (0, 0.12), (3, 0.1)];
+    let fractions = [0.1, 0.2, 0.3, 0.5, 0.7];
+    let accels = [1.0, 2.0, 5.0, 10.0, 20.0, 0.0];
+    println!("law (mu_s, mu_d, v0): attacks in Helmholtz motion / within 50 ms / median ms");
+    for (mu_s, mu_d, v0) in [
+        (0.4, 0.2, 0.1),
+        (0.4, 0.2, 0.03),
+        (0.8, 0.3, 0.1),
+        (0.8, 0.3, 0.03),
+        (1.2, 0.35, 0.03),
+        (1.2, 0.35, 0.01),
+    ] {
+        let mut spoke = Vec::new();
+        let mut attacks = 0;
+        for &(index, beta) in &places {
+            let spec = InstrumentKind::Cello.strings()[index];
+            let f_max = 2.0 * spec.z0_kg_per_s * v_b / (beta * (mu_s - mu_d));
+            for &fraction in &fractions {
+                for &a in &accels {
+                    let mut string = WaveguideString::new(spec, FS, 60.0);
+                    string.stop_at(spec.open_hz);
+                    string.set_bow_position(beta);
+                    let mut contact = HyperbolicFriction::default();
+                    (contact.mu_s, contact.mu_d, contact.v0_m_per_s) = (mu_s, mu_d, v0);
+                    let force = fraction * f_max;
+                    let probe: Vec<ContactSample> = (0..n)
+                        .map(|i| {
+                            let v = if a == 0.0 {
+                                v_b
+                            } else {
+                                (a * i as f64 / FS).min(v_b)
+                            };
+                            let bow = BowInput {
+                                velocity_m_per_s: v,
+                                normal_force_n: force,
+                            };
+                            let out = string.tick(&mut contact, bow);
+                            let surface = out.bow_point_velocity_m_per_s;
+                            ContactSample {
+                                string_velocity: surface as f32,
+                                relative_velocity: (surface - v) as f32,
+                                mu: (out.friction_force_n / force) as f32,
+                            }
+                        })
+                        .collect();
+                    attacks += 1;
+                    if let Some(k) = helmholtz_since(&probe, FS as f32, spec.open_hz as f32) {
+                        spoke.push(k as f64 / FS * 1e3);
+                    }
+                }
+            }
+        }
+        spoke.sort_by(f64::total_cmp);
+        let quick = spoke.iter().filter(|&&ms| ms <= 50.0).count();
+        let median = spoke.get(spoke.len() / 2).copied().unwrap_or(f64::NAN);
+        println!(
+            "  ({mu_s}, {mu_d}, {v0}): {} of {attacks} / {quick} / {median:.0}",
+            spoke.len()
+        );
+    }
+}
