@@ -203,12 +203,18 @@ impl MinimalString {
         self.from_nut[self.at_n] = reflected_n;
         self.at_b = (self.at_b + 1) % self.to_bridge.len();
         self.at_n = (self.at_n + 1) % self.to_nut.len();
-        let v = load.free_velocity_m_per_s + dv;
-        ContactSample {
-            string_velocity: v as f32,
-            relative_velocity: (v - velocity) as f32,
-            mu: (f / force) as f32,
-        }
+        contact_sample(load.free_velocity_m_per_s + dv, velocity, f, force)
+    }
+}
+
+/// The contact sample of a bare string's tick: the string's velocity at the bow `v` and
+/// the friction force `friction_n` under a bow at `bow_velocity` pressing with `force_n`
+/// (what `ContactSample::new` reads from an instrument's frame).
+fn contact_sample(v: f64, bow_velocity: f64, friction_n: f64, force_n: f64) -> ContactSample {
+    ContactSample {
+        string_velocity: v as f32,
+        relative_velocity: (v - bow_velocity) as f32,
+        mu: (friction_n / force_n) as f32,
     }
 }
 
@@ -477,12 +483,12 @@ fn attacks_against_the_friction_curve_survey() {
                                 normal_force_n: force,
                             };
                             let out = string.tick(&mut contact, bow);
-                            let surface = out.bow_point_velocity_m_per_s;
-                            ContactSample {
-                                string_velocity: surface as f32,
-                                relative_velocity: (surface - v) as f32,
-                                mu: (out.friction_force_n / force) as f32,
-                            }
+                            contact_sample(
+                                out.bow_point_velocity_m_per_s,
+                                v,
+                                out.friction_force_n,
+                                force,
+                            )
                         })
                         .collect();
                     attacks += 1;

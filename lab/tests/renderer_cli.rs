@@ -571,7 +571,8 @@ fn bench_peers_compares_with_stk_or_says_how_to_install_it() {
     if run.status.success() {
         // Every row of the speed table, the strings with their ratio to STK (STK's own
         // is 1), paper B's scenes in % of a core, each with its goal and whether it is met:
-        // the cello's goals at the plugin's quality, the exact N_B 60 beside them.
+        // the cello's goals at the plugin's quality, the reference quality's exact N_B beside
+        // them.
         let (good, exact) = (
             colophony::quality::GOOD_NODES,
             colophony::quality::REFERENCE_NODES,
