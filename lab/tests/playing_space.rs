@@ -443,3 +443,70 @@ fn the_thermal_model_plays_the_same_cell_at_44_1_and_96_khz() {
         );
     }
 }
+
+/// Near the bridge (docs/playing-space.md, "Near the bridge the motion forms slowest"): the
+/// violin's and cello's map cells of the three beta 0.05 rows (every third semitone, 48 kHz,
+/// the hyperbolic law, the performer's attack) played for 2 s, counted by when the
+/// Helmholtz motion that lasts to the end began; then, landed at `F_max / 2`, the smallest
+/// beta at which five notes play Helmholtz motion from 0.3 s to 1 s. A survey, printed, not
+/// asserted: when an attack settles is chaotic, so it is read as counts.
+/// `cargo test --release -p colophony-lab --test playing_space near_the_bridge --
+/// --ignored --nocapture`.
+#[test]
+#[ignore]
+fn near_the_bridge_survey() {
+    use colophony::dsp::friction::FrictionModel;
+    use colophony_lab::playing_space::Attack;
+    let law = Model::Point(FrictionModel::Hyperbolic);
+    let rows = [
+        Bowing::TwiceMin(0.05),
+        Bowing::Centre(0.05),
+        Bowing::HalfMax(0.05),
+    ];
+    for bowing in rows {
+        let mut cells = Vec::new();
+        for kind in [InstrumentKind::Violin, InstrumentKind::Cello] {
+            for note in notes(kind, 3) {
+                let mut cell = Cell::new(law, kind, note, 48_000.0, bowing, 2.0);
+                cell.attack = Attack::Performer;
+                cells.push(cell);
+            }
+        }
+        let spoke: Vec<Option<f64>> = measure_all(&cells)
+            .iter()
+            .map(|(_, m)| m.speaks_ms)
+            .collect();
+        let by = |ms: f64| spoke.iter().flatten().filter(|&&s| s <= ms).count();
+        println!(
+            "{}: of {} cells, lasting Helmholtz motion by 0.3 / 0.6 / 1 / 1.5 s: {} / {} / {} / {}; never within 2 s: {}",
+            bowing.label(),
+            cells.len(),
+            by(300.0),
+            by(600.0),
+            by(1000.0),
+            by(1500.0),
+            spoke.iter().filter(|s| s.is_none()).count()
+        );
+    }
+    let betas = [0.03, 0.04, 0.05, 0.06, 0.07, 0.08, 0.1];
+    for (kind, note) in [
+        (InstrumentKind::Cello, 50u8),
+        (InstrumentKind::Cello, 51),
+        (InstrumentKind::Cello, 57),
+        (InstrumentKind::Violin, 62),
+        (InstrumentKind::Violin, 55),
+    ] {
+        let cells: Vec<Cell> = betas
+            .iter()
+            .map(|&b| Cell::new(law, kind, note, 48_000.0, Bowing::HalfMax(b), 1.0))
+            .collect();
+        let regimes: Vec<String> = measure_all(&cells)
+            .iter()
+            .map(|(c, m)| format!("{}: {}", c.bow.position_beta, regime_name(m.regime)))
+            .collect();
+        println!(
+            "{kind:?} {note} landed at F_max / 2: {}",
+            regimes.join(", ")
+        );
+    }
+}
