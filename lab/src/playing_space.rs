@@ -60,7 +60,7 @@ use colophony::measure::contact::ContactSample;
 use colophony::measure::corner::predicted_slip_fraction;
 use colophony::measure::regime::{classify_regime, helmholtz_since, Regime};
 use colophony::measure::window::{model_coefficients, SchellengWindow};
-use colophony::performer::catch::{catches, Catch};
+use colophony::performer::catch::{catches, Catch, CatchRule};
 use colophony::performer::stroke::{Stroke, StrokeMode};
 use colophony::performer::{DYNAMICS_DRIFT_EXPONENT, DYNAMICS_RANGE_DB};
 use colophony::quality::{Quality, GOOD_NODES};
@@ -455,7 +455,6 @@ impl Catcher {
         let bow = cell.bow;
         let velocity = PERFORMER_VELOCITY as f64 / 127.0;
         let performer_catch = stroke.as_ref().filter(|_| catches(velocity)).and_then(|_| {
-            let thermal = cell.model == Model::Thermal;
             Catch::new(
                 cell_window(
                     cell.model,
@@ -464,7 +463,10 @@ impl Catcher {
                     cell.string,
                     bow.position_beta,
                 ),
-                Catch::engage_ratio(thermal),
+                CatchRule::for_law(match cell.model {
+                    Model::Point(law) => Some(law),
+                    Model::Thermal => None,
+                }),
                 cell.nominal_hz(),
                 cell.rate_hz,
             )

@@ -304,6 +304,7 @@ mod tests {
     use super::*;
     use crate::analysis::{cents, partial_amplitude, peak_frequency_hz, rms};
     use crate::dsp::friction::FrictionModel;
+    use crate::performer::catch::{CATCH_FALL_S, CATCH_HOLD_MAX_S};
     use crate::performer::testing::*;
 
     /// `seconds` of `note` at velocity 0.8 on a performer set up as `setup`, with the
@@ -837,10 +838,15 @@ mod tests {
         p.note_on(note, 0.8);
         let bow = BowControl::default();
         let (mut out, mut largest) = (Vec::new(), 0.0f64);
-        for _ in 0..96_000 {
+        // The largest friction force once the performer's catch has eased to the asked
+        // force (it holds at most 0.24 s and falls over 0.06 s).
+        let caught = ((CATCH_HOLD_MAX_S + CATCH_FALL_S) * FS).ceil() as usize + 1;
+        for i in 0..96_000 {
             let frame = p.tick(bow);
             out.push(frame.audio);
-            largest = largest.max(frame.friction_force_n.abs());
+            if i >= caught {
+                largest = largest.max(frame.friction_force_n.abs());
+            }
         }
         let f = crate::dsp::vocabulary::midi_to_hz(note as f64);
         let tail = &out[48_000..];
@@ -892,7 +898,7 @@ mod tests {
 
     /// Col legno tratto draws the stick across the string: through the performer at the
     /// defaults, on notes of every instrument, the largest friction force the stick
-    /// exerts, over the hair's on the same note, is the stick's static friction over the
+    /// exerts, over the hair's on the same note (both once the hair's catch is over), is the stick's static friction over the
     /// rosin's (`STICK_MU_S / 0.4`; within 5 %: the hair's largest force falls a little
     /// short of its static limit on the violin), and the note is no louder than arco: where
     /// the stick holds Helmholtz motion its amplitude, `v_b / beta`, does not depend on

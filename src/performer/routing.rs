@@ -86,7 +86,7 @@ impl Performer {
         );
         catch::Catch::new(
             window,
-            catch::Catch::engage_ratio(thermal),
+            catch::CatchRule::for_law(if thermal { None } else { self.setup.point_law }),
             midi_to_hz(note as f64),
             self.sample_rate_hz,
         )
