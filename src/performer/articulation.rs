@@ -861,9 +861,10 @@ mod tests {
     /// point-bow strings' hyperbolic law with the wood's coefficients, no hair). Through
     /// the performer at the defaults, on notes of the cello, viola and violin: the largest
     /// friction force of the stick over the hair's is the ratio of their static
-    /// frictions (`STICK_MU_S` over the cool rosin's 0.8) within 20 % (measured 0.90-0.93
-    /// of it: the thermal hair's largest force overshoots its static limit where the
-    /// vertical junction presses harder at the attack), the note sounds within 15 cents
+    /// frictions (`STICK_MU_S` over the cool rosin's 0.8) within 20 % (measured 0.98-1.00
+    /// of it once the attack's first 0.3 s are over; with them 0.90-0.93, the thermal
+    /// hair's largest force overshooting its static limit where the vertical junction
+    /// presses harder at the attack), the note sounds within 15 cents
     /// of its pitch (the repertoire's criterion; measured within 10.2) and fainter than
     /// arco (measured 8.5-21.6 dB: at the thermal model's lighter default force the
     /// stick's small friction drop holds a weak motion).
@@ -898,11 +899,12 @@ mod tests {
 
     /// Col legno tratto draws the stick across the string: through the performer at the
     /// defaults, on notes of every instrument, the largest friction force the stick
-    /// exerts, over the hair's on the same note (both once the hair's catch is over), is the stick's static friction over the
-    /// rosin's (`STICK_MU_S / 0.4`; within 5 %: the hair's largest force falls a little
-    /// short of its static limit on the violin), and the note is no louder than arco: where
-    /// the stick holds Helmholtz motion its amplitude, `v_b / beta`, does not depend on
-    /// the friction (measured 0.5-0.9 dB fainter; the double bass's E2, 6.3 dB).
+    /// exerts, over the hair's on the same note (both once the hair's catch is over), is
+    /// the stick's static friction over the rosin's (`STICK_MU_S / 0.4`; within 5 %: the
+    /// hair's largest force falls a little short of its static limit on the violin), and
+    /// the note is no louder than arco: where the stick holds Helmholtz motion its
+    /// amplitude, `v_b / beta`, does not depend on the friction (measured 0.5-0.8 dB
+    /// fainter; the double bass's E2, 6.6 dB).
     #[test]
     fn col_legno_tratto_plays_the_stick_and_is_no_louder_than_the_hair() {
         use crate::dsp::instrument::STICK_MU_S;

@@ -22,11 +22,11 @@
 //! caught, the defaults (`F_max / 2`) too: pressed harder, the string finds one slip a
 //! period sooner (a bite, as a player's martelé). The static (Stribeck) law and paper B's
 //! thermal bow catch at `F_max / 2`, and only notes lighter than [`CATCH_BELOW_DEFAULTS`]
-//! of where their defaults sit: caught harder, the static law's notes can keep a flattened
-//! motion after the catch (docs/playing-space.md, "The performer's catch"). The window is the one the editor
-//! draws ([`SchellengWindow::for_model`]), in the force parameter's units: `F_max = 2 Z v_b
-//! / (beta (mu_s - mu_d))` with the string's `Z0` (over its String Weight when that is on)
-//! and the model's friction coefficients. Helmholtz motion's amplitude is `v_b / beta`
+//! of where their defaults sit: caught harder, a static-law note was found to stay 32
+//! cents flat after the catch (docs/playing-space.md, "The performer's catch"). The window
+//! is the one the editor draws ([`SchellengWindow::for_model`]), in the force parameter's
+//! units: `F_max = 2 Z v_b / (beta (mu_s - mu_d))` with the string's `Z0` (over its String
+//! Weight when that is on) and the model's friction coefficients. Helmholtz motion's amplitude is `v_b / beta`
 //! whatever the force, so a note the catch brings into that motion sounds as loud as one
 //! that found it alone.
 
@@ -56,6 +56,11 @@ pub const LIGHT_CATCH_LEVEL: f64 = 0.5;
 /// on: `F_max / 2` for paper A's laws, `F_max / 6.7` for paper B's,
 /// [`CatchRule::engage_ratio`]): the defaults themselves are not caught.
 pub const CATCH_BELOW_DEFAULTS: f64 = 0.9;
+
+/// The longest the catching force is held, s (the map's).
+pub const CATCH_HOLD_MAX_S: f64 = 0.24;
+/// How long the force takes to fall to the asked one once caught, s (the map's).
+pub const CATCH_FALL_S: f64 = 0.06;
 
 /// Which notes a model's bow catches, and how hard.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -99,10 +104,6 @@ impl CatchRule {
         CATCH_BELOW_DEFAULTS * bow.force_n / window.max_force_n(bow.velocity_m_per_s)
     }
 }
-/// The longest the catching force is held, s (the map's).
-pub const CATCH_HOLD_MAX_S: f64 = 0.24;
-/// How long the force takes to fall to the asked one once caught, s (the map's).
-pub const CATCH_FALL_S: f64 = 0.06;
 
 /// A catch in progress (see the module documentation).
 #[derive(Debug, Clone, Copy, PartialEq)]
