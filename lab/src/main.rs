@@ -177,6 +177,12 @@ enum Command {
         /// cell's force by 0.3 s: whether that force holds Helmholtz motion).
         #[arg(long, default_value = "performer")]
         attack: String,
+        /// playing-space: the point-bow strings' most dispersion sections (default the
+        /// plugin's 8; 0: strings without stiffness), to measure what the strings'
+        /// stiffness does to the map. The intonation table stays the one fitted for the
+        /// stiff strings, so the pitches move with it.
+        #[arg(long)]
+        dispersion_stages: Option<usize>,
     },
     /// List the presets: the factory set and the user presets (in the folder the editor
     /// saves to; COLOPHONY_PRESET_DIR overrides it).
@@ -428,6 +434,7 @@ fn main() -> ExitCode {
             free,
             seconds,
             attack,
+            dispersion_stages,
         } => report(match what.as_str() {
             "friction" => colophony_lab::bench::friction_table(),
             "table1" => colophony_lab::bench::table1(),
@@ -449,6 +456,7 @@ fn main() -> ExitCode {
                     .and_then(|mut plan| {
                         plan.attack = colophony_lab::playing_space::Attack::from_name(&attack)
                             .ok_or_else(|| format!("unknown attack '{attack}': choose landing or catch"))?;
+                        plan.dispersion_stages = dispersion_stages;
                         colophony_lab::playing_space::run(&dir, &plan)
                     }),
                 None => Err("bench playing-space needs --out DIR".into()),

@@ -177,6 +177,10 @@ pub struct Cell {
     /// The dynamics' expression the engine's intonation follows (1: full, as the map
     /// bows; [`Cell::at_expression`] also plays the bow the Dynamics Guard plays there).
     pub expression: f64,
+    /// The most dispersion sections each point-bow string may fit (`None`: the plugin's
+    /// [`colophony::dsp::waveguide::DEFAULT_DISPERSION_STAGES`]; 0: strings without
+    /// stiffness). A research knob: what the strings' stiffness does to the map.
+    pub dispersion_stages: Option<usize>,
 }
 
 /// How a cell's note begins.
@@ -296,6 +300,7 @@ impl Cell {
             attack: Attack::Landing,
             thermal: ThermalParams::default(),
             expression: 1.0,
+            dispersion_stages: None,
         }
     }
 
@@ -390,6 +395,9 @@ fn point_engine(cell: &Cell, law: FrictionModel) -> Instrument {
     engine.set_preferred_string(cell.string);
     engine.set_bristle_integrator(cell.integrator);
     engine.set_dynamics(cell.expression);
+    if let Some(stages) = cell.dispersion_stages {
+        engine.set_dispersion_cap(stages);
+    }
     engine
 }
 
@@ -645,6 +653,8 @@ pub struct Plan {
     pub seconds: f64,
     /// How every cell's note begins.
     pub attack: Attack,
+    /// The point-bow strings' most dispersion sections ([`Cell::dispersion_stages`]).
+    pub dispersion_stages: Option<usize>,
 }
 
 impl Plan {
@@ -658,6 +668,7 @@ impl Plan {
             rates_hz: vec![44_100.0, 48_000.0, 88_200.0, 96_000.0, 176_400.0, 192_000.0],
             seconds: 1.0,
             attack: Attack::Landing,
+            dispersion_stages: None,
         }
     }
 
@@ -730,6 +741,7 @@ impl Plan {
                         for &bowing in &self.bowings {
                             let mut cell = Cell::new(model, kind, note, rate, bowing, self.seconds);
                             cell.attack = self.attack;
+                            cell.dispersion_stages = self.dispersion_stages;
                             cells.push(cell);
                         }
                     }

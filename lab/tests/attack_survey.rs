@@ -105,14 +105,21 @@ fn attacks_through_the_performer_survey() {
 /// Guettler's diagram on the bare instrument (no performer): cello D3 (or `NOTE`), the
 /// hyperbolic law, beta 0.1 (or `BETA`), the bow from rest at constant acceleration to
 /// 0.1 m/s (0: landing at speed) at constant force, 0.6 s; printed: the time from the
-/// landing to established Helmholtz motion ([`helmholtz_since`]), ms. `cargo test --release
-/// -p colophony-lab --test attack_survey guettler -- --ignored --nocapture`.
+/// landing to established Helmholtz motion ([`helmholtz_since`]), ms. `FORCE_SCALE`
+/// multiplies the forces (1: 0.25-6 N, 0.05-1.2 of the D string's `F_max`; the C string's
+/// `F_max` is 3.77 times the D string's, the G string's 1.65, the A string's 1.0);
+/// `STIFF=0` turns the strings' dispersion sections off.
+/// `cargo test --release -p colophony-lab --test attack_survey guettler -- --ignored
+/// --nocapture`.
 #[test]
 #[ignore]
 fn guettler_diagram_survey() {
     use colophony::measure::regime::helmholtz_since;
     let note: u8 = std::env::var("NOTE").map_or(50, |s| s.parse().expect("NOTE: a MIDI note"));
     let beta: f64 = std::env::var("BETA").map_or(0.1, |s| s.parse().expect("BETA: 0.02-0.25"));
+    let scale: f64 =
+        std::env::var("FORCE_SCALE").map_or(1.0, |s| s.parse().expect("FORCE_SCALE: a factor"));
+    let stiff = std::env::var("STIFF").map_or(true, |s| s != "0");
     let f0 = midi_to_hz(note as f64);
     let accels = [0.0, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0];
     println!("cello note {note}, beta {beta}: rows bow force (N), columns acceleration (m/s^2; 0: landing at speed); ms to Helmholtz motion");
@@ -120,10 +127,10 @@ fn guettler_diagram_survey() {
         "      {}",
         accels.iter().map(|a| format!("{a:>7}")).collect::<String>()
     );
-    for force_n in [0.25, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 6.0] {
-        let mut row = format!("{force_n:>5} ");
+    for force_n in [0.25, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 6.0].map(|f| f * scale) {
+        let mut row = format!("{force_n:>5.2} ");
         for &a in &accels {
-            let probe = bare_cello_probe(note, force_n, beta, (0.6 * FS) as usize, true, |i| {
+            let probe = bare_cello_probe(note, force_n, beta, (0.6 * FS) as usize, stiff, |i| {
                 if a == 0.0 {
                     0.1
                 } else {

@@ -1431,6 +1431,44 @@ mod tests {
         assert!(worst(&fine) < worst(&at_48k) && worst(&at_48k) < worst(&none));
     }
 
+    /// Every instrument's open strings at the rate the point-bow instrument runs them:
+    /// the fitted loop's partials against the stiff string's `n F sqrt(1 + B n^2)`, cents
+    /// above the harmonic `n f1`. A survey for docs/playing-space.md: `cargo test
+    /// --release -p colophony --lib dispersion_fit_on_every_open_string -- --ignored
+    /// --nocapture`.
+    #[test]
+    #[ignore]
+    fn dispersion_fit_on_every_open_string_survey() {
+        use crate::dsp::vocabulary::InstrumentKind;
+        for kind in InstrumentKind::ALL {
+            for (i, spec) in kind.strings().iter().enumerate() {
+                let fs = 48_000.0 * kind.spec().point_oversampling[i] as f64;
+                let mut s = WaveguideString::new(*spec, fs, 30.0);
+                let (f1, b) = (spec.open_hz, spec.inharmonicity_open);
+                s.stop_at(f1);
+                let big_f = f1 / (1.0 + b).sqrt();
+                let row: Vec<String> = [2usize, 5, 10, 15, 20, 25, 30, 40]
+                    .iter()
+                    .filter(|&&n| n as f64 * f1 < 0.45 * fs)
+                    .map(|&n| {
+                        let target = n as f64 * big_f * (1.0 + b * (n * n) as f64).sqrt();
+                        let cents = |f: f64| 1200.0 * (f / (n as f64 * f1)).log2();
+                        let got = s.partial_hz(n);
+                        assert!(got.is_finite() && got > 0.0);
+                        format!("{n}: {:+.0} / {:+.0}", cents(got), cents(target))
+                    })
+                    .collect();
+                println!(
+                    "{} string {i} ({f1:.1} Hz, B {b:.1e}, {} sections at {} kHz), partial: fitted / stiff string (cents) {}",
+                    kind.name(),
+                    s.dispersion_stages(),
+                    fs / 1000.0,
+                    row.join(", ")
+                );
+            }
+        }
+    }
+
     #[test]
     fn strings_too_high_for_the_sample_rate_are_silent_not_mistuned() {
         let mut s = WaveguideString::new(cello_d(), 1000.0, 60.0);
