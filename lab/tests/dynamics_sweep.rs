@@ -10,7 +10,9 @@
 //! survey, printed, not asserted (docs/testing.md, "Dynamics"). `cargo test
 //! --release -p colophony-lab --test dynamics_sweep -- --ignored --nocapture` (about
 //! 3 min on two cores; `MODELS=hyperbolic,thermal` for some of the models, `LEVELS=85,106`
-//! for other levels).
+//! for other levels, `VELOCITY=64` for another note velocity, `PREROLL_MS=200` to let
+//! the dynamics settle before the note: set just before it, the dynamics' smoothing
+//! starts each note from the performer's resting full expression).
 use colophony::analysis::{cents, peak_frequency_hz, rms};
 use colophony::dsp::friction::FrictionModel;
 use colophony::dsp::vocabulary::{midi_to_hz, BowControl, InstrumentKind};
@@ -50,7 +52,15 @@ fn play(
     // As the plugin does: the block's setup (the source among it) before its events.
     p.configure(&setup);
     p.set_controller(11, cc11 as f32 / 127.0);
-    p.note_on(note, 100.0 / 127.0);
+    if let Ok(ms) = std::env::var("PREROLL_MS") {
+        let ms: f64 = ms.parse().expect("PREROLL_MS: milliseconds");
+        for _ in 0..(ms * FS / 1000.0) as usize {
+            p.tick(BowControl::default());
+        }
+    }
+    let velocity: f32 =
+        std::env::var("VELOCITY").map_or(100.0, |s| s.parse().expect("VELOCITY: 1-127"));
+    p.note_on(note, velocity / 127.0);
     let n = (SECONDS * FS) as usize;
     let from = (FROM_S * FS) as usize;
     let mut audio = Vec::with_capacity(n - from);
