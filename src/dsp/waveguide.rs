@@ -881,6 +881,13 @@ fn flush(x: f64) -> f64 {
     super::filters::flush_tiny(x)
 }
 
+/// The stiff string's `n`-th partial, Hz, for a string sounding `f1` with inharmonicity
+/// `b`: `n F sqrt(1 + b n^2)`, `F = f1 / sqrt(1 + b)` (so partial 1 is `f1`).
+fn stiff_partial_hz(f1: f64, b: f64, n: usize) -> f64 {
+    let big_f = f1 / (1.0 + b).sqrt();
+    n as f64 * big_f * (1.0 + b * (n * n) as f64).sqrt()
+}
+
 /// Chooses the number of first-order allpass sections and their common coefficient so that
 /// the loop's partials follow `f_n = n F sqrt(1 + B n^2)` (least squares in cents over the
 /// partials below `FIT_MAX_HZ` and 0.4 fs), with the fundamental tuned exactly afterwards.
@@ -894,11 +901,10 @@ fn fit_dispersion(
     budget: f64,
     cap: usize,
 ) -> (usize, f64) {
-    let big_f = f1 / (1.0 + b).sqrt();
     let mut partials = [0.0f64; MAX_FIT_PARTIALS];
     let mut count = 0;
     for n in 2..=MAX_FIT_PARTIALS + 1 {
-        let f_n = n as f64 * big_f * (1.0 + b * (n * n) as f64).sqrt();
+        let f_n = stiff_partial_hz(f1, b, n);
         if f_n > FIT_MAX_HZ.min(0.4 * fs) {
             break;
         }
@@ -1397,11 +1403,10 @@ mod tests {
             let w = 2.0 * PI * f / fs;
             stages as f64 * Allpass1::phase_delay(a, w) + s.loss.phase_delay(w)
         };
-        let big_f = f1 / (1.0 + b).sqrt();
         [2usize, 5, 10, 20]
             .iter()
             .map(|&k| {
-                let f_n = k as f64 * big_f * (1.0 + b * (k * k) as f64).sqrt();
+                let f_n = stiff_partial_hz(f1, b, k);
                 let heard = k as f64 * fs / (fs / f1 + g(f_n) - g(f1));
                 1200.0 * (heard / f_n).log2()
             })
@@ -1446,12 +1451,11 @@ mod tests {
                 let mut s = WaveguideString::new(*spec, fs, 30.0);
                 let (f1, b) = (spec.open_hz, spec.inharmonicity_open);
                 s.stop_at(f1);
-                let big_f = f1 / (1.0 + b).sqrt();
                 let row: Vec<String> = [2usize, 5, 10, 15, 20, 25, 30, 40]
                     .iter()
                     .filter(|&&n| n as f64 * f1 < 0.45 * fs)
                     .map(|&n| {
-                        let target = n as f64 * big_f * (1.0 + b * (n * n) as f64).sqrt();
+                        let target = stiff_partial_hz(f1, b, n);
                         let cents = |f: f64| 1200.0 * (f / (n as f64 * f1)).log2();
                         let got = s.partial_hz(n);
                         assert!(got.is_finite() && got > 0.0);
