@@ -161,15 +161,18 @@ fn fill_gaps(values: &mut [f64]) {
 }
 
 /// Runs `passes` passes at `rate_hz` for `models` and returns the table and a report;
-/// with `dynamics`, instead, as many for each of [`SOFT_EXPRESSIONS`], starting from the
-/// shipped table's full-expression corrections, which stay (the point laws only: paper
-/// B's thermal bow slides at the soft dynamics, docs/testing.md, "Dynamics").
+/// with `dynamics`, instead, as many for each of [`SOFT_EXPRESSIONS`] (those within 0.001
+/// of one of `expressions`, or all where it is empty), lowest first, each starting from
+/// the correction the shipped table interpolates there without it; the full expression's
+/// corrections stay (the point laws only: paper B's thermal bow slides at the soft
+/// dynamics, docs/testing.md, "Dynamics").
 pub fn fit(
     models: &[Model],
     kinds: &[InstrumentKind],
     rate_hz: f64,
     passes: usize,
     dynamics: bool,
+    expressions: &[f64],
 ) -> Result<(IntonationTable, String), String> {
     if !dynamics {
         return fit_full(models, kinds, rate_hz, passes);
@@ -183,6 +186,13 @@ pub fn fit(
             .filter(|m| matches!(m, Model::Point(_)))
             .collect();
         for level in 0..SOFT_EXPRESSIONS.len() {
+            let asked = expressions.is_empty()
+                || expressions
+                    .iter()
+                    .any(|e| (e - SOFT_EXPRESSIONS[level]).abs() < 1e-3);
+            if !asked {
+                continue;
+            }
             let more = fit_soft(&mut table, &points, kinds, rate_hz, passes, level)?;
             report += &more;
         }
@@ -202,8 +212,9 @@ fn progress(n: usize) -> indicatif::ProgressBar {
 }
 
 /// The passes at soft expression `level` ([`SOFT_EXPRESSIONS`]) for `models`, starting
-/// from the full expression's corrections: each pass bows with the table so far and
-/// adds its residuals to the entries at that level.
+/// from what the table interpolates there without the level (between its neighbours):
+/// each pass bows with the table so far and adds its residuals to the entries at that
+/// level.
 fn fit_soft(
     table: &mut IntonationTable,
     models: &[Model],
@@ -217,8 +228,9 @@ fn fit_soft(
     let mut report = String::new();
     for e in &entries {
         let row = e.model.row();
-        let full = table.get(row, e.kind, e.string, e.semitone);
-        table.set_soft(row, e.kind, e.string, e.semitone, level, full);
+        table.set_soft(row, e.kind, e.string, e.semitone, level, f64::NAN);
+        let between = table.correction_at(row, e.kind, e.string, e.semitone as f64, expression);
+        table.set_soft(row, e.kind, e.string, e.semitone, level, between);
     }
     for pass in 0..passes.max(1) {
         let current: &'static IntonationTable = Box::leak(Box::new(table.clone()));
@@ -465,6 +477,7 @@ pub fn run(
     rate_hz: f64,
     passes: usize,
     dynamics: bool,
+    expressions: &[f64],
     free: bool,
 ) -> Result<String, String> {
     if free {
@@ -472,7 +485,7 @@ pub fn run(
         let (table, report) = fit_free(kinds, rate_hz, passes)?;
         return write_table(out, &table, rate_hz).map(|done| format!("{report}{done}"));
     }
-    let (table, report) = fit(models, kinds, rate_hz, passes, dynamics)?;
+    let (table, report) = fit(models, kinds, rate_hz, passes, dynamics, expressions)?;
     // Models and instruments not fitted keep the shipped entries (and, without
     // `dynamics`, their soft ones).
     let mut merged = colophony::dsp::intonation::shipped().clone();

@@ -163,6 +163,10 @@ enum Command {
         /// passes again for each; the shipped table has them).
         #[arg(long)]
         dynamics: bool,
+        /// intonation --dynamics: fit only these soft expressions (0..1, comma-separated;
+        /// default every one the table holds), the others kept as shipped.
+        #[arg(long, value_delimiter = ',')]
+        expressions: Vec<f64>,
         /// intonation: fit paper B's thermal strings' plucked notes instead (the table's
         /// thermal-free rows: each note moved so that it rings in tune).
         #[arg(long)]
@@ -431,6 +435,7 @@ fn main() -> ExitCode {
             instruments,
             passes,
             dynamics,
+            expressions,
             free,
             seconds,
             attack,
@@ -465,7 +470,7 @@ fn main() -> ExitCode {
                 Some(file) => colophony_lab::playing_space::Plan::from_options(false, &rates, None, &models, &instruments)
                     .and_then(|plan| {
                         let rate = if rates.is_empty() { 48_000.0 } else { plan.rates_hz[0] };
-                        colophony_lab::intonation_fit::run(&file, &plan.models, &plan.kinds, rate, passes.unwrap_or(2), dynamics, free)
+                        colophony_lab::intonation_fit::run(&file, &plan.models, &plan.kinds, rate, passes.unwrap_or(2), dynamics, &expressions, free)
                     }),
                 None => Err("bench intonation needs --out FILE (the shipped one: assets/intonation.csv)".into()),
             },

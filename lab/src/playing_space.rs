@@ -62,7 +62,7 @@ use colophony::measure::regime::{classify_regime, helmholtz_since, Regime};
 use colophony::measure::window::{model_coefficients, SchellengWindow};
 use colophony::performer::catch::{catches, Catch, CatchRule};
 use colophony::performer::stroke::{Stroke, StrokeMode};
-use colophony::performer::{DYNAMICS_DRIFT_EXPONENT, DYNAMICS_RANGE_DB};
+use colophony::performer::{guarded_bow, DYNAMICS_RANGE_DB};
 use colophony::quality::{Quality, GOOD_NODES};
 use rayon::prelude::*;
 use std::fmt::Write as _;
@@ -305,19 +305,23 @@ impl Cell {
     }
 
     /// The cell at the dynamics' `expression` (0..=1) as the performer plays it with the
-    /// Dynamics Guard on: the bow's speed and force scaled by
-    /// `10^(-range (1 - e) / 20)` ([`DYNAMICS_RANGE_DB`]), the bow moved from the bridge
-    /// by that scale to the power `-`[`DYNAMICS_DRIFT_EXPONENT`], and the engine's
+    /// Dynamics Guard on: at the scale `10^(-range (1 - e) / 20)` ([`DYNAMICS_RANGE_DB`]),
+    /// the bow's speed and force scaled and the bow moved from the bridge as
+    /// [`guarded_bow`] says (no slower than the model's slowest bow), and the engine's
     /// intonation told the expression.
     pub fn at_expression(self, expression: f64) -> Self {
         let e = expression.clamp(0.0, 1.0);
         let scale = 10f64.powf(-DYNAMICS_RANGE_DB * (1.0 - e) / 20.0);
-        let beta = (self.bow.position_beta * scale.powf(-DYNAMICS_DRIFT_EXPONENT))
-            .clamp(MIN_NOTE_BETA, MAX_NOTE_BETA);
+        let law = match self.model {
+            Model::Point(law) => Some(law),
+            Model::Thermal => None,
+        };
+        let (speed, away) = guarded_bow(law, self.kind, scale);
+        let beta = (self.bow.position_beta * away).clamp(MIN_NOTE_BETA, MAX_NOTE_BETA);
         Self {
             bow: BowControl {
-                velocity_m_per_s: self.bow.velocity_m_per_s * scale,
-                force_n: self.bow.force_n * scale,
+                velocity_m_per_s: self.bow.velocity_m_per_s * speed,
+                force_n: self.bow.force_n * speed,
                 position_beta: beta,
             },
             expression: e,

@@ -429,7 +429,14 @@ mod tests {
         let mut table = IntonationTable::zero();
         // F#3 on the D string (4 semitones up): +2 cents at full expression, +14 at a third.
         table.set(0, kind, 2, 4, 2.0);
-        table.set_soft(0, kind, 2, 4, 1, 14.0);
+        table.set_soft(
+            0,
+            kind,
+            2,
+            4,
+            intonation::soft_level(1.0 / 3.0).unwrap(),
+            14.0,
+        );
         let mut f = Fingering::new(kind, Some(0));
         f.set_intonation(Some(Box::leak(Box::new(table))));
         let string = f.string_for_note_on(54).unwrap();

@@ -71,9 +71,25 @@ fn rows() -> impl Iterator<Item = (usize, &'static str)> {
         .chain(std::iter::once((THERMAL_FREE_ROW, THERMAL_FREE_NAME)))
 }
 
-/// The expressions below full (1) the table holds corrections for: the dynamics at 0, a
-/// third and two thirds (CC11 0, 42 and 85).
-pub const SOFT_EXPRESSIONS: [f64; 3] = [0.0, 1.0 / 3.0, 2.0 / 3.0];
+/// The expressions below full (1) the table may hold corrections for: the dynamics at 0,
+/// then every twelfth from a quarter (CC11 0, 32, 42, 53, 64, 74, 85, 95, 106, 116). The
+/// Stribeck-type laws' bowed pitch moves by up to 30 cents between a third and two thirds
+/// and not along a line (docs/testing.md, "Dynamics"), so they are fitted at every level;
+/// the hyperbolic law's moves little and is fitted at 0, 1/3 and 2/3 only. Below a
+/// quarter the Stribeck laws' guard holds the violin's and viola's bow at its slowest
+/// (`STRIBECK_SLOWEST_SCALE`), so nothing lies between 0 and 1/4 to fit.
+pub const SOFT_EXPRESSIONS: [f64; 10] = [
+    0.0,
+    3.0 / 12.0,
+    4.0 / 12.0,
+    5.0 / 12.0,
+    6.0 / 12.0,
+    7.0 / 12.0,
+    8.0 / 12.0,
+    9.0 / 12.0,
+    10.0 / 12.0,
+    11.0 / 12.0,
+];
 
 /// A model the table holds corrections for: one of paper A's point laws on the waveguide
 /// strings ([`FrictionModel::ALL`], each by its `name()`), or paper B's thermal bow
@@ -191,8 +207,9 @@ fn index(model: usize, kind: InstrumentKind, string: usize, semitone: usize) -> 
     ((model * InstrumentKind::COUNT + kind.index()) * STRINGS + string) * SEMITONES + semitone
 }
 
-/// The place of `expression` among [`SOFT_EXPRESSIONS`], if it is one of them.
-fn soft_level(expression: f64) -> Option<usize> {
+/// The place of `expression` among [`SOFT_EXPRESSIONS`], if it is one of them (within
+/// 0.001).
+pub fn soft_level(expression: f64) -> Option<usize> {
     SOFT_EXPRESSIONS
         .iter()
         .position(|&e| (e - expression).abs() < 1e-3)
@@ -240,8 +257,9 @@ impl IntonationTable {
         self.soft[index(model, kind, string, semitone) * SOFT_EXPRESSIONS.len() + level] = c;
     }
 
-    /// One entry at `expression` (0..=1): linear between [`SOFT_EXPRESSIONS`] and full,
-    /// a level the table does not hold taking the full expression's correction.
+    /// One entry at `expression` (0..=1): linear between the levels of
+    /// [`SOFT_EXPRESSIONS`] the table holds for it and full expression (the levels it does
+    /// not hold are passed over; below the lowest it holds, that one's correction).
     fn entry_at(
         &self,
         model: usize,
@@ -254,29 +272,24 @@ impl IntonationTable {
         if expression >= 1.0 {
             return full;
         }
-        let at = |level: usize| {
-            if level == SOFT_EXPRESSIONS.len() {
-                return full;
-            }
-            let c = self.get_soft(model, kind, string, semitone, level);
-            if c.is_nan() {
-                full
-            } else {
-                c
-            }
-        };
         let e = expression.max(0.0);
-        let upper = SOFT_EXPRESSIONS
-            .iter()
-            .position(|&x| x > e)
-            .unwrap_or(SOFT_EXPRESSIONS.len());
-        if upper == 0 {
-            return at(0);
+        let held = |level: usize| {
+            let c = self.get_soft(model, kind, string, semitone, level);
+            (!c.is_nan()).then_some((SOFT_EXPRESSIONS[level], c))
+        };
+        // The nearest held levels either side of `e` (full expression above them all).
+        let below = (0..SOFT_EXPRESSIONS.len())
+            .rev()
+            .filter(|&l| SOFT_EXPRESSIONS[l] <= e)
+            .find_map(held);
+        let above = (0..SOFT_EXPRESSIONS.len())
+            .filter(|&l| SOFT_EXPRESSIONS[l] > e)
+            .find_map(held)
+            .unwrap_or((1.0, full));
+        match below {
+            Some((lo, a)) => a + (e - lo) / (above.0 - lo) * (above.1 - a),
+            None => above.1,
         }
-        let lo = SOFT_EXPRESSIONS[upper - 1];
-        let hi = SOFT_EXPRESSIONS.get(upper).copied().unwrap_or(1.0);
-        let t = (e - lo) / (hi - lo);
-        at(upper - 1) + t * (at(upper) - at(upper - 1))
     }
 
     /// The correction of one table entry, cents.
@@ -459,7 +472,8 @@ mod tests {
         let mut t = IntonationTable::zero();
         t.set(2, InstrumentKind::Viola, 3, 17, -4.25);
         t.set(4, InstrumentKind::Cello, 0, 0, 12.5);
-        t.set_soft(0, InstrumentKind::Cello, 2, 4, 1, 7.75);
+        let third = soft_level(1.0 / 3.0).unwrap();
+        t.set_soft(0, InstrumentKind::Cello, 2, 4, third, 7.75);
         t.set(THERMAL_FREE_ROW, InstrumentKind::DoubleBass, 1, 9, 8.5);
         assert_eq!(IntonationTable::parse(&t.to_csv()).unwrap(), t);
         // The table without the expression column is read at full expression.
@@ -470,19 +484,25 @@ mod tests {
     }
 
     #[test]
-    fn corrections_interpolate_across_the_dynamics_and_fall_back_to_full_expression() {
+    fn corrections_interpolate_across_the_held_dynamics_and_fall_back_to_full_expression() {
         let mut t = IntonationTable::zero();
         let k = InstrumentKind::Cello;
         t.set(0, k, 2, 4, 2.0);
-        t.set_soft(0, k, 2, 4, 0, 20.0);
-        t.set_soft(0, k, 2, 4, 1, 14.0);
-        // Level 2 (two thirds) is not held: the full expression's 2 cents stand there.
+        t.set_soft(0, k, 2, 4, soft_level(0.0).unwrap(), 20.0);
+        t.set_soft(0, k, 2, 4, soft_level(1.0 / 3.0).unwrap(), 14.0);
+        // No other level is held: the line runs from 0 to a third, then on to full
+        // expression's 2 cents.
         assert_eq!(t.correction_at(0, k, 2, 4.0, 1.0), 2.0);
         assert_eq!(t.correction_at(0, k, 2, 4.0, 0.0), 20.0);
         assert_eq!(t.correction_at(0, k, 2, 4.0, 1.0 / 3.0), 14.0);
-        // Halfway from 0 to a third, and from a third to two thirds.
+        // Halfway from 0 to a third (past the quarter, not held), and from a third to
+        // full (1e-9: rounding).
         assert!((t.correction_at(0, k, 2, 4.0, 1.0 / 6.0) - 17.0).abs() < 1e-9);
-        assert!((t.correction_at(0, k, 2, 4.0, 0.5) - 8.0).abs() < 1e-9);
+        assert!((t.correction_at(0, k, 2, 4.0, 2.0 / 3.0) - 8.0).abs() < 1e-9);
+        // A level held above a third takes over from full expression there.
+        t.set_soft(0, k, 2, 4, soft_level(0.5).unwrap(), 26.0);
+        assert!((t.correction_at(0, k, 2, 4.0, 5.0 / 12.0) - 20.0).abs() < 1e-9);
+        assert!((t.correction_at(0, k, 2, 4.0, 0.75) - 14.0).abs() < 1e-9);
         // A model with no soft entries keeps its full correction at every expression.
         t.set(4, k, 2, 4, -3.0);
         assert_eq!(t.correction_at(4, k, 2, 4.0, 0.2), -3.0);
@@ -510,7 +530,7 @@ mod tests {
             "model,instrument,string,semitone,cents\nhyperbolic,cello,9,0,1\n",
             "model,instrument,string,semitone,cents\nhyperbolic,lute,0,0,1\n",
             "model,instrument,string,semitone,cents\nhyperbolic,cello,0,0,NaN\n",
-            "model,instrument,string,semitone,expression,cents\nhyperbolic,cello,0,0,0.5,1\n",
+            "model,instrument,string,semitone,expression,cents\nhyperbolic,cello,0,0,0.1,1\n",
             "model,instrument,string,semitone,expression,cents\nhyperbolic,cello,0,0,1\n",
         ] {
             assert!(IntonationTable::parse(bad).is_err(), "{bad:?}");

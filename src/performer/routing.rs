@@ -42,6 +42,9 @@ impl Performer {
             }
         }
         let separate = !self.held.iter().any(|&h| h);
+        if separate {
+            self.land_dynamics();
+        }
         // Portamento: a legato note played softly, or any legato note with CC65 down,
         // slides the finger there on the waveguide strings.
         let glide = !separate
