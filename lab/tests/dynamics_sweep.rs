@@ -10,9 +10,9 @@
 //! survey, printed, not asserted (docs/testing.md, "Dynamics"). `cargo test
 //! --release -p colophony-lab --test dynamics_sweep -- --ignored --nocapture` (about
 //! 3 min on two cores; `MODELS=hyperbolic,thermal` for some of the models, `LEVELS=85,106`
-//! for other levels, `VELOCITY=64` for another note velocity, `PREROLL_MS=200` to let
-//! the dynamics settle before the note: set just before it, the dynamics' smoothing
-//! starts each note from the performer's resting full expression).
+//! for other levels, `VELOCITY=64` for another note velocity, `PREROLL_MS=200` to bow
+//! nothing for a while with the dynamics set first: a separate note lands at the
+//! dynamics sent with it either way).
 use colophony::analysis::{cents, peak_frequency_hz, rms};
 use colophony::dsp::friction::FrictionModel;
 use colophony::dsp::vocabulary::{midi_to_hz, BowControl, InstrumentKind};

@@ -23,9 +23,9 @@
 //! and the bowed pitch moves with it (a slower bow's corners are rounder; up to tens of
 //! cents sharp on the Stribeck-type laws at mezzo piano). So the table also holds, for
 //! the point laws, the correction at the softer expressions [`SOFT_EXPRESSIONS`], fitted
-//! the same way with the bow the performer plays there; between them, and up to full
-//! expression, it is interpolated linearly, and an expression the table does not hold
-//! (paper B's thermal bow) takes the full expression's correction.
+//! the same way with the bow the performer plays there; between the ones it holds, and
+//! up to full expression, it is interpolated linearly, and a model with none (paper B's
+//! thermal bow) takes the full expression's correction.
 //!
 //! A plucked or struck note sounds its free ring, not the bowed sound. The point-bow
 //! strings ring where they are tuned; paper B's thermal strings, coupled through their
