@@ -315,15 +315,13 @@ impl Performer {
         out
     }
 
-    /// The point law the source bows with (`None`: paper B's thermal bow), or `Err` for a
-    /// rubbed source (no window guard floor).
-    fn bow_law(&self) -> Result<Option<FrictionModel>, ()> {
+    /// The law whose slowest bow and drift the guard plays the source with (`None`:
+    /// paper B's thermal bow; a rubbed source takes the hyperbolic law's: no floor).
+    fn bow_law(&self) -> Option<FrictionModel> {
         match self.source {
-            Source::Strings => Ok(Some(
-                self.setup.point_law.unwrap_or(FrictionModel::Hyperbolic),
-            )),
-            Source::Thermal(_) => Ok(None),
-            Source::Rubbed(_) => Err(()),
+            Source::Thermal(_) => None,
+            Source::Strings => Some(self.setup.point_law.unwrap_or(FrictionModel::Hyperbolic)),
+            Source::Rubbed(_) => Some(FrictionModel::Hyperbolic),
         }
     }
 
@@ -347,29 +345,21 @@ impl Performer {
     /// The source's slowest scale of the parameters' bow ([`slowest_bow_scale`]), below
     /// which its string slides; `None` for the hyperbolic law and the rubbed sources.
     fn slowest_bow_scale(&self) -> Option<f64> {
-        self.bow_law()
-            .ok()
-            .and_then(|law| slowest_bow_scale(law, self.setup.instrument))
+        slowest_bow_scale(self.bow_law(), self.setup.instrument)
     }
 
     /// [`guarded_bow`] for the source at the dynamics' bow scale `scale`.
     fn guarded_bow(&self, scale: f64) -> (f64, f64) {
-        match self.bow_law() {
-            Ok(law) => guarded_bow(law, self.setup.instrument, scale),
-            Err(()) => guarded_bow(
-                Some(FrictionModel::Hyperbolic),
-                self.setup.instrument,
-                scale,
-            ),
-        }
+        guarded_bow(self.bow_law(), self.setup.instrument, scale)
     }
 
     /// The dynamics' factor on the bow's speed at the dynamics' scale `scale`: with the
     /// guard, no lower than the source's slowest bow scale.
     fn dynamics_velocity_scale(&self, scale: f64) -> f64 {
-        match self.slowest_bow_scale() {
-            Some(slowest) if self.setup.dynamics_guard => scale.max(slowest),
-            _ => scale,
+        if self.setup.dynamics_guard {
+            self.guarded_bow(scale).0
+        } else {
+            scale
         }
     }
 
