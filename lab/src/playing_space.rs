@@ -316,12 +316,12 @@ impl Cell {
             Model::Point(law) => Some(law),
             Model::Thermal => None,
         };
-        let (speed, away) = guarded_bow(law, self.kind, scale);
-        let beta = (self.bow.position_beta * away).clamp(MIN_NOTE_BETA, MAX_NOTE_BETA);
+        let guarded = guarded_bow(law, self.kind, scale);
+        let beta = (self.bow.position_beta * guarded.away).clamp(MIN_NOTE_BETA, MAX_NOTE_BETA);
         Self {
             bow: BowControl {
-                velocity_m_per_s: self.bow.velocity_m_per_s * speed,
-                force_n: self.bow.force_n * speed,
+                velocity_m_per_s: self.bow.velocity_m_per_s * guarded.speed,
+                force_n: self.bow.force_n * guarded.force,
                 position_beta: beta,
             },
             expression: e,

@@ -249,3 +249,82 @@ fn play_bow(setup: &Setup, note: u8, bow: BowControl) -> (f64, f64, Option<Regim
     p.note_on(note, 100.0 / 127.0);
     measure(&mut p, setup, note, bow)
 }
+
+/// The share of every note in Helmholtz motion at the middle dynamics with the force
+/// below the guard's: every third semitone as in [`dynamics_sweep_survey`], the static
+/// law (`LAW=lugre` for another), bowed directly (guard off) at the guard's speed and
+/// distance from the bridge for CC11 53-85 and `F` times the guard's force (`F=1,0.7,0.5,0.35`
+/// by default). Printed per instrument, level and force: notes in Helmholtz motion of 13
+/// (any pitch: the intonation table is fitted for the guard's force), and the slip's
+/// negative damping `F |mu'(v_slip)|` over the reference string's `2 Z0` at the guard's
+/// force (`v_slip = v_b (1 - beta) / beta`). `cargo test --release -p colophony-lab --test
+/// dynamics_sweep mid_dynamics_force_map -- --ignored --nocapture` (about 16 min).
+#[test]
+#[ignore]
+fn mid_dynamics_force_map() {
+    let law = match std::env::var("LAW").as_deref() {
+        Ok("lugre") => FrictionModel::LuGre,
+        Ok("elasto-plastic") => FrictionModel::ElastoPlastic,
+        _ => FrictionModel::Stribeck,
+    };
+    let factors: Vec<f64> = std::env::var("F").map_or(vec![1.0, 0.7, 0.5, 0.35], |s| {
+        s.split(',')
+            .map(|x| x.parse().expect("F: factors"))
+            .collect()
+    });
+    let ccs = [53u8, 58, 64, 69, 74, 80, 85];
+    for kind in InstrumentKind::ALL {
+        let (low, high) = kind.note_range();
+        let notes: Vec<u8> = (low..=high.min(low + 36)).step_by(3).collect();
+        for &cc in &ccs {
+            let s = 10f64
+                .powf(-colophony::performer::DYNAMICS_RANGE_DB * (1.0 - cc as f64 / 127.0) / 20.0);
+            let guarded = colophony::performer::guarded_bow(Some(law), kind, s);
+            let (speed, away) = (guarded.speed, guarded.away);
+            let bow0 = BowControl::default();
+            let (v, beta) = (bow0.velocity_m_per_s * speed, bow0.position_beta * away);
+            let x = v * (1.0 - beta) / beta / 0.1;
+            let damping = bow0.force_n * speed * 0.2 * 2.0 * x * (-x * x).exp()
+                / 0.1
+                / (2.0 * colophony::dsp::vocabulary::WEIGHT_REFERENCE_Z0);
+            let setup = Setup {
+                instrument: kind,
+                point_law: Some(law),
+                dynamics_guard: false,
+                ..Setup::default()
+            };
+            let cells: Vec<String> = factors
+                .iter()
+                .map(|&f| {
+                    let bow = BowControl {
+                        velocity_m_per_s: v,
+                        force_n: bow0.force_n * speed * f,
+                        position_beta: beta,
+                    };
+                    let results: Vec<(u8, Option<Regime>, f64)> = notes
+                        .par_iter()
+                        .map(|&note| {
+                            let (_, c, g) = play_bow(&setup, note, bow);
+                            (note, g, c)
+                        })
+                        .collect();
+                    let h = results
+                        .iter()
+                        .filter(|r| r.1 == Some(Regime::Helmholtz))
+                        .count();
+                    let off: Vec<String> = results
+                        .iter()
+                        .filter(|r| r.1 != Some(Regime::Helmholtz))
+                        .map(|r| format!("{}{}", r.0, regime_name(r.1)))
+                        .collect();
+                    format!("x{f}: {h}/{} [{}]", notes.len(), off.join(" "))
+                })
+                .collect();
+            println!(
+                "{} {kind:?} CC11 {cc} (slip {x:.2} v_s, damping {damping:.2}): {}",
+                law.name(),
+                cells.join("; ")
+            );
+        }
+    }
+}
