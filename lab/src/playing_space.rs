@@ -177,6 +177,9 @@ pub struct Cell {
     /// The dynamics' expression the engine's intonation follows (1: full, as the map
     /// bows; [`Cell::at_expression`] also plays the bow the Dynamics Guard plays there).
     pub expression: f64,
+    /// Whether [`Attack::Performer`] catches the note as the plugin does (the default); a
+    /// research knob: what the catch does at each dynamic.
+    pub performer_catch: bool,
     /// The most dispersion sections each point-bow string may fit (`None`: the plugin's
     /// [`colophony::dsp::waveguide::DEFAULT_DISPERSION_STAGES`]; 0: strings without
     /// stiffness). A research knob: what the strings' stiffness does to the map.
@@ -300,6 +303,7 @@ impl Cell {
             attack: Attack::Landing,
             thermal: ThermalParams::default(),
             expression: 1.0,
+            performer_catch: true,
             dispersion_stages: None,
         }
     }
@@ -466,23 +470,26 @@ impl Catcher {
         // The performer catches a note of velocity above mezzo on the cell's own window.
         let bow = cell.bow;
         let velocity = PERFORMER_VELOCITY as f64 / 127.0;
-        let performer_catch = stroke.as_ref().filter(|_| catches(velocity)).and_then(|_| {
-            Catch::new(
-                cell_window(
-                    cell.model,
-                    cell.kind,
-                    cell.note,
-                    cell.string,
-                    bow.position_beta,
-                ),
-                CatchRule::for_law(match cell.model {
-                    Model::Point(law) => Some(law),
-                    Model::Thermal => None,
-                }),
-                cell.nominal_hz(),
-                cell.rate_hz,
-            )
-        });
+        let performer_catch = stroke
+            .as_ref()
+            .filter(|_| cell.performer_catch && catches(velocity))
+            .and_then(|_| {
+                Catch::new(
+                    cell_window(
+                        cell.model,
+                        cell.kind,
+                        cell.note,
+                        cell.string,
+                        bow.position_beta,
+                    ),
+                    CatchRule::for_law(match cell.model {
+                        Model::Point(law) => Some(law),
+                        Model::Thermal => None,
+                    }),
+                    cell.nominal_hz(),
+                    cell.rate_hz,
+                )
+            });
         Self {
             bow: cell.bow,
             stroke,

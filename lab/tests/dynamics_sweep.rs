@@ -403,8 +403,9 @@ fn attack_short_slip_survey() {
 /// (docs/testing.md, "What still fails: CC11 80-85"): each note off the map's full
 /// criterion or more than 10 cents from its pitch, with its cents, its slip fraction over
 /// beta and its slips a period. `LAW=static|lugre|elasto-plastic|hyperbolic` (LuGre
-/// without), `CCS=80,85` for the levels, `LANDING=1` for the map's landing instead.
-/// `cargo test --release -p colophony-lab --test dynamics_sweep short_slip_map --
+/// without), `CCS=80,85` for the levels, `LANDING=1` for the map's landing instead,
+/// `NO_CATCH=1` for the performer's attack without its catch. Also printed: when lasting
+/// Helmholtz motion began, median and 90th percentile over the notes. `cargo test --release -p colophony-lab --test dynamics_sweep short_slip_map --
 /// --ignored --nocapture` (about 15 s).
 #[test]
 #[ignore]
@@ -434,15 +435,16 @@ fn short_slip_map() {
         let (low, high) = kind.note_range();
         let notes: Vec<u8> = (low..=high.min(low + 36)).step_by(3).collect();
         for &cc in &levels {
-            let off: Vec<String> = notes
+            let results: Vec<(Option<String>, Option<f64>)> = notes
                 .par_iter()
-                .filter_map(|&note| {
+                .map(|&note| {
                     let mut cell =
                         Cell::new(Model::Point(law), kind, note, FS, Bowing::Defaults, SECONDS)
                             .at_expression(cc / 127.0);
                     cell.attack = attack;
+                    cell.performer_catch = std::env::var("NO_CATCH").is_err();
                     let m = measure_cell(&cell).expect("measure");
-                    (!m.helmholtz || m.cents.abs() > 10.0).then(|| {
+                    let off = (!m.helmholtz || m.cents.abs() > 10.0).then(|| {
                         format!(
                             "{note}:{}{:+.0} c, slip {:.2} beta, {:.1} a period",
                             if m.helmholtz { "H" } else { "x" },
@@ -450,15 +452,27 @@ fn short_slip_map() {
                             m.slip_fraction / cell.bow.position_beta,
                             m.slips_per_period
                         )
-                    })
+                    });
+                    (off, m.speaks_ms)
                 })
                 .collect();
+            let off: Vec<&String> = results.iter().filter_map(|r| r.0.as_ref()).collect();
+            // When lasting Helmholtz motion began: the median and the 90th percentile over
+            // the notes, a note that never reached it counting as latest.
+            let mut speaks: Vec<f64> = results
+                .iter()
+                .map(|r| r.1.unwrap_or(f64::INFINITY))
+                .collect();
+            speaks.sort_by(f64::total_cmp);
+            let p90 = speaks[((0.9 * speaks.len() as f64).ceil() as usize).min(speaks.len()) - 1];
             println!(
-                "{} {kind:?} CC11 {cc} ({attack:?}): {} of {} off [{}]",
+                "{} {kind:?} CC11 {cc} ({attack:?}): {} of {} off, spoke by {:.0} ms (median), {:.0} ms (p90) [{}]",
                 law.name(),
                 off.len(),
                 notes.len(),
-                off.join("; ")
+                speaks[speaks.len() / 2],
+                p90,
+                off.iter().map(|s| s.as_str()).collect::<Vec<_>>().join("; ")
             );
         }
     }
