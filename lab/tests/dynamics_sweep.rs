@@ -412,10 +412,7 @@ fn attack_short_slip_survey() {
 fn short_slip_map() {
     use colophony_lab::playing_space::{measure as measure_cell, Attack, Bowing, Cell, Model};
     let law = std::env::var("LAW").map_or(FrictionModel::LuGre, |name| {
-        *FrictionModel::ALL
-            .iter()
-            .find(|m| m.name() == name)
-            .expect("LAW: a point law's name")
+        FrictionModel::from_name(&name).expect("LAW: a point law's name")
     });
     let levels: Vec<f64> = std::env::var("CCS").map_or(vec![80.0, 85.0], |s| {
         s.split(',')
@@ -464,7 +461,7 @@ fn short_slip_map() {
                 .map(|r| r.1.unwrap_or(f64::INFINITY))
                 .collect();
             speaks.sort_by(f64::total_cmp);
-            let p90 = speaks[((0.9 * speaks.len() as f64).ceil() as usize).min(speaks.len()) - 1];
+            let p90 = speaks[(speaks.len() * 9).div_ceil(10) - 1];
             println!(
                 "{} {kind:?} CC11 {cc} ({attack:?}): {} of {} off, spoke by {:.0} ms (median), {:.0} ms (p90) [{}]",
                 law.name(),
