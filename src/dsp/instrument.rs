@@ -35,7 +35,7 @@ use super::halfband::HalfbandDecimator;
 use super::intonation;
 use super::resample::Resampler;
 pub use super::strings::FourStrings;
-use super::strings::{StringBank, StringBow, HARMONIC_FINGER_RESISTANCE_Z0};
+use super::strings::{InternalSample, StringBank, StringBow, HARMONIC_FINGER_RESISTANCE_Z0};
 use super::waveguide::WaveguideString;
 
 use super::vocabulary::*;
@@ -82,6 +82,11 @@ pub struct WaveguideBank {
     decimator: HalfbandDecimator,
     /// Whether quiet lifted strings sleep (the default; off only to measure the saving).
     skipping: bool,
+    /// The strings [`StringBank::sample`] computes, in order: the awake ones (every one
+    /// when not skipping), the first `computed_count` entries
+    /// ([`WaveguideBank::update_computed`]).
+    computed: [usize; STRINGS],
+    computed_count: usize,
     /// No string awake and the body rung out: a sample costs nothing.
     body_asleep: bool,
     /// A mute on the bridge (con sordino, [`super::body::muted`]).
@@ -111,6 +116,19 @@ pub const STICK_MU_D: f64 = 0.12;
 pub type Instrument = FourStrings<WaveguideBank>;
 
 impl WaveguideBank {
+    /// Lists the strings a sample computes, after any change of which are awake or of
+    /// skipping: a sample then walks only those.
+    fn update_computed(&mut self) {
+        let mut count = 0;
+        for (i, voice) in self.voices.iter().enumerate() {
+            if voice.awake || !self.skipping {
+                self.computed[count] = i;
+                count += 1;
+            }
+        }
+        self.computed_count = count;
+    }
+
     /// The rate string `index` runs at: the bank's times its oversampling.
     pub fn string_rate_hz(&self, index: usize) -> f64 {
         self.sample_rate_hz * self.oversample[index.min(STRINGS - 1)] as f64
@@ -192,6 +210,7 @@ impl StringBank for WaveguideBank {
     fn wake(&mut self, i: usize) {
         let voice = &mut self.voices[i];
         voice.awake = voice.string.is_playable();
+        self.update_computed();
     }
 
     fn string_awake(&self, i: usize) -> bool {
@@ -205,6 +224,7 @@ impl StringBank for WaveguideBank {
 
     fn set_skipping(&mut self, skipping: bool) {
         self.skipping = skipping;
+        self.update_computed();
     }
 
     /// One internal sample. Out of line, with the strings and friction inlined into it,
@@ -215,10 +235,23 @@ impl StringBank for WaveguideBank {
     /// this inlined into an out-of-line tick.
     #[inline(never)]
     fn sample(&mut self, probed: usize, bow_of: impl FnMut(usize) -> StringBow) -> f64 {
+        self.sample_inline(probed, bow_of)
+    }
+
+    #[inline(always)]
+    fn sample_inline(&mut self, probed: usize, bow_of: impl FnMut(usize) -> StringBow) -> f64 {
         if self.slow {
             return self.sample_slow(probed, bow_of);
         }
         self.sample_as::<false>(probed, bow_of)
+    }
+
+    /// The block's samples in one out-of-line loop, each one inlined into it.
+    #[inline(never)]
+    fn samples(&mut self, out: &mut [f64], step: &mut impl InternalSample<Self>) {
+        for sample in out {
+            *sample = step.tick(self);
+        }
     }
 
     fn probe(&self) -> (f64, f64) {
@@ -240,6 +273,7 @@ impl StringBank for WaveguideBank {
                 voice.awake = false;
             }
         }
+        self.update_computed();
         self.body_asleep
     }
 
@@ -288,6 +322,7 @@ impl StringBank for WaveguideBank {
             voice.contact.reset();
             voice.awake = false;
         }
+        self.update_computed();
         self.body.reset();
         self.decimator.reset();
         self.probe = (0.0, 0.0);
@@ -329,16 +364,14 @@ impl WaveguideBank {
             }
         };
         // `tick` checked that something is awake; sleep changes only between blocks.
-        let skipping = self.skipping;
         self.body_asleep = false;
         let mut bridge = 0.0;
         // The bridge force of the strings at twice the bank's rate, a pair a bank sample.
         let mut fine = [0.0; 2];
         let mut any_fine = false;
-        for (i, voice) in self.voices.iter_mut().enumerate() {
-            if !voice.awake && skipping {
-                continue;
-            }
+        for k in 0..self.computed_count.min(STRINGS) {
+            let i = self.computed[k] % STRINGS;
+            let voice = &mut self.voices[i];
             let bow = bow_of(i);
             voice.string.set_bow_position(bow.position_beta);
             let input = BowInput {
@@ -461,6 +494,8 @@ impl Instrument {
             oversampling,
             decimator: HalfbandDecimator::new(),
             skipping: true,
+            computed: [0; STRINGS],
+            computed_count: 0,
             body_asleep: true,
             muted: false,
             law: FrictionModel::Hyperbolic,
@@ -499,6 +534,7 @@ impl Instrument {
             voice.contact.set_sample_rate(string_rate_hz);
             voice.awake = false;
         }
+        bank.update_computed();
         bank.body.playing = bank.body_of(kind);
         bank.output_scale = kind.output_scale_per_n();
     }

@@ -147,6 +147,24 @@ pub trait StringBank {
     /// computed, in order, and not for a string that sleeps. `probed`: the string whose
     /// contact [`StringBank::probe`] reports.
     fn sample(&mut self, probed: usize, bow_of: impl FnMut(usize) -> StringBow) -> f64;
+    /// [`StringBank::sample`] inlined where it is called: for a bank's own
+    /// [`StringBank::samples`] loop.
+    #[inline(always)]
+    fn sample_inline(&mut self, probed: usize, bow_of: impl FnMut(usize) -> StringBow) -> f64 {
+        self.sample(probed, bow_of)
+    }
+    /// Internal samples into `out`, each computed by `step`: the samples of a loop of
+    /// `step.tick(self)`, in one call for the block (a bank runs its strings in that loop
+    /// without a call a sample).
+    #[inline(always)]
+    fn samples(&mut self, out: &mut [f64], step: &mut impl InternalSample<Self>)
+    where
+        Self: Sized,
+    {
+        for sample in out {
+            *sample = step.tick(self);
+        }
+    }
     /// The internal samples `out.len()` host samples need, through `resampler`, each
     /// computed by `step` (which sets the bows, moving at the internal rate, and calls
     /// [`StringBank::sample`]).
@@ -254,25 +272,27 @@ pub trait InternalSample<B> {
 }
 
 /// The player's hands with the bow of this host sample: [`InternalSample`] for
-/// [`FourStrings::tick`].
-struct HandsSample<'a> {
+/// [`FourStrings::tick`] (`INLINE` false) and, with the bank's sample inlined into the
+/// bank's loop, for a block's [`StringBank::samples`] (`INLINE` true).
+struct HandsSample<'a, const INLINE: bool> {
     hands: &'a mut Hands,
     bow: BowControl,
 }
 
-impl<B: StringBank> InternalSample<B> for HandsSample<'_> {
+impl<B: StringBank, const INLINE: bool> InternalSample<B> for HandsSample<'_, INLINE> {
     #[inline(always)]
     fn tick(&mut self, bank: &mut B) -> f64 {
-        self.hands.tick(bank, self.bow)
+        self.hands.tick::<B, INLINE>(bank, self.bow)
     }
 }
 
 impl Hands {
     /// One internal sample of `bank` with the player's bow `bow`: the finger's glide, then
     /// the bank's sample, asking for each string's bow as it computes it (the envelope,
-    /// the weighting and the note's expression on the shared bow).
+    /// the weighting and the note's expression on the shared bow). `INLINE`: the bank's
+    /// sample inlined here ([`StringBank::sample_inline`]).
     #[inline(always)]
-    fn tick<B: StringBank>(&mut self, bank: &mut B, bow: BowControl) -> f64 {
+    fn tick<B: StringBank, const INLINE: bool>(&mut self, bank: &mut B, bow: BowControl) -> f64 {
         if self.lifting {
             self.lift_tick(bank);
         }
@@ -287,9 +307,12 @@ impl Hands {
         }
         let divisor = bank.force_divisor();
         let probed = self.probed;
-        bank.sample(probed, move |i| {
-            self.string_bow(i, bow, divisor, B::HARMONIC_BOW_AT_ROOT)
-        })
+        let bow_of = move |i| self.string_bow(i, bow, divisor, B::HARMONIC_BOW_AT_ROOT);
+        if INLINE {
+            bank.sample_inline(probed, bow_of)
+        } else {
+            bank.sample(probed, bow_of)
+        }
     }
 
     /// One internal sample of the lifting fingers: each one's reflection dips to
@@ -975,13 +998,14 @@ impl<B: StringBank> FourStrings<B> {
         let out = match &mut self.resampler {
             None if B::SAMPLE_IS_FLUSHED && self.pending.is_none() => {
                 // One internal sample, already audio: as it is.
-                let audio = self.hands.tick(&mut self.bank, bow) * self.bank.output_gain();
+                let audio =
+                    self.hands.tick::<B, false>(&mut self.bank, bow) * self.bank.output_gain();
                 return self.finish(audio);
             }
-            None => self.hands.tick(&mut self.bank, bow),
+            None => self.hands.tick::<B, false>(&mut self.bank, bow),
             Some(resampler) => {
                 let mut out = [0.0];
-                let step = HandsSample {
+                let step = HandsSample::<false> {
                     hands: &mut self.hands,
                     bow,
                 };
@@ -1027,6 +1051,29 @@ impl<B: StringBank> FourStrings<B> {
     pub fn process(&mut self, bow: BowControl, out: &mut [f64]) {
         if self.skipping && !self.bank.is_awake() {
             out.fill(0.0);
+            return;
+        }
+        if B::SAMPLE_IS_FLUSHED && B::HAS_BODY && self.resampler.is_none() && self.pending.is_none()
+        {
+            // What `tick` does a sample on this path, a stage at a time over the block: the
+            // bank's samples (already audio), then the gain and the radiation.
+            let mut step = HandsSample::<true> {
+                hands: &mut self.hands,
+                bow,
+            };
+            self.bank.samples(out, &mut step);
+            let gain = self.bank.output_gain();
+            for k in 0..out.len() {
+                let audio = self.radiation.tick(out[k] * gain);
+                if !audio.is_finite() {
+                    // As `finish`: silence, and the instrument reset.
+                    self.reset();
+                    self.recoveries += 1;
+                    out[k..].fill(0.0);
+                    return;
+                }
+                out[k] = audio;
+            }
             return;
         }
         for sample in out {
