@@ -267,6 +267,12 @@ impl BodyModes {
 
     #[inline]
     pub fn tick(&mut self, bridge_force_n: f64) -> f64 {
+        self.tick_inline(bridge_force_n)
+    }
+
+    /// [`BodyModes::tick`] inlined where it is called (a block's loop over the body).
+    #[inline(always)]
+    pub fn tick_inline(&mut self, bridge_force_n: f64) -> f64 {
         let x = bridge_force_n;
         let mut out = [0.0; MAX_BODY_MODES];
         for k in 0..MAX_BODY_MODES {

@@ -243,14 +243,33 @@ impl StringBank for WaveguideBank {
         if self.slow {
             return self.sample_slow(probed, bow_of);
         }
-        self.sample_as::<false>(probed, bow_of)
+        self.sample_as::<false, true>(probed, bow_of)
     }
 
-    /// The block's samples in one out-of-line loop, each one inlined into it.
+    /// The strings' bridge force, for [`StringBank::samples`] to run the body over.
+    #[inline(always)]
+    fn strings_inline(&mut self, probed: usize, bow_of: impl FnMut(usize) -> StringBow) -> f64 {
+        self.sample_as::<false, false>(probed, bow_of)
+    }
+
+    /// The block's samples in out-of-line loops, each sample inlined into them: while no
+    /// stick strikes and the body does not fade, the strings' bridge force over the block,
+    /// then the body over it (the same operations on the same values, a stage at a time).
     #[inline(never)]
     fn samples(&mut self, out: &mut [f64], step: &mut impl InternalSample<Self>) {
+        if self.slow {
+            for sample in out {
+                *sample = step.tick(self);
+            }
+            return;
+        }
+        for sample in out.iter_mut() {
+            *sample = step.tick_strings(self);
+        }
+        let body = &mut self.body.playing;
+        let scale = self.output_scale;
         for sample in out {
-            *sample = step.tick(self);
+            *sample = super::filters::flush_tiny(body.tick_inline(*sample) * scale);
         }
     }
 
@@ -343,7 +362,7 @@ impl WaveguideBank {
     #[cold]
     #[inline(never)]
     fn sample_slow(&mut self, probed: usize, bow_of: impl FnMut(usize) -> StringBow) -> f64 {
-        let out = self.sample_as::<true>(probed, bow_of);
+        let out = self.sample_as::<true, true>(probed, bow_of);
         self.slow = self.body.is_fading() || self.voices.iter().any(|v| v.string.is_struck());
         out
     }
@@ -351,7 +370,7 @@ impl WaveguideBank {
     /// One internal sample of every awake string and the body; with `SLOW`, a struck
     /// string ticks as struck and a fading body fades.
     #[inline(always)]
-    fn sample_as<const SLOW: bool>(
+    fn sample_as<const SLOW: bool, const BODY: bool>(
         &mut self,
         probed: usize,
         mut bow_of: impl FnMut(usize) -> StringBow,
@@ -398,6 +417,9 @@ impl WaveguideBank {
         }
         if any_fine {
             bridge += self.decimator.tick(fine[0], fine[1]);
+        }
+        if !BODY {
+            return bridge;
         }
         let body = if SLOW {
             self.body.tick(bridge)

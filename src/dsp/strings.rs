@@ -153,6 +153,13 @@ pub trait StringBank {
     fn sample_inline(&mut self, probed: usize, bow_of: impl FnMut(usize) -> StringBow) -> f64 {
         self.sample(probed, bow_of)
     }
+    /// The strings' part of [`StringBank::sample_inline`] for a bank whose
+    /// [`StringBank::samples`] runs the rest over the block (what the rest takes is the
+    /// bank's own).
+    #[inline(always)]
+    fn strings_inline(&mut self, probed: usize, bow_of: impl FnMut(usize) -> StringBow) -> f64 {
+        self.sample_inline(probed, bow_of)
+    }
     /// Internal samples into `out`, each computed by `step`: the samples of a loop of
     /// `step.tick(self)`, in one call for the block (a bank runs its strings in that loop
     /// without a call a sample).
@@ -269,6 +276,12 @@ pub(super) struct Hands {
 pub trait InternalSample<B> {
     /// Sets the bows for one internal sample and computes it.
     fn tick(&mut self, bank: &mut B) -> f64;
+    /// [`InternalSample::tick`] through [`StringBank::strings_inline`]: the strings' part
+    /// of the sample only, for a bank that runs the rest over the block.
+    #[inline(always)]
+    fn tick_strings(&mut self, bank: &mut B) -> f64 {
+        self.tick(bank)
+    }
 }
 
 /// The player's hands with the bow of this host sample: [`InternalSample`] for
@@ -282,7 +295,12 @@ struct HandsSample<'a, const INLINE: bool> {
 impl<B: StringBank, const INLINE: bool> InternalSample<B> for HandsSample<'_, INLINE> {
     #[inline(always)]
     fn tick(&mut self, bank: &mut B) -> f64 {
-        self.hands.tick::<B, INLINE>(bank, self.bow)
+        self.hands.tick::<B, INLINE, false>(bank, self.bow)
+    }
+
+    #[inline(always)]
+    fn tick_strings(&mut self, bank: &mut B) -> f64 {
+        self.hands.tick::<B, true, true>(bank, self.bow)
     }
 }
 
@@ -292,7 +310,11 @@ impl Hands {
     /// the weighting and the note's expression on the shared bow). `INLINE`: the bank's
     /// sample inlined here ([`StringBank::sample_inline`]).
     #[inline(always)]
-    fn tick<B: StringBank, const INLINE: bool>(&mut self, bank: &mut B, bow: BowControl) -> f64 {
+    fn tick<B: StringBank, const INLINE: bool, const STRINGS_ONLY: bool>(
+        &mut self,
+        bank: &mut B,
+        bow: BowControl,
+    ) -> f64 {
         if self.lifting {
             self.lift_tick(bank);
         }
@@ -308,7 +330,9 @@ impl Hands {
         let divisor = bank.force_divisor();
         let probed = self.probed;
         let bow_of = move |i| self.string_bow(i, bow, divisor, B::HARMONIC_BOW_AT_ROOT);
-        if INLINE {
+        if STRINGS_ONLY {
+            bank.strings_inline(probed, bow_of)
+        } else if INLINE {
             bank.sample_inline(probed, bow_of)
         } else {
             bank.sample(probed, bow_of)
@@ -998,11 +1022,11 @@ impl<B: StringBank> FourStrings<B> {
         let out = match &mut self.resampler {
             None if B::SAMPLE_IS_FLUSHED && self.pending.is_none() => {
                 // One internal sample, already audio: as it is.
-                let audio =
-                    self.hands.tick::<B, false>(&mut self.bank, bow) * self.bank.output_gain();
+                let audio = self.hands.tick::<B, false, false>(&mut self.bank, bow)
+                    * self.bank.output_gain();
                 return self.finish(audio);
             }
-            None => self.hands.tick::<B, false>(&mut self.bank, bow),
+            None => self.hands.tick::<B, false, false>(&mut self.bank, bow),
             Some(resampler) => {
                 let mut out = [0.0];
                 let step = HandsSample::<false> {
