@@ -30,7 +30,9 @@
 pub use super::body::MUTE_FADE_S;
 use super::body::{body_for, BodyMode, BodyModes, FadingBody, MAX_BODY_MODES};
 use super::friction::bristle::{BristleParams, SolverStats};
-use super::friction::{AnyFriction, BowInput, FrictionContact, FrictionModel, HyperbolicFriction};
+use super::friction::{
+    law, AnyFriction, BowInput, FrictionContact, FrictionModel, HyperbolicFriction, KnownLaw,
+};
 use super::halfband::HalfbandDecimator;
 use super::intonation;
 use super::resample::Resampler;
@@ -243,13 +245,17 @@ impl StringBank for WaveguideBank {
         if self.slow {
             return self.sample_slow(probed, bow_of);
         }
-        self.sample_as::<false, true>(probed, bow_of)
+        self.sample_as::<false, true, { law::ANY }>(probed, bow_of)
     }
 
     /// The strings' bridge force, for [`StringBank::samples`] to run the body over.
     #[inline(always)]
-    fn strings_inline(&mut self, probed: usize, bow_of: impl FnMut(usize) -> StringBow) -> f64 {
-        self.sample_as::<false, false>(probed, bow_of)
+    fn strings_inline<const LAW: u8>(
+        &mut self,
+        probed: usize,
+        bow_of: impl FnMut(usize) -> StringBow,
+    ) -> f64 {
+        self.sample_as::<false, false, LAW>(probed, bow_of)
     }
 
     /// The block's samples in out-of-line loops, each sample inlined into them: while no
@@ -263,8 +269,19 @@ impl StringBank for WaveguideBank {
             }
             return;
         }
-        for sample in out.iter_mut() {
-            *sample = step.tick_strings(self);
+        // The strings' law, where they share one (compiled in, not asked each sample).
+        let computed = &self.computed[..self.computed_count.min(STRINGS)];
+        let first = computed
+            .first()
+            .map_or(law::ANY, |&i| self.voices[i].contact.law());
+        let shared = computed
+            .iter()
+            .all(|&i| self.voices[i].contact.law() == first);
+        match if shared { first } else { law::ANY } {
+            law::HYPERBOLIC => self.strings_block::<{ law::HYPERBOLIC }>(out, step),
+            law::STRIBECK => self.strings_block::<{ law::STRIBECK }>(out, step),
+            law::BRISTLE => self.strings_block::<{ law::BRISTLE }>(out, step),
+            _ => self.strings_block::<{ law::ANY }>(out, step),
         }
         let body = &mut self.body.playing;
         let scale = self.output_scale;
@@ -355,6 +372,18 @@ impl StringBank for WaveguideBank {
 }
 
 impl WaveguideBank {
+    /// The strings' bridge force over a block, with their law `LAW`.
+    #[inline(always)]
+    fn strings_block<const LAW: u8>(
+        &mut self,
+        out: &mut [f64],
+        step: &mut impl InternalSample<Self>,
+    ) {
+        for sample in out {
+            *sample = step.tick_strings::<LAW>(self);
+        }
+    }
+
     /// [`StringBank::sample`] while a stick strikes a string (col legno: the struck
     /// strings take the stick's contact, [`WaveguideString::tick_struck`]) or the body
     /// fades to a mute's modes. Out of line, off the bowed strings' path: a few
@@ -362,7 +391,7 @@ impl WaveguideBank {
     #[cold]
     #[inline(never)]
     fn sample_slow(&mut self, probed: usize, bow_of: impl FnMut(usize) -> StringBow) -> f64 {
-        let out = self.sample_as::<true, true>(probed, bow_of);
+        let out = self.sample_as::<true, true, { law::ANY }>(probed, bow_of);
         self.slow = self.body.is_fading() || self.voices.iter().any(|v| v.string.is_struck());
         out
     }
@@ -370,7 +399,7 @@ impl WaveguideBank {
     /// One internal sample of every awake string and the body; with `SLOW`, a struck
     /// string ticks as struck and a fading body fades.
     #[inline(always)]
-    fn sample_as<const SLOW: bool, const BODY: bool>(
+    fn sample_as<const SLOW: bool, const BODY: bool, const LAW: u8>(
         &mut self,
         probed: usize,
         mut bow_of: impl FnMut(usize) -> StringBow,
@@ -378,8 +407,12 @@ impl WaveguideBank {
         let tick = |voice: &mut StringVoice, input: BowInput| {
             if SLOW && voice.string.is_struck() {
                 voice.string.tick_struck(&mut voice.contact, input)
-            } else {
+            } else if LAW == law::ANY {
                 voice.string.tick(&mut voice.contact, input)
+            } else {
+                voice
+                    .string
+                    .tick(&mut KnownLaw::<LAW>(&mut voice.contact), input)
             }
         };
         // `tick` checked that something is awake; sleep changes only between blocks.

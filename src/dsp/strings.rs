@@ -35,6 +35,7 @@
 use super::body::{body_for, BodyModes, FadingBody};
 use super::filters::flush_tiny;
 use super::fingering::{BowEnvelope, Fingering};
+use super::friction::law;
 use super::intonation::IntonationTable;
 use super::radiation::Radiation;
 use super::resample::Resampler;
@@ -155,9 +156,14 @@ pub trait StringBank {
     }
     /// The strings' part of [`StringBank::sample_inline`] for a bank whose
     /// [`StringBank::samples`] runs the rest over the block (what the rest takes is the
-    /// bank's own).
+    /// bank's own). `LAW`: the strings' friction law where the bank knows it for the
+    /// block ([`crate::dsp::friction::law`]).
     #[inline(always)]
-    fn strings_inline(&mut self, probed: usize, bow_of: impl FnMut(usize) -> StringBow) -> f64 {
+    fn strings_inline<const LAW: u8>(
+        &mut self,
+        probed: usize,
+        bow_of: impl FnMut(usize) -> StringBow,
+    ) -> f64 {
         self.sample_inline(probed, bow_of)
     }
     /// Internal samples into `out`, each computed by `step`: the samples of a loop of
@@ -277,9 +283,9 @@ pub trait InternalSample<B> {
     /// Sets the bows for one internal sample and computes it.
     fn tick(&mut self, bank: &mut B) -> f64;
     /// [`InternalSample::tick`] through [`StringBank::strings_inline`]: the strings' part
-    /// of the sample only, for a bank that runs the rest over the block.
+    /// of the sample only, for a bank that runs the rest over the block; `LAW` as there.
     #[inline(always)]
-    fn tick_strings(&mut self, bank: &mut B) -> f64 {
+    fn tick_strings<const LAW: u8>(&mut self, bank: &mut B) -> f64 {
         self.tick(bank)
     }
 }
@@ -295,12 +301,13 @@ struct HandsSample<'a, const INLINE: bool> {
 impl<B: StringBank, const INLINE: bool> InternalSample<B> for HandsSample<'_, INLINE> {
     #[inline(always)]
     fn tick(&mut self, bank: &mut B) -> f64 {
-        self.hands.tick::<B, INLINE, false>(bank, self.bow)
+        self.hands
+            .tick::<B, INLINE, false, { law::ANY }>(bank, self.bow)
     }
 
     #[inline(always)]
-    fn tick_strings(&mut self, bank: &mut B) -> f64 {
-        self.hands.tick::<B, true, true>(bank, self.bow)
+    fn tick_strings<const LAW: u8>(&mut self, bank: &mut B) -> f64 {
+        self.hands.tick::<B, true, true, LAW>(bank, self.bow)
     }
 }
 
@@ -310,7 +317,7 @@ impl Hands {
     /// the weighting and the note's expression on the shared bow). `INLINE`: the bank's
     /// sample inlined here ([`StringBank::sample_inline`]).
     #[inline(always)]
-    fn tick<B: StringBank, const INLINE: bool, const STRINGS_ONLY: bool>(
+    fn tick<B: StringBank, const INLINE: bool, const STRINGS_ONLY: bool, const LAW: u8>(
         &mut self,
         bank: &mut B,
         bow: BowControl,
@@ -331,7 +338,7 @@ impl Hands {
         let probed = self.probed;
         let bow_of = move |i| self.string_bow(i, bow, divisor, B::HARMONIC_BOW_AT_ROOT);
         if STRINGS_ONLY {
-            bank.strings_inline(probed, bow_of)
+            bank.strings_inline::<LAW>(probed, bow_of)
         } else if INLINE {
             bank.sample_inline(probed, bow_of)
         } else {
@@ -1022,11 +1029,15 @@ impl<B: StringBank> FourStrings<B> {
         let out = match &mut self.resampler {
             None if B::SAMPLE_IS_FLUSHED && self.pending.is_none() => {
                 // One internal sample, already audio: as it is.
-                let audio = self.hands.tick::<B, false, false>(&mut self.bank, bow)
+                let audio = self
+                    .hands
+                    .tick::<B, false, false, { law::ANY }>(&mut self.bank, bow)
                     * self.bank.output_gain();
                 return self.finish(audio);
             }
-            None => self.hands.tick::<B, false, false>(&mut self.bank, bow),
+            None => self
+                .hands
+                .tick::<B, false, false, { law::ANY }>(&mut self.bank, bow),
             Some(resampler) => {
                 let mut out = [0.0];
                 let step = HandsSample::<false> {
