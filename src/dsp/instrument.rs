@@ -38,7 +38,7 @@ use super::intonation;
 use super::resample::Resampler;
 pub use super::strings::FourStrings;
 use super::strings::{InternalSample, StringBank, StringBow, HARMONIC_FINGER_RESISTANCE_Z0};
-use super::waveguide::WaveguideString;
+use super::waveguide::{StringOutput, WaveguideString};
 
 use super::vocabulary::*;
 
@@ -55,6 +55,23 @@ struct StringVoice {
     string: WaveguideString,
     contact: AnyFriction,
     awake: bool,
+}
+
+impl StringVoice {
+    /// One sample of the string with its contact; with `SLOW`, as struck while the stick
+    /// strikes; `LAW` as [`KnownLaw`]'s. Always inlined: a call a string and sample
+    /// costs its saving of the registers around it.
+    #[inline(always)]
+    fn tick<const SLOW: bool, const LAW: u8>(&mut self, input: BowInput) -> StringOutput {
+        if SLOW && self.string.is_struck() {
+            self.string.tick_struck(&mut self.contact, input)
+        } else if LAW == law::ANY {
+            self.string.tick(&mut self.contact, input)
+        } else {
+            self.string
+                .tick(&mut KnownLaw::<LAW>(&mut self.contact), input)
+        }
+    }
 }
 
 /// The point-bow instrument's strings and body at the internal rate: four independent
@@ -404,17 +421,6 @@ impl WaveguideBank {
         probed: usize,
         mut bow_of: impl FnMut(usize) -> StringBow,
     ) -> f64 {
-        let tick = |voice: &mut StringVoice, input: BowInput| {
-            if SLOW && voice.string.is_struck() {
-                voice.string.tick_struck(&mut voice.contact, input)
-            } else if LAW == law::ANY {
-                voice.string.tick(&mut voice.contact, input)
-            } else {
-                voice
-                    .string
-                    .tick(&mut KnownLaw::<LAW>(&mut voice.contact), input)
-            }
-        };
         // `tick` checked that something is awake; sleep changes only between blocks.
         self.body_asleep = false;
         let mut bridge = 0.0;
@@ -431,7 +437,7 @@ impl WaveguideBank {
                 normal_force_n: bow.force,
             };
             if self.oversample[i] == 1 {
-                let out = tick(voice, input);
+                let out = voice.tick::<SLOW, LAW>(input);
                 bridge += out.bridge_force_n;
                 if i == probed {
                     self.probe = (out.bow_point_velocity_m_per_s, out.friction_force_n);
@@ -440,7 +446,7 @@ impl WaveguideBank {
                 // The bow is held over the string's two samples; the probe is the later's.
                 any_fine = true;
                 for force in &mut fine {
-                    let out = tick(voice, input);
+                    let out = voice.tick::<SLOW, LAW>(input);
                     *force += out.bridge_force_n;
                     if i == probed {
                         self.probe = (out.bow_point_velocity_m_per_s, out.friction_force_n);
