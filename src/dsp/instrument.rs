@@ -246,12 +246,10 @@ impl StringBank for WaveguideBank {
         self.update_computed();
     }
 
-    /// One internal sample. Out of line, with the strings and friction inlined into it,
-    /// so the caller's loop stays small. Callgrind, `colophony render` of cello D3 with
-    /// the hyperbolic law (192 000 samples, whole process): 621 instructions a sample,
-    /// against 600 for the point-bow instrument before it became a [`FourStrings`] (the
-    /// fade, the probe and the closure that hands each string its bow), and 632 with
-    /// this inlined into an out-of-line tick.
+    /// One internal sample, for the callers that go a sample at a time (the resampled
+    /// path, a live view, the frame renderer). Out of line, with the strings and friction
+    /// inlined into it, so the caller's loop stays small; a block goes through
+    /// [`StringBank::samples`] instead, one call for all its samples.
     #[inline(never)]
     fn sample(&mut self, probed: usize, bow_of: impl FnMut(usize) -> StringBow) -> f64 {
         self.sample_inline(probed, bow_of)
