@@ -919,6 +919,87 @@ mod tests {
 }
 
 #[cfg(test)]
+mod block_tests {
+    //! [`FourStrings::process`]'s block path (the bank's [`StringBank::samples`]) against
+    //! the same instrument ticked sample by sample.
+    use super::*;
+
+    /// Every friction law, on the cello (strings at the bank's rate), the violin (strings
+    /// at twice it, through the decimator) and the double bass, with two strings bowed, a
+    /// glide, a mute put on (the body fading: the slow path within blocks), a stick's
+    /// strike and a note released, in blocks of 1, 37 and 512: the same bits as ticking.
+    #[test]
+    fn a_block_of_every_law_gives_the_samples_of_ticking_it() {
+        let n = 24_000;
+        let events = |i: &mut Instrument, at: usize, kind: InstrumentKind| {
+            let open = kind.open_notes();
+            match at {
+                0 => {
+                    i.note_on(open[1] + 4);
+                }
+                3_000 => {
+                    i.note_on(open[2] + 2);
+                }
+                8_000 => {
+                    i.note_on_gliding(open[2] + 5, 0.05);
+                }
+                12_000 => i.set_mute(true),
+                15_000 => {
+                    i.strike(
+                        open[3],
+                        Strike {
+                            mass_kg: 0.005,
+                            velocity_m_per_s: 0.5,
+                        },
+                    );
+                }
+                18_000 => i.note_off(open[1] + 4),
+                _ => {}
+            }
+        };
+        let marks = [0, 3_000, 8_000, 12_000, 15_000, 18_000, n];
+        let bow = BowControl::default();
+        for law in FrictionModel::ALL {
+            for kind in [
+                InstrumentKind::Cello,
+                InstrumentKind::Violin,
+                InstrumentKind::DoubleBass,
+            ] {
+                let fresh = || {
+                    let mut i = Instrument::new(kind, 48_000.0);
+                    i.set_friction_model(law);
+                    i
+                };
+                let mut ticked = fresh();
+                let mut want = Vec::with_capacity(n);
+                for at in 0..n {
+                    events(&mut ticked, at, kind);
+                    want.push(ticked.tick(bow).audio.to_bits());
+                }
+                // Bowed (a bowed note is far louder than -60 dBFS), not a silent render.
+                assert!(want.iter().any(|&x| f64::from_bits(x).abs() > 1e-3));
+                for block in [1, 37, 512] {
+                    let mut i = fresh();
+                    let mut got = Vec::with_capacity(n);
+                    let mut out = vec![0.0; block];
+                    for span in marks.windows(2) {
+                        events(&mut i, span[0], kind);
+                        let mut at = span[0];
+                        while at < span[1] {
+                            let len = block.min(span[1] - at);
+                            i.process(bow, &mut out[..len]);
+                            got.extend(out[..len].iter().map(|x| x.to_bits()));
+                            at += len;
+                        }
+                    }
+                    assert!(got == want, "{law:?}, {kind:?}, blocks of {block}");
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
 mod finger_tests {
     //! The four-string instrument's finger lift ([`super::FourStrings::note_off`]), on the
     //! point-bow instrument.
