@@ -59,13 +59,13 @@ struct StringVoice {
 
 impl StringVoice {
     /// One sample of the string with its contact; with `SLOW`, as struck while the stick
-    /// strikes; `LAW` as [`KnownLaw`]'s. Always inlined: a call a string and sample
+    /// strikes; `LAW` as [`KnownLaw`]'s (its bits above [`law::MASK`] the caller's). Always inlined: a call a string and sample
     /// costs its saving of the registers around it.
     #[inline(always)]
     fn tick<const SLOW: bool, const LAW: u8>(&mut self, input: BowInput) -> StringOutput {
         if SLOW && self.string.is_struck() {
             self.string.tick_struck(&mut self.contact, input)
-        } else if LAW == law::ANY {
+        } else if LAW & law::MASK == law::ANY {
             self.string.tick(&mut self.contact, input)
         } else {
             self.string
@@ -265,12 +265,12 @@ impl StringBank for WaveguideBank {
 
     /// The strings' bridge force, for [`StringBank::samples`] to run the body over.
     #[inline(always)]
-    fn strings_inline<const LAW: u8>(
+    fn strings_inline<const SHAPE: u8>(
         &mut self,
         probed: usize,
         bow_of: impl FnMut(usize) -> StringBow,
     ) -> f64 {
-        self.sample_as::<false, false, LAW>(probed, bow_of)
+        self.sample_as::<false, false, SHAPE>(probed, bow_of)
     }
 
     /// The block's samples in out-of-line loops, each sample inlined into them: while no
@@ -292,11 +292,26 @@ impl StringBank for WaveguideBank {
         let shared = computed
             .iter()
             .all(|&i| self.voices[i].contact.law() == first);
-        match if shared { first } else { law::ANY } {
-            law::HYPERBOLIC => self.strings_block::<{ law::HYPERBOLIC }>(out, step),
-            law::STRIBECK => self.strings_block::<{ law::STRIBECK }>(out, step),
-            law::BRISTLE => self.strings_block::<{ law::BRISTLE }>(out, step),
-            _ => self.strings_block::<{ law::ANY }>(out, step),
+        // One string at the bank's own rate: no loop over strings, no decimator.
+        let lone = computed.len() == 1 && self.oversample[computed[0] % STRINGS] == 1;
+        match (if shared { first } else { law::ANY }, lone) {
+            (law::HYPERBOLIC, true) => {
+                self.strings_block::<{ shape(law::HYPERBOLIC, true) }>(out, step)
+            }
+            (law::HYPERBOLIC, false) => {
+                self.strings_block::<{ shape(law::HYPERBOLIC, false) }>(out, step)
+            }
+            (law::STRIBECK, true) => {
+                self.strings_block::<{ shape(law::STRIBECK, true) }>(out, step)
+            }
+            (law::STRIBECK, false) => {
+                self.strings_block::<{ shape(law::STRIBECK, false) }>(out, step)
+            }
+            (law::BRISTLE, true) => self.strings_block::<{ shape(law::BRISTLE, true) }>(out, step),
+            (law::BRISTLE, false) => {
+                self.strings_block::<{ shape(law::BRISTLE, false) }>(out, step)
+            }
+            _ => self.strings_block::<{ shape(law::ANY, false) }>(out, step),
         }
         let body = &mut self.body.playing;
         let scale = self.output_scale;
@@ -386,16 +401,26 @@ impl StringBank for WaveguideBank {
     }
 }
 
+/// Marks a [`shape`] whose block computes one string at the bank's own rate.
+const LONE: u8 = 4;
+
+/// What [`WaveguideBank::samples`] found true of a whole block, as
+/// [`StringBank::strings_inline`]'s `SHAPE`: the strings' [`law`], and whether it computes
+/// one string at the bank's own rate (`lone`: no loop over the strings, no decimator).
+const fn shape(law: u8, lone: bool) -> u8 {
+    law | if lone { LONE } else { 0 }
+}
+
 impl WaveguideBank {
-    /// The strings' bridge force over a block, with their law `LAW`.
+    /// The strings' bridge force over a block of shape `SHAPE` ([`shape`]).
     #[inline(always)]
-    fn strings_block<const LAW: u8>(
+    fn strings_block<const SHAPE: u8>(
         &mut self,
         out: &mut [f64],
         step: &mut impl InternalSample<Self>,
     ) {
         for sample in out {
-            *sample = step.tick_strings::<LAW>(self);
+            *sample = step.tick_strings::<SHAPE>(self);
         }
     }
 
@@ -414,11 +439,35 @@ impl WaveguideBank {
     /// One internal sample of every awake string and the body; with `SLOW`, a struck
     /// string ticks as struck and a fading body fades.
     #[inline(always)]
-    fn sample_as<const SLOW: bool, const BODY: bool, const LAW: u8>(
+    fn sample_as<const SLOW: bool, const BODY: bool, const SHAPE: u8>(
         &mut self,
         probed: usize,
         mut bow_of: impl FnMut(usize) -> StringBow,
     ) -> f64 {
+        const { assert!(SHAPE & LONE == 0 || !SLOW) };
+        if SHAPE & LONE != 0 {
+            // The block's one string, at the bank's rate ([`shape`]).
+            self.body_asleep = false;
+            let i = self.computed[0] % STRINGS;
+            let voice = &mut self.voices[i];
+            let bow = bow_of(i);
+            voice.string.set_bow_position(bow.position_beta);
+            let input = BowInput {
+                velocity_m_per_s: bow.velocity_m_per_s,
+                normal_force_n: bow.force,
+            };
+            let out = voice.tick::<SLOW, SHAPE>(input);
+            if i == probed {
+                self.probe = (out.bow_point_velocity_m_per_s, out.friction_force_n);
+            }
+            // As the loop below sums it: `0 + F` (a negative zero becomes a positive one).
+            let bridge = 0.0 + out.bridge_force_n;
+            if !BODY {
+                return bridge;
+            }
+            let body = self.body.playing.tick(bridge);
+            return super::filters::flush_tiny(body * self.output_scale);
+        }
         // `tick` checked that something is awake; sleep changes only between blocks.
         self.body_asleep = false;
         let mut bridge = 0.0;
@@ -435,7 +484,7 @@ impl WaveguideBank {
                 normal_force_n: bow.force,
             };
             if self.oversample[i] == 1 {
-                let out = voice.tick::<SLOW, LAW>(input);
+                let out = voice.tick::<SLOW, SHAPE>(input);
                 bridge += out.bridge_force_n;
                 if i == probed {
                     self.probe = (out.bow_point_velocity_m_per_s, out.friction_force_n);
@@ -444,7 +493,7 @@ impl WaveguideBank {
                 // The bow is held over the string's two samples; the probe is the later's.
                 any_fine = true;
                 for force in &mut fine {
-                    let out = voice.tick::<SLOW, LAW>(input);
+                    let out = voice.tick::<SLOW, SHAPE>(input);
                     *force += out.bridge_force_n;
                     if i == probed {
                         self.probe = (out.bow_point_velocity_m_per_s, out.friction_force_n);

@@ -156,10 +156,11 @@ pub trait StringBank {
     }
     /// The strings' part of [`StringBank::sample_inline`] for a bank whose
     /// [`StringBank::samples`] runs the rest over the block (what the rest takes is the
-    /// bank's own). `LAW`: the strings' friction law where the bank knows it for the
-    /// block ([`crate::dsp::friction::law`]).
+    /// bank's own). `SHAPE`: what the bank found true of the whole block (its friction
+    /// law, how many strings it computes), in the bank's own code, compiled into the
+    /// block's loop.
     #[inline(always)]
-    fn strings_inline<const LAW: u8>(
+    fn strings_inline<const SHAPE: u8>(
         &mut self,
         probed: usize,
         bow_of: impl FnMut(usize) -> StringBow,
@@ -283,9 +284,9 @@ pub trait InternalSample<B> {
     /// Sets the bows for one internal sample and computes it.
     fn tick(&mut self, bank: &mut B) -> f64;
     /// [`InternalSample::tick`] through [`StringBank::strings_inline`]: the strings' part
-    /// of the sample only, for a bank that runs the rest over the block; `LAW` as there.
+    /// of the sample only, for a bank that runs the rest over the block; `SHAPE` as there.
     #[inline(always)]
-    fn tick_strings<const LAW: u8>(&mut self, bank: &mut B) -> f64 {
+    fn tick_strings<const SHAPE: u8>(&mut self, bank: &mut B) -> f64 {
         self.tick(bank)
     }
 }
@@ -306,8 +307,8 @@ impl<B: StringBank, const INLINE: bool> InternalSample<B> for HandsSample<'_, IN
     }
 
     #[inline(always)]
-    fn tick_strings<const LAW: u8>(&mut self, bank: &mut B) -> f64 {
-        self.hands.tick::<B, true, true, LAW>(bank, self.bow)
+    fn tick_strings<const SHAPE: u8>(&mut self, bank: &mut B) -> f64 {
+        self.hands.tick::<B, true, true, SHAPE>(bank, self.bow)
     }
 }
 
@@ -317,7 +318,7 @@ impl Hands {
     /// the weighting and the note's expression on the shared bow). `INLINE`: the bank's
     /// sample inlined here ([`StringBank::sample_inline`]).
     #[inline(always)]
-    fn tick<B: StringBank, const INLINE: bool, const STRINGS_ONLY: bool, const LAW: u8>(
+    fn tick<B: StringBank, const INLINE: bool, const STRINGS_ONLY: bool, const SHAPE: u8>(
         &mut self,
         bank: &mut B,
         bow: BowControl,
@@ -338,7 +339,7 @@ impl Hands {
         let probed = self.probed;
         let bow_of = move |i| self.string_bow(i, bow, divisor, B::HARMONIC_BOW_AT_ROOT);
         if STRINGS_ONLY {
-            bank.strings_inline::<LAW>(probed, bow_of)
+            bank.strings_inline::<SHAPE>(probed, bow_of)
         } else if INLINE {
             bank.sample_inline(probed, bow_of)
         } else {

@@ -323,10 +323,12 @@ pub mod law {
     pub const BRISTLE: u8 = 2;
     /// Whichever the contact's model says, asked each sample.
     pub const ANY: u8 = 3;
+    /// The bits that name the law; a caller may use the others for its own flags.
+    pub const MASK: u8 = 3;
 }
 
 /// An [`AnyFriction`] whose law is known where the code is compiled (`LAW`, one of
-/// [`law`]'s): the same solve, without asking the model each sample, for a block in
+/// [`law`]'s, under [`law::MASK`]): the same solve, without asking the model each sample, for a block in
 /// which the law does not change.
 pub struct KnownLaw<'a, const LAW: u8>(pub &'a mut AnyFriction);
 
@@ -345,13 +347,17 @@ impl<const LAW: u8> FrictionContact for KnownLaw<'_, LAW> {
     #[inline(always)]
     fn solve(&mut self, load: LoadLine, bow: BowInput) -> f64 {
         let contact = &mut *self.0;
-        let f = match LAW {
+        let f = match LAW & law::MASK {
             law::HYPERBOLIC => contact.hyperbolic.solve(load, bow),
             law::STRIBECK => contact.stribeck.solve(load, bow),
             law::BRISTLE => contact.bristle.solve(load, bow),
             _ => return contact.solve(load, bow),
         };
-        debug_assert_eq!(contact.law(), LAW, "the block's law is its contacts'");
+        debug_assert_eq!(
+            contact.law(),
+            LAW & law::MASK,
+            "the block's law is its contacts'"
+        );
         contact.last_force_n = f;
         f
     }
