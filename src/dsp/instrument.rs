@@ -445,36 +445,20 @@ impl WaveguideBank {
         mut bow_of: impl FnMut(usize) -> StringBow,
     ) -> f64 {
         const { assert!(SHAPE & LONE == 0 || !SLOW) };
-        if SHAPE & LONE != 0 {
-            // The block's one string, at the bank's rate ([`shape`]).
-            self.body_asleep = false;
-            let i = self.computed[0] % STRINGS;
-            let voice = &mut self.voices[i];
-            let bow = bow_of(i);
-            voice.string.set_bow_position(bow.position_beta);
-            let input = BowInput {
-                velocity_m_per_s: bow.velocity_m_per_s,
-                normal_force_n: bow.force,
-            };
-            let out = voice.tick::<SLOW, SHAPE>(input);
-            if i == probed {
-                self.probe = (out.bow_point_velocity_m_per_s, out.friction_force_n);
-            }
-            // As the loop below sums it: `0 + F` (a negative zero becomes a positive one).
-            let bridge = 0.0 + out.bridge_force_n;
-            if !BODY {
-                return bridge;
-            }
-            let body = self.body.playing.tick(bridge);
-            return super::filters::flush_tiny(body * self.output_scale);
-        }
         // `tick` checked that something is awake; sleep changes only between blocks.
         self.body_asleep = false;
         let mut bridge = 0.0;
         // The bridge force of the strings at twice the bank's rate, a pair a bank sample.
         let mut fine = [0.0; 2];
         let mut any_fine = false;
-        for k in 0..self.computed_count.min(STRINGS) {
+        // A lone string ([`shape`]): one pass at the bank's rate, known where compiled.
+        let lone = SHAPE & LONE != 0;
+        let count = if lone {
+            1
+        } else {
+            self.computed_count.min(STRINGS)
+        };
+        for k in 0..count {
             let i = self.computed[k] % STRINGS;
             let voice = &mut self.voices[i];
             let bow = bow_of(i);
@@ -483,7 +467,7 @@ impl WaveguideBank {
                 velocity_m_per_s: bow.velocity_m_per_s,
                 normal_force_n: bow.force,
             };
-            if self.oversample[i] == 1 {
+            if lone || self.oversample[i] == 1 {
                 let out = voice.tick::<SLOW, SHAPE>(input);
                 bridge += out.bridge_force_n;
                 if i == probed {
@@ -501,7 +485,7 @@ impl WaveguideBank {
                 }
             }
         }
-        if any_fine {
+        if !lone && any_fine {
             bridge += self.decimator.tick(fine[0], fine[1]);
         }
         if !BODY {
