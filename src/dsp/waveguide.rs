@@ -106,6 +106,9 @@ pub struct StringOutput {
 #[derive(Debug, Clone)]
 pub struct WaveguideString {
     spec: StringSpec,
+    /// The string's admittance seen from a point on it, `1 / (2 Z0)`, s/kg (kept with
+    /// `spec`, out of the sample's chain of dependent operations).
+    admittance_s_per_kg: f64,
     sample_rate_hz: f64,
     /// right-going (towards the nut) and left-going waves, indexed by time (see `tick`):
     /// rings of a power-of-two length, so an index wraps with a mask, not a division
@@ -256,6 +259,7 @@ impl WaveguideString {
         let capacity = (sample_rate_hz.max(max_rate_hz) / lowest_hz / 2.0).ceil() as usize + 4;
         let mut s = Self {
             spec,
+            admittance_s_per_kg: 0.5 / spec.z0_kg_per_s,
             sample_rate_hz,
             right: DelayLine::new(capacity),
             left: DelayLine::new(capacity),
@@ -342,6 +346,7 @@ impl WaveguideString {
     /// Replaces the string (instrument change). Real-time safe; resets the state.
     pub fn set_spec(&mut self, spec: StringSpec) {
         self.spec = spec;
+        self.admittance_s_per_kg = 0.5 / spec.z0_kg_per_s;
         self.reset();
         self.stop_at(spec.open_hz);
     }
@@ -720,7 +725,7 @@ impl WaveguideString {
         let m = self.m;
         let at = |delay: usize| self.t.wrapping_sub(delay) & mask;
         let z0 = self.spec.z0_kg_per_s;
-        let admittance = 0.5 / z0;
+        let admittance = self.admittance_s_per_kg;
 
         // Bow junction.
         let (ir, il) = (at(self.bow_index), at(m - 1 - self.bow_index));
