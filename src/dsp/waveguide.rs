@@ -780,14 +780,17 @@ impl WaveguideString {
             }
         }
 
+        // Untouched, the bridge reflects what reached it, already flushed where the nut
+        // wrote it (the bow's additions to it are far above the flush's level or zero);
+        // the touching finger's fraction has a state of its own, so its output is flushed.
         let from_bridge = if self.touch.partial == 0 {
             -at_bridge
         } else {
-            self.touch.fraction.tick(-at_bridge)
+            flush(self.touch.fraction.tick(-at_bridge))
         };
 
         self.t = (self.t + 1) & mask;
-        self.right[self.t] = flush(from_bridge);
+        self.right[self.t] = from_bridge;
         self.left[self.t] = flush(reflected);
 
         StringOutput {
