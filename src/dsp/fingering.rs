@@ -34,6 +34,11 @@ pub struct BowEnvelope {
 }
 
 impl BowEnvelope {
+    /// Whether the ramp has arrived: [`BowEnvelope::tick`] then changes nothing.
+    pub fn is_settled(&self) -> bool {
+        self.gain == if self.bowed { 1.0 } else { 0.0 }
+    }
+
     /// One step of the ramp toward 1 (bowed) or 0 (lifted) by `step`; returns the gain.
     #[inline(always)]
     pub fn tick(&mut self, step: f64) -> f64 {
@@ -235,6 +240,11 @@ impl Fingering {
         });
         self.glide_countdown -= 1;
         retune
+    }
+
+    /// Whether a finger is gliding (a retune due within the next samples).
+    pub fn is_gliding(&self) -> bool {
+        self.gliding
     }
 
     /// The note on `string`, if any.

@@ -312,7 +312,49 @@ impl<B: StringBank, const INLINE: bool> InternalSample<B> for HandsSample<'_, IN
     }
 }
 
+/// Each string's bow over a block in which nothing moves it ([`Hands::steady_bows`]):
+/// [`InternalSample`] without the hands' per-sample work.
+struct SteadyBows {
+    bows: [StringBow; STRINGS],
+    probed: usize,
+}
+
+impl<B: StringBank> InternalSample<B> for SteadyBows {
+    #[inline(always)]
+    fn tick(&mut self, bank: &mut B) -> f64 {
+        let bows = self.bows;
+        bank.sample_inline(self.probed, move |i| bows[i % STRINGS])
+    }
+
+    #[inline(always)]
+    fn tick_strings<const SHAPE: u8>(&mut self, bank: &mut B) -> f64 {
+        let bows = self.bows;
+        bank.strings_inline::<SHAPE>(self.probed, move |i| bows[i % STRINGS])
+    }
+}
+
 impl Hands {
+    /// Each string's bow for a block played with the player's bow `bow`, where nothing in
+    /// the hands moves within it: no finger lifting or gliding, every bow's ramp arrived.
+    /// The bows [`Hands::tick`] would give each sample of the block (a settled ramp's step
+    /// changes nothing); `None` while something moves.
+    fn steady_bows<B: StringBank>(
+        &mut self,
+        bank: &B,
+        bow: BowControl,
+    ) -> Option<[StringBow; STRINGS]> {
+        if self.lifting
+            || self.fingering.is_gliding()
+            || !self.bows.iter().all(BowEnvelope::is_settled)
+        {
+            return None;
+        }
+        let divisor = bank.force_divisor();
+        Some(std::array::from_fn(|i| {
+            self.string_bow(i, bow, divisor, B::HARMONIC_BOW_AT_ROOT)
+        }))
+    }
+
     /// One internal sample of `bank` with the player's bow `bow`: the finger's glide, then
     /// the bank's sample, asking for each string's bow as it computes it (the envelope,
     /// the weighting and the note's expression on the shared bow). `INLINE`: the bank's
@@ -1093,11 +1135,19 @@ impl<B: StringBank> FourStrings<B> {
         {
             // What `tick` does a sample on this path, a stage at a time over the block: the
             // bank's samples (already audio), then the gain and the radiation.
-            let mut step = HandsSample::<true> {
-                hands: &mut self.hands,
-                bow,
-            };
-            self.bank.samples(out, &mut step);
+            if let Some(bows) = self.hands.steady_bows(&self.bank, bow) {
+                let mut step = SteadyBows {
+                    bows,
+                    probed: self.hands.probed,
+                };
+                self.bank.samples(out, &mut step);
+            } else {
+                let mut step = HandsSample::<true> {
+                    hands: &mut self.hands,
+                    bow,
+                };
+                self.bank.samples(out, &mut step);
+            }
             let gain = self.bank.output_gain();
             for k in 0..out.len() {
                 let audio = self.radiation.tick(out[k] * gain);
