@@ -59,8 +59,9 @@ struct StringVoice {
 
 impl StringVoice {
     /// One sample of the string with its contact; with `SLOW`, as struck while the stick
-    /// strikes; `LAW` as [`KnownLaw`]'s (its bits above [`law::MASK`] the caller's). Always inlined: a call a string and sample
-    /// costs its saving of the registers around it.
+    /// strikes; `LAW` as [`KnownLaw`]'s (its bits above [`law::MASK`] the caller's).
+    /// Always inlined: a call a string and sample costs its saving of the registers
+    /// around it.
     #[inline(always)]
     fn tick<const SLOW: bool, const LAW: u8>(&mut self, input: BowInput) -> StringOutput {
         if SLOW && self.string.is_struck() {

@@ -328,8 +328,8 @@ pub mod law {
 }
 
 /// An [`AnyFriction`] whose law is known where the code is compiled (`LAW`, one of
-/// [`law`]'s, under [`law::MASK`]): the same solve, without asking the model each sample, for a block in
-/// which the law does not change.
+/// [`law`]'s, under [`law::MASK`]): the same solve, without asking the model each
+/// sample, for a block in which the law does not change.
 pub struct KnownLaw<'a, const LAW: u8>(pub &'a mut AnyFriction);
 
 impl AnyFriction {
