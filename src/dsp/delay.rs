@@ -48,6 +48,22 @@ impl DelayLine {
     pub fn back(&self, t: usize, delay: usize) -> usize {
         t.wrapping_sub(delay) & self.mask
     }
+
+    /// The sample at index `i` wrapped into the ring (`i & mask`), with no bounds check:
+    /// a wrapped index is always inside.
+    #[inline(always)]
+    pub fn at(&self, i: usize) -> f64 {
+        // SAFETY: `samples.len() == mask + 1` from `new` on (the length never changes: the
+        // field is private and `DerefMut` lends a slice), and `i & mask <= mask`.
+        unsafe { *self.samples.get_unchecked(i & self.mask) }
+    }
+
+    /// [`DelayLine::at`], to write.
+    #[inline(always)]
+    pub fn at_mut(&mut self, i: usize) -> &mut f64 {
+        // SAFETY: as in `at`.
+        unsafe { self.samples.get_unchecked_mut(i & self.mask) }
+    }
 }
 
 impl Deref for DelayLine {

@@ -154,12 +154,32 @@ impl<const N: usize> AllpassChain<N> {
 /// Its gain is largest at DC (`g`), which is kept below 1 so the loop is passive.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct OnePoleLoss {
-    pub g: f64,
-    pub p: f64,
+    g: f64,
+    p: f64,
+    /// The input's coefficient `g (1 - p)`.
+    b: f64,
     y1: f64,
 }
 
 impl OnePoleLoss {
+    /// The filter of DC gain `g` and pole `p`, at rest.
+    pub fn new(g: f64, p: f64) -> Self {
+        Self {
+            g,
+            p,
+            b: g * (1.0 - p),
+            y1: 0.0,
+        }
+    }
+
+    /// Takes `other`'s coefficients, keeping the state.
+    pub fn retune(&mut self, other: &Self) {
+        *self = Self {
+            y1: self.y1,
+            ..*other
+        };
+    }
+
     /// Fits `p` and `g` so the filter's gain is `gain1` at `w1` and `gain2` at `w2`
     /// (`w1 < w2`, `gain2 <= gain1 < 1`). The DC gain is capped at `MAX_DC_GAIN`.
     pub fn fit(w1: f64, gain1: f64, w2: f64, gain2: f64) -> Self {
@@ -183,7 +203,7 @@ impl OnePoleLoss {
         }
         let p = 0.5 * (lo + hi);
         let g = (gain1 / Self::unit_gain(p, w1)).min(MAX_DC_GAIN);
-        Self { g, p, y1: 0.0 }
+        Self::new(g, p)
     }
 
     /// The loss of a string's loop, one design for both string models: per round trip the
@@ -218,7 +238,7 @@ impl OnePoleLoss {
 
     #[inline]
     pub fn tick(&mut self, x: f64) -> f64 {
-        self.y1 = self.g * (1.0 - self.p) * x + self.p * self.y1;
+        self.y1 = self.b * x + self.p * self.y1;
         self.y1
     }
 
@@ -233,7 +253,7 @@ impl OnePoleLoss {
     /// (it is at least `1 / (1 - p^2)`, which the form's `y1^2` term needs). `p = 0` gives
     /// `c = 0`: a plain gain holds nothing.
     pub fn stored_energy(&self) -> f64 {
-        let (b, p) = (self.g * (1.0 - self.p), self.p);
+        let (b, p) = (self.b, self.p);
         let d = (((1.0 - b).powi(2) - p * p) * ((1.0 + b).powi(2) - p * p)).max(0.0);
         let u = 2.0 / (1.0 + b * b - p * p + d.sqrt());
         (u - 1.0).max(0.0) * self.y1 * self.y1
@@ -429,7 +449,7 @@ mod tests {
             (0.9, 0.99),
             (1.0, 0.999),
         ] {
-            let mut loss = OnePoleLoss { g, p, y1: 0.0 };
+            let mut loss = OnePoleLoss::new(g, p);
             let mut dissipated = 0.0;
             for x in chaotic(20_000) {
                 let before = loss.stored_energy();

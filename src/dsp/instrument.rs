@@ -420,8 +420,47 @@ impl WaveguideBank {
         out: &mut [f64],
         step: &mut impl InternalSample<Self>,
     ) {
+        if SHAPE & LONE != 0 {
+            if let Some((bows, probed)) = step.steady() {
+                let i = self.computed[0] % STRINGS;
+                self.lone_steady_block::<SHAPE>(out, i, bows[i], probed);
+                return;
+            }
+        }
         for sample in out {
             *sample = step.tick_strings::<SHAPE>(self);
+        }
+    }
+
+    /// The bridge force over a block of a lone string `i` ([`shape`]) bowed by `bow`
+    /// throughout, `probed` the probed string: its bow set once, then the string alone
+    /// in the loop (the samples of [`WaveguideBank::sample_as`] for it).
+    #[inline(always)]
+    fn lone_steady_block<const SHAPE: u8>(
+        &mut self,
+        out: &mut [f64],
+        i: usize,
+        bow: StringBow,
+        probed: usize,
+    ) {
+        if out.is_empty() {
+            return;
+        }
+        self.body_asleep = false;
+        let voice = &mut self.voices[i];
+        voice.string.set_bow_position(bow.position_beta);
+        let input = BowInput {
+            velocity_m_per_s: bow.velocity_m_per_s,
+            normal_force_n: bow.force,
+        };
+        let mut last = StringOutput::default();
+        for sample in out {
+            last = voice.tick::<false, SHAPE>(input);
+            // The sum over the strings starts at +0 ([`WaveguideBank::sample_as`]).
+            *sample = 0.0 + last.bridge_force_n;
+        }
+        if i == probed {
+            self.probe = (last.bow_point_velocity_m_per_s, last.friction_force_n);
         }
     }
 

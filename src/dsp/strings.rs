@@ -289,6 +289,12 @@ pub trait InternalSample<B> {
     fn tick_strings<const SHAPE: u8>(&mut self, bank: &mut B) -> f64 {
         self.tick(bank)
     }
+    /// Each string's bow and the probed string, when every sample this computes bows
+    /// the same ([`SteadyBows`]): a bank may then set them once for its whole block.
+    #[inline(always)]
+    fn steady(&self) -> Option<(&[StringBow; STRINGS], usize)> {
+        None
+    }
 }
 
 /// The player's hands with the bow of this host sample: [`InternalSample`] for
@@ -330,6 +336,11 @@ impl<B: StringBank> InternalSample<B> for SteadyBows {
     fn tick_strings<const SHAPE: u8>(&mut self, bank: &mut B) -> f64 {
         let bows = self.bows;
         bank.strings_inline::<SHAPE>(self.probed, move |i| bows[i % STRINGS])
+    }
+
+    #[inline(always)]
+    fn steady(&self) -> Option<(&[StringBow; STRINGS], usize)> {
+        Some((&self.bows, self.probed))
     }
 }
 

@@ -729,7 +729,7 @@ impl WaveguideString {
 
         // Bow junction.
         let (ir, il) = (at(self.bow_index), at(m - 1 - self.bow_index));
-        let v_h = self.right[ir] + self.left[il];
+        let v_h = self.right.at(ir) + self.left.at(il);
         // The surface under the bow (transverse plus torsional velocity) against the hair
         // (bow velocity minus its yield): both admittances add to the string's.
         let (torsion, hair) = (&mut self.torsion.filter, &mut self.hair);
@@ -754,21 +754,21 @@ impl WaveguideString {
             )
         };
         let dv = force * admittance;
-        self.right[ir] += dv;
-        self.left[il] += dv;
+        *self.right.at_mut(ir) += dv;
+        *self.left.at_mut(il) += dv;
         if self.touch.partial != 0 {
             // The touching finger: the string's velocity there `v` meets its force
             // `-R v'` (`v'` the velocity after it), so `v' = v (1 - share)` and each wave
             // gains `v' - v`.
             let (jr, jl) = (at(self.touch.index), at(m - 1 - self.touch.index));
-            let dv = -self.touch.share * (self.right[jr] + self.left[jl]);
-            self.right[jr] += dv;
-            self.left[jl] += dv;
+            let dv = -self.touch.share * (self.right.at(jr) + self.left.at(jl));
+            *self.right.at_mut(jr) += dv;
+            *self.left.at_mut(jl) += dv;
         }
 
         // Terminations: rigid bridge, filtered nut.
-        let at_bridge = self.left[at(m - 1)];
-        let at_nut = self.right[at(m - 1)];
+        let at_bridge = self.left.at(at(m - 1));
+        let at_nut = self.right.at(at(m - 1));
         let mut reflected = self.fraction.tick(at_nut);
         reflected = self.dispersion.tick(reflected);
         reflected = -self.loss.tick(reflected) * self.finger_reflection;
@@ -790,8 +790,8 @@ impl WaveguideString {
         };
 
         self.t = (self.t + 1) & mask;
-        self.right[self.t] = from_bridge;
-        self.left[self.t] = flush(reflected);
+        *self.right.at_mut(self.t) = from_bridge;
+        *self.left.at_mut(self.t) = flush(reflected);
 
         StringOutput {
             bridge_force_n: 2.0 * z0 * at_bridge,

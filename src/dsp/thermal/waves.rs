@@ -118,8 +118,7 @@ impl Waves {
             self.touch = Touch::default();
         }
         for p in 0..2 {
-            self.loss[p].g = loss.g;
-            self.loss[p].p = loss.p;
+            self.loss[p].retune(&loss);
             self.fraction[p].a = thiran;
         }
     }
