@@ -1160,16 +1160,11 @@ impl<B: StringBank> FourStrings<B> {
                 self.bank.samples(out, &mut step);
             }
             let gain = self.bank.output_gain();
-            for k in 0..out.len() {
-                let audio = self.radiation.tick(out[k] * gain);
-                if !audio.is_finite() {
-                    // As `finish`: silence, and the instrument reset.
-                    self.reset();
-                    self.recoveries += 1;
-                    out[k..].fill(0.0);
-                    return;
-                }
-                out[k] = audio;
+            if let Some(k) = self.radiation.block(gain, out) {
+                // As `finish`: silence, and the instrument reset.
+                self.reset();
+                self.recoveries += 1;
+                out[k..].fill(0.0);
             }
             return;
         }
