@@ -123,9 +123,24 @@ impl<const N: usize> AllpassChain<N> {
     }
 
     #[inline]
-    pub fn tick(&mut self, mut x: f64) -> f64 {
+    pub fn tick(&mut self, x: f64) -> f64 {
+        let stages = self.stages;
+        self.tick_first(stages, x)
+    }
+
+    /// [`AllpassChain::tick`] where the caller knows the chain has `K` sections
+    /// ([`AllpassChain::stages`]), compiled for that count: no loop bookkeeping.
+    #[inline(always)]
+    pub fn tick_known<const K: usize>(&mut self, x: f64) -> f64 {
+        debug_assert_eq!(K, self.stages);
+        self.tick_first(K, x)
+    }
+
+    /// The first `stages` sections (`stages <= N`).
+    #[inline(always)]
+    fn tick_first(&mut self, stages: usize, mut x: f64) -> f64 {
         let a = self.a;
-        for s in &mut self.s[..self.stages] {
+        for s in &mut self.s[..stages] {
             let y = a * x + *s;
             *s = x - a * y;
             x = y;

@@ -38,7 +38,7 @@ use super::intonation;
 use super::resample::Resampler;
 pub use super::strings::FourStrings;
 use super::strings::{InternalSample, StringBank, StringBow, HARMONIC_FINGER_RESISTANCE_Z0};
-use super::waveguide::{StringOutput, WaveguideString};
+use super::waveguide::{StringOutput, WaveguideString, ANY_STAGES, DEFAULT_DISPERSION_STAGES};
 
 use super::vocabulary::*;
 
@@ -71,6 +71,22 @@ impl StringVoice {
         } else {
             self.string
                 .tick(&mut KnownLaw::<LAW>(&mut self.contact), input)
+        }
+    }
+
+    /// [`StringVoice::tick`], not `SLOW`, for a string whose dispersion has `STAGES`
+    /// sections ([`WaveguideString::tick_with_stages`]).
+    #[inline(always)]
+    fn tick_with_stages<const LAW: u8, const STAGES: usize>(
+        &mut self,
+        input: BowInput,
+    ) -> StringOutput {
+        if LAW & law::MASK == law::ANY {
+            self.string
+                .tick_with_stages::<STAGES>(&mut self.contact, input)
+        } else {
+            self.string
+                .tick_with_stages::<STAGES>(&mut KnownLaw::<LAW>(&mut self.contact), input)
         }
     }
 }
@@ -371,6 +387,25 @@ impl StringBank for WaveguideBank {
     }
 }
 
+/// [`WaveguideBank::lone_steady_block`]'s loop: `voice` bowed by `input` for each sample
+/// of `out` (its bridge force), its dispersion's sections `STAGES`; the last sample's
+/// output.
+#[inline(always)]
+fn lone_loop<const SHAPE: u8, const STAGES: usize>(
+    voice: &mut StringVoice,
+    input: BowInput,
+    out: &mut [f64],
+) -> StringOutput {
+    const { assert!(STAGES == ANY_STAGES || STAGES <= DEFAULT_DISPERSION_STAGES) };
+    let mut last = StringOutput::default();
+    for sample in out {
+        last = voice.tick_with_stages::<SHAPE, STAGES>(input);
+        // The sum over the strings starts at +0 ([`WaveguideBank::sample_as`]).
+        *sample = 0.0 + last.bridge_force_n;
+    }
+    last
+}
+
 /// [`StringBank::samples`] compiled for AVX2: the body's modes four to a vector, and three
 /// operands an instruction where SSE2 copies a register first (no FMA: the same bits as
 /// the portable path).
@@ -480,12 +515,19 @@ impl WaveguideBank {
             velocity_m_per_s: bow.velocity_m_per_s,
             normal_force_n: bow.force,
         };
-        let mut last = StringOutput::default();
-        for sample in out {
-            last = voice.tick::<false, SHAPE>(input);
-            // The sum over the strings starts at +0 ([`WaveguideBank::sample_as`]).
-            *sample = 0.0 + last.bridge_force_n;
-        }
+        // The dispersion's count compiled in, up to the fit's default cap.
+        let last = match voice.string.dispersion_stages() {
+            0 => lone_loop::<SHAPE, 0>(voice, input, out),
+            1 => lone_loop::<SHAPE, 1>(voice, input, out),
+            2 => lone_loop::<SHAPE, 2>(voice, input, out),
+            3 => lone_loop::<SHAPE, 3>(voice, input, out),
+            4 => lone_loop::<SHAPE, 4>(voice, input, out),
+            5 => lone_loop::<SHAPE, 5>(voice, input, out),
+            6 => lone_loop::<SHAPE, 6>(voice, input, out),
+            7 => lone_loop::<SHAPE, 7>(voice, input, out),
+            8 => lone_loop::<SHAPE, 8>(voice, input, out),
+            _ => lone_loop::<SHAPE, ANY_STAGES>(voice, input, out),
+        };
         if i == probed {
             self.probe = (last.bow_point_velocity_m_per_s, last.friction_force_n);
         }

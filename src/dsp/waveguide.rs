@@ -74,6 +74,9 @@ pub const MAX_DISPERSION_STAGES: usize = 32;
 /// ([`WaveguideString::set_dispersion_cap`]): the fit's search runs on the audio thread at
 /// each note, and its cost grows with the cap.
 pub const DEFAULT_DISPERSION_STAGES: usize = 8;
+
+/// [`WaveguideString::tick_with_stages`]'s count for "not known where compiled".
+pub const ANY_STAGES: usize = usize::MAX;
 /// Most negative allpass coefficient the dispersion fit may choose: a first-order section
 /// disperses only below about `fs (1 + a) / 2 pi`, so the coefficient must approach -1 as
 /// the rate rises (at 768 kHz the cello D string needs -0.976). (A clamp at -0.95 made
@@ -696,7 +699,18 @@ impl WaveguideString {
     /// share the time index `t`.
     #[inline(always)]
     pub fn tick(&mut self, contact: &mut impl FrictionContact, bow: BowInput) -> StringOutput {
-        self.tick_as::<false>(contact, bow)
+        self.tick_as::<false, ANY_STAGES>(contact, bow)
+    }
+
+    /// [`WaveguideString::tick`] for a string whose dispersion has `STAGES` sections
+    /// ([`WaveguideString::dispersion_stages`]), compiled for that count.
+    #[inline(always)]
+    pub fn tick_with_stages<const STAGES: usize>(
+        &mut self,
+        contact: &mut impl FrictionContact,
+        bow: BowInput,
+    ) -> StringOutput {
+        self.tick_as::<false, STAGES>(contact, bow)
     }
 
     /// [`WaveguideString::tick`] while the stick strikes ([`WaveguideString::strike`],
@@ -708,12 +722,13 @@ impl WaveguideString {
         contact: &mut impl FrictionContact,
         bow: BowInput,
     ) -> StringOutput {
-        self.tick_as::<true>(contact, bow)
+        self.tick_as::<true, ANY_STAGES>(contact, bow)
     }
 
-    /// [`WaveguideString::tick`] (`STRUCK` false) or [`WaveguideString::tick_struck`].
+    /// [`WaveguideString::tick`] (`STRUCK` false) or [`WaveguideString::tick_struck`];
+    /// `STAGES` the dispersion's sections where known, else [`ANY_STAGES`].
     #[inline(always)]
-    fn tick_as<const STRUCK: bool>(
+    fn tick_as<const STRUCK: bool, const STAGES: usize>(
         &mut self,
         contact: &mut impl FrictionContact,
         bow: BowInput,
@@ -770,7 +785,11 @@ impl WaveguideString {
         let at_bridge = self.left.at(at(m - 1));
         let at_nut = self.right.at(at(m - 1));
         let mut reflected = self.fraction.tick(at_nut);
-        reflected = self.dispersion.tick(reflected);
+        reflected = if STAGES == ANY_STAGES {
+            self.dispersion.tick(reflected)
+        } else {
+            self.dispersion.tick_known::<STAGES>(reflected)
+        };
         reflected = -self.loss.tick(reflected) * self.finger_reflection;
         if self.pluck_tail_samples != 0 {
             reflected += self.pluck_tail;
