@@ -515,8 +515,14 @@ impl WaveguideBank {
             velocity_m_per_s: bow.velocity_m_per_s,
             normal_force_n: bow.force,
         };
-        // The dispersion's count compiled in, up to the fit's default cap.
-        let last = match voice.string.dispersion_stages() {
+        // The dispersion's count compiled in, up to the fit's default cap, for a string
+        // with nothing else on it.
+        let stages = if voice.string.is_plain() {
+            voice.string.dispersion_stages()
+        } else {
+            ANY_STAGES
+        };
+        let last = match stages {
             0 => lone_loop::<SHAPE, 0>(voice, input, out),
             1 => lone_loop::<SHAPE, 1>(voice, input, out),
             2 => lone_loop::<SHAPE, 2>(voice, input, out),

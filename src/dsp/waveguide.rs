@@ -703,7 +703,8 @@ impl WaveguideString {
     }
 
     /// [`WaveguideString::tick`] for a string whose dispersion has `STAGES` sections
-    /// ([`WaveguideString::dispersion_stages`]), compiled for that count.
+    /// ([`WaveguideString::dispersion_stages`]), compiled for that count, and that the
+    /// caller found [`WaveguideString::is_plain`] (which ticking keeps true).
     #[inline(always)]
     pub fn tick_with_stages<const STAGES: usize>(
         &mut self,
@@ -725,15 +726,26 @@ impl WaveguideString {
         self.tick_as::<true, ANY_STAGES>(contact, bow)
     }
 
+    /// Whether the string sounds with nothing on it but the bow: playable, no finger
+    /// touching it, no pluck still feeding in. Ticking keeps it so; only a call between
+    /// samples (a touch, a pluck, a new length) changes it.
+    #[inline(always)]
+    pub fn is_plain(&self) -> bool {
+        self.playable && self.touch.partial == 0 && self.pluck_tail_samples == 0
+    }
+
     /// [`WaveguideString::tick`] (`STRUCK` false) or [`WaveguideString::tick_struck`];
-    /// `STAGES` the dispersion's sections where known, else [`ANY_STAGES`].
+    /// `STAGES` the dispersion's sections where known (the string then
+    /// [`WaveguideString::is_plain`]), else [`ANY_STAGES`].
     #[inline(always)]
     fn tick_as<const STRUCK: bool, const STAGES: usize>(
         &mut self,
         contact: &mut impl FrictionContact,
         bow: BowInput,
     ) -> StringOutput {
-        if !self.playable {
+        // Known stages: a plain string, checked by the caller.
+        let plain = STAGES != ANY_STAGES;
+        if !plain && !self.playable {
             return StringOutput::default();
         }
         let mask = self.right.mask();
@@ -771,7 +783,7 @@ impl WaveguideString {
         let dv = force * admittance;
         *self.right.at_mut(ir) += dv;
         *self.left.at_mut(il) += dv;
-        if self.touch.partial != 0 {
+        if !plain && self.touch.partial != 0 {
             // The touching finger: the string's velocity there `v` meets its force
             // `-R v'` (`v'` the velocity after it), so `v' = v (1 - share)` and each wave
             // gains `v' - v`.
@@ -791,7 +803,7 @@ impl WaveguideString {
             self.dispersion.tick_known::<STAGES>(reflected)
         };
         reflected = -self.loss.tick(reflected) * self.finger_reflection;
-        if self.pluck_tail_samples != 0 {
+        if !plain && self.pluck_tail_samples != 0 {
             reflected += self.pluck_tail;
             self.pluck_tail_samples -= 1;
             if self.pluck_tail_samples == 0 {
@@ -802,7 +814,7 @@ impl WaveguideString {
         // Untouched, the bridge reflects what reached it, already flushed where the nut
         // wrote it (the bow's additions to it are far above the flush's level or zero);
         // the touching finger's fraction has a state of its own, so its output is flushed.
-        let from_bridge = if self.touch.partial == 0 {
+        let from_bridge = if plain || self.touch.partial == 0 {
             -at_bridge
         } else {
             flush(self.touch.fraction.tick(-at_bridge))
