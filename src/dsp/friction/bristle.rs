@@ -287,12 +287,40 @@ struct Curve {
     v_s: f64,
     z_ba: f64,
     elasto_plastic: bool,
+    /// `1 / v_s` and `1 / sigma0`, for [`Curve::eval`] with `RECIPROCALS`.
+    inv_v_s: f64,
+    inv_sigma0: f64,
 }
 
+/// A contact whose Newton tolerance is looser than this (m/s) evaluates its curve with
+/// reciprocals ([`Curve::eval`]'s `RECIPROCALS`): a division and a multiplication by the
+/// reciprocal differ by an ulp or two, ten orders of magnitude below such a tolerance.
+/// The reference tolerance ([`Y_TOLERANCE_M_PER_S`]) divides.
+pub const RECIPROCALS_ABOVE_M_PER_S: f64 = 1e-6;
+
 impl Curve {
-    /// `f_NL(v, z)` and its partial derivatives `(f, df/dv, df/dz)`.
+    /// The root of `g(y) = f(v~ + k1 y, z~ + k2 y) - y` where it lies in the
+    /// elasto-plastic bristle's elastic region, in closed form: there `f = v`, so `g` is
+    /// linear and its root is `y = v~ / (1 - k1)` (`k1 < 0`), exact where the point it
+    /// gives is elastic (against the slip, or at most the breakaway displacement). `None`
+    /// for LuGre (no elastic region) or a root outside the region.
     #[inline(always)]
-    fn eval(&self, v: f64, z: f64) -> (f64, f64, f64) {
+    fn elastic_root(&self, v_tilde: f64, k1: f64, z_tilde: f64, k2: f64) -> Option<f64> {
+        if !self.elasto_plastic {
+            return None;
+        }
+        let y = v_tilde / (1.0 - k1);
+        let (v, z) = (v_tilde + k1 * y, z_tilde + k2 * y);
+        let elastic = !(v * z > 0.0) || z.abs() <= self.z_ba;
+        (elastic && y.is_finite()).then_some(y)
+    }
+
+    /// `f_NL(v, z)` and its partial derivatives `(f, df/dv, df/dz)`. With `RECIPROCALS`
+    /// two divisions stand for the nine (by `v_s` and `sigma0` through their reciprocals,
+    /// by `h` and the transition's width once each): the same function to an ulp or two,
+    /// and a shorter chain of latencies in the Newton iteration.
+    #[inline(always)]
+    fn eval<const RECIPROCALS: bool>(&self, v: f64, z: f64) -> (f64, f64, f64) {
         let az = z.abs();
         let same_sign = v * z > 0.0;
         // The elasto-plastic bristle below its breakaway (or against the slip) is purely
@@ -301,36 +329,76 @@ impl Curve {
             return (v, 1.0, 0.0);
         }
         // Stribeck: h(v) = f_c + (f_s - f_c) e^{-(v/v_s)^2}, |z_ss| = h / sigma0.
-        let r = v / self.v_s;
+        let r = if RECIPROCALS {
+            v * self.inv_v_s
+        } else {
+            v / self.v_s
+        };
         let e = exp_nonpositive(-(r * r));
         let h = self.f_c + (self.f_s - self.f_c) * e;
         if h <= 0.0 {
             // No normal force: no bristle resistance.
             return (v, 1.0, 0.0);
         }
-        let dh = (self.f_s - self.f_c) * e * (-2.0 * r / self.v_s);
-        let zss = h / self.sigma0;
+        let (dh, zss) = if RECIPROCALS {
+            (
+                (self.f_s - self.f_c) * e * (-2.0 * r * self.inv_v_s),
+                h * self.inv_sigma0,
+            )
+        } else {
+            (
+                (self.f_s - self.f_c) * e * (-2.0 * r / self.v_s),
+                h / self.sigma0,
+            )
+        };
         // alpha and its partials
         let (alpha, dalpha_dz, dalpha_dv) = if !self.elasto_plastic || az >= zss {
             (1.0, 0.0, 0.0)
         } else {
             let width = zss - self.z_ba;
-            let theta = std::f64::consts::PI * (az - 0.5 * (zss + self.z_ba)) / width;
+            let pi = std::f64::consts::PI;
+            let (theta, dtheta_dabsz, dtheta_dzss) = if RECIPROCALS {
+                let inv_width = 1.0 / width;
+                (
+                    pi * (az - 0.5 * (zss + self.z_ba)) * inv_width,
+                    pi * inv_width,
+                    pi * (self.z_ba - az) * (inv_width * inv_width),
+                )
+            } else {
+                (
+                    pi * (az - 0.5 * (zss + self.z_ba)) / width,
+                    pi / width,
+                    pi * (self.z_ba - az) / (width * width),
+                )
+            };
             let (sin, c) = sin_cos_quarter_turn(theta);
-            let dtheta_dabsz = std::f64::consts::PI / width;
-            let dtheta_dzss = std::f64::consts::PI * (self.z_ba - az) / (width * width);
+            let dalpha_dv = if RECIPROCALS {
+                0.5 * c * dtheta_dzss * dh * self.inv_sigma0
+            } else {
+                0.5 * c * dtheta_dzss * dh / self.sigma0
+            };
             (
                 0.5 * (1.0 + sin),
                 0.5 * c * dtheta_dabsz * z.signum(),
-                0.5 * c * dtheta_dzss * dh / self.sigma0,
+                dalpha_dv,
             )
         };
         if alpha == 0.0 {
             return (v, 1.0, 0.0);
         }
         // f = v - alpha z |v| sigma0 / h   (z_ss carries the sign of v)
-        let phi = v.abs() * self.sigma0 / h;
-        let dphi_dv = self.sigma0 * (v.signum() * h - v.abs() * dh) / (h * h);
+        let (phi, dphi_dv) = if RECIPROCALS {
+            let inv_h = 1.0 / h;
+            (
+                v.abs() * self.sigma0 * inv_h,
+                self.sigma0 * (v.signum() * h - v.abs() * dh) * (inv_h * inv_h),
+            )
+        } else {
+            (
+                v.abs() * self.sigma0 / h,
+                self.sigma0 * (v.signum() * h - v.abs() * dh) / (h * h),
+            )
+        };
         let f = v - alpha * z * phi;
         let df_dz = -(dalpha_dz * z + alpha) * phi;
         let df_dv = 1.0 - z * (dalpha_dv * phi + alpha * dphi_dv);
@@ -446,12 +514,14 @@ impl BristleFriction {
             v_s: p.stribeck_m_per_s,
             z_ba: p.breakaway_ratio * p.mu_d * normal_force_n / p.sigma0_n_per_m,
             elasto_plastic: self.law == BristleLaw::ElastoPlastic,
+            inv_v_s: 1.0 / p.stribeck_m_per_s,
+            inv_sigma0: 1.0 / p.sigma0_n_per_m,
         }
     }
 
     /// Solves `g(y) = 0` (see the module doc); returns `y` and the Newton iteration count,
     /// or the fallback's evaluations of `g` if it was used.
-    fn solve_y(
+    fn solve_y<const RECIPROCALS: bool>(
         &self,
         curve: &Curve,
         v_tilde: f64,
@@ -462,7 +532,7 @@ impl BristleFriction {
         partials: &Cell<[f64; 3]>,
     ) -> (f64, Result<u32, u32>) {
         let g = |y: f64| {
-            let (f, dfv, dfz) = curve.eval(v_tilde + k1 * y, z_tilde + k2 * y);
+            let (f, dfv, dfz) = curve.eval::<RECIPROCALS>(v_tilde + k1 * y, z_tilde + k2 * y);
             let dg = dfv * k1 + dfz * k2 - 1.0;
             partials.set([dfv, dfz, dg]);
             (f - y, dg)
@@ -814,7 +884,15 @@ impl FrictionContact for BristleFriction {
             previous
         };
         let partials = Cell::new(NO_TANGENT);
-        let (y, iterations) = self.solve_y(&curve, v_tilde, k1, z_tilde, k2, start, &partials);
+        let quick = self.newton_tolerance_m_per_s > RECIPROCALS_ABOVE_M_PER_S;
+        let (y, iterations) = match quick.then(|| curve.elastic_root(v_tilde, k1, z_tilde, k2)) {
+            Some(Some(y)) => {
+                partials.set([1.0, 0.0, k1 - 1.0]);
+                (y, Ok(1))
+            }
+            _ if quick => self.solve_y::<true>(&curve, v_tilde, k1, z_tilde, k2, start, &partials),
+            _ => self.solve_y::<false>(&curve, v_tilde, k1, z_tilde, k2, start, &partials),
+        };
         self.last_partials = partials.get();
         self.last_tilde = (v_tilde, z_tilde);
         match iterations {
@@ -863,12 +941,23 @@ mod tests {
             v_s: 0.1,
             z_ba: 0.7 * 0.2 / p.sigma0_n_per_m,
             elasto_plastic,
+            inv_v_s: 1.0 / 0.1,
+            inv_sigma0: 1.0 / p.sigma0_n_per_m,
+        }
+    }
+
+    /// The curve and its partials, dividing (`false`) or through reciprocals (`true`).
+    fn eval(c: &Curve, reciprocals: bool, v: f64, z: f64) -> (f64, f64, f64) {
+        if reciprocals {
+            c.eval::<true>(v, z)
+        } else {
+            c.eval::<false>(v, z)
         }
     }
 
     #[test]
     fn analytic_derivatives_match_finite_differences() {
-        for ep in [false, true] {
+        for (ep, reciprocals) in [(false, false), (true, false), (false, true), (true, true)] {
             let c = curve(ep);
             for &(v, z) in &[
                 (0.05, 2.5e-5),
@@ -877,11 +966,12 @@ mod tests {
                 (0.01, 3.9e-5),
                 (0.5, 1e-6),
             ] {
-                let (_, dv, dz) = c.eval(v, z);
+                let (_, dv, dz) = eval(&c, reciprocals, v, z);
                 let hv = 1e-7;
                 let hz = 1e-11;
-                let nv = (c.eval(v + hv, z).0 - c.eval(v - hv, z).0) / (2.0 * hv);
-                let nz = (c.eval(v, z + hz).0 - c.eval(v, z - hz).0) / (2.0 * hz);
+                let f = |v, z| eval(&c, reciprocals, v, z).0;
+                let nv = (f(v + hv, z) - f(v - hv, z)) / (2.0 * hv);
+                let nz = (f(v, z + hz) - f(v, z - hz)) / (2.0 * hz);
                 // 1e-5 relative: central differences in f64 at these steps
                 assert!(
                     (dv - nv).abs() <= 1e-5 * nv.abs().max(1.0),
@@ -892,6 +982,101 @@ mod tests {
                     "ep {ep} v {v} z {z}: {dz} vs {nz}"
                 );
             }
+        }
+    }
+
+    /// Over a grid of slip velocities and bristle displacements through every branch (the
+    /// elastic region, the transition, the plastic side, both signs), the curve through
+    /// reciprocals is the dividing one to rounding: each of the value and its partials
+    /// within 1e-13 of the size of the terms it is made of (a few ulps of each of a dozen
+    /// operations; `f = v - alpha z phi` and `df/dv = 1 - z (...)` are differences, so their
+    /// terms, not the difference, set the scale). The good quality's Newton tolerance is
+    /// 1e-4 m/s.
+    /// Over a grid of load lines (free slip velocity `v~`, predicted displacement `z~`, the
+    /// string's admittance at 48 kHz), the elastic region's closed-form root is the root
+    /// the dividing Newton iteration finds at the reference tolerance, to 1e-12 m/s (the
+    /// iteration's own tolerance is 1e-10 relative), wherever it gives one; and wherever
+    /// that root lies in the elastic region, the closed form gives it (it misses none).
+    #[test]
+    fn the_elastic_regions_closed_form_root_is_newtons_root() {
+        let contact = BristleFriction::new(
+            BristleParams::modal_scenario(),
+            BristleLaw::ElastoPlastic,
+            48e3,
+        )
+        .unwrap();
+        let p = contact.params;
+        let curve = contact.curve(1.0);
+        let admittance = 1.0 / (2.0 * 0.55);
+        let k2 = contact.half_period_s;
+        let denominator = 1.0 + admittance * p.sigma2_kg_per_s;
+        let k1 = -admittance * (p.sigma0_n_per_m * k2 + p.sigma1_kg_per_s) / denominator;
+        let (mut closed, mut elastic_roots) = (0, 0);
+        for i in -30..=30 {
+            let v_tilde = 0.6 * f64::from(i) / 30.0;
+            for j in -30..=30 {
+                let z_tilde = 1.5 * curve.z_ba * f64::from(j) / 30.0;
+                let partials = Cell::new(NO_TANGENT);
+                let (newton, _) =
+                    contact.solve_y::<false>(&curve, v_tilde, k1, z_tilde, k2, 0.0, &partials);
+                let (v, z) = (v_tilde + k1 * newton, z_tilde + k2 * newton);
+                // Clearly inside the region (not within rounding of its edge).
+                let inside = !(v * z > 0.0) || z.abs() < curve.z_ba * (1.0 - 1e-9);
+                match curve.elastic_root(v_tilde, k1, z_tilde, k2) {
+                    Some(y) => {
+                        closed += 1;
+                        assert!(
+                            (y - newton).abs() <= 1e-12,
+                            "v~ {v_tilde}, z~ {z_tilde}: {y} against {newton}"
+                        );
+                    }
+                    None => assert!(!inside, "v~ {v_tilde}, z~ {z_tilde}: missed {newton}"),
+                }
+                elastic_roots += usize::from(inside);
+            }
+        }
+        // The grid reaches both regions.
+        assert!(
+            closed > 100 && closed < 61 * 61 - 100,
+            "{closed} closed-form roots"
+        );
+        assert!(elastic_roots <= closed);
+    }
+
+    #[test]
+    fn the_curve_through_reciprocals_is_the_dividing_curve_to_rounding() {
+        for ep in [false, true] {
+            let c = curve(ep);
+            let z_max = 1.5 * c.f_s / c.sigma0;
+            let mut worst = [0.0f64; 3];
+            for i in -40..=40 {
+                let v = 0.5 * f64::from(i) / 40.0;
+                for j in -40..=40 {
+                    let z = z_max * f64::from(j) / 40.0;
+                    let exact = eval(&c, false, v, z);
+                    let quick = eval(&c, true, v, z);
+                    let scales = [
+                        v.abs() + (exact.0 - v).abs(),
+                        1.0 + (exact.1 - 1.0).abs(),
+                        exact.2.abs(),
+                    ];
+                    let differences = [
+                        (exact.0 - quick.0).abs(),
+                        (exact.1 - quick.1).abs(),
+                        (exact.2 - quick.2).abs(),
+                    ];
+                    for k in 0..3 {
+                        if differences[k] > 0.0 {
+                            worst[k] = worst[k].max(differences[k] / scales[k]);
+                        }
+                    }
+                }
+            }
+            println!(
+                "ep {ep}: worst differences over the terms' size (f, df/dv, df/dz) {:.1e} {:.1e} {:.1e}",
+                worst[0], worst[1], worst[2]
+            );
+            assert!(worst.iter().all(|&w| w < 1e-13), "{worst:?}");
         }
     }
 
@@ -1071,7 +1256,7 @@ mod tests {
             };
             assert!((z - (z_prev + step)).abs() < 1e-15);
             let curve = c.curve(1.1);
-            assert!((curve.eval(v, z).0 - y).abs() < 1e-8, "sample {n}");
+            assert!((curve.eval::<false>(v, z).0 - y).abs() < 1e-8, "sample {n}");
             assert!(
                 (f - (p.sigma0_n_per_m * z + p.sigma1_kg_per_s * y + p.sigma2_kg_per_s * v)).abs()
                     < 1e-12
