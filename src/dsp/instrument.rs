@@ -388,20 +388,30 @@ impl StringBank for WaveguideBank {
 }
 
 /// [`WaveguideBank::lone_steady_block`]'s loop: `voice` bowed by `input` for each sample
-/// of `out` (its bridge force), its dispersion's sections `STAGES`; the last sample's
-/// output.
+/// of `out` (its bridge force; with `TWICE`, two of the string's samples through
+/// `decimator`), its dispersion's sections `STAGES`; the string's last output.
 #[inline(always)]
-fn lone_loop<const SHAPE: u8, const STAGES: usize>(
+fn lone_loop<const SHAPE: u8, const STAGES: usize, const TWICE: bool>(
     voice: &mut StringVoice,
+    decimator: &mut HalfbandDecimator,
     input: BowInput,
     out: &mut [f64],
 ) -> StringOutput {
     const { assert!(STAGES == ANY_STAGES || STAGES <= DEFAULT_DISPERSION_STAGES) };
     let mut last = StringOutput::default();
     for sample in out {
-        last = voice.tick_with_stages::<SHAPE, STAGES>(input);
-        // The sum over the strings starts at +0 ([`WaveguideBank::sample_as`]).
-        *sample = 0.0 + last.bridge_force_n;
+        // The sums over the strings start at +0 ([`WaveguideBank::sample_as`]).
+        *sample = if TWICE {
+            let first = 0.0
+                + voice
+                    .tick_with_stages::<SHAPE, STAGES>(input)
+                    .bridge_force_n;
+            last = voice.tick_with_stages::<SHAPE, STAGES>(input);
+            0.0 + decimator.tick(first, 0.0 + last.bridge_force_n)
+        } else {
+            last = voice.tick_with_stages::<SHAPE, STAGES>(input);
+            0.0 + last.bridge_force_n
+        };
     }
     last
 }
@@ -482,10 +492,15 @@ impl WaveguideBank {
         out: &mut [f64],
         step: &mut impl InternalSample<Self>,
     ) {
-        if SHAPE & LONE != 0 {
-            if let Some((bows, probed)) = step.steady() {
-                let i = self.computed[0] % STRINGS;
-                self.lone_steady_block::<SHAPE>(out, i, bows[i], probed);
+        if let Some((bows, probed)) = step.steady() {
+            let i = self.computed[0] % STRINGS;
+            if SHAPE & LONE != 0 {
+                self.lone_steady_block::<SHAPE, false>(out, i, bows[i], probed);
+                return;
+            }
+            // One string at twice the bank's rate (the violin's and viola's).
+            if self.computed_count == 1 && self.oversample[i] == 2 {
+                self.lone_steady_block::<SHAPE, true>(out, i, bows[i], probed);
                 return;
             }
         }
@@ -494,11 +509,12 @@ impl WaveguideBank {
         }
     }
 
-    /// The bridge force over a block of a lone string `i` ([`shape`]) bowed by `bow`
-    /// throughout, `probed` the probed string: its bow set once, then the string alone
-    /// in the loop (the samples of [`WaveguideBank::sample_as`] for it).
+    /// The bridge force over a block of a lone string `i` bowed by `bow` throughout,
+    /// `probed` the probed string: its bow set once, then the string alone in the loop
+    /// (the samples of [`WaveguideBank::sample_as`] for it). The string runs at the bank's
+    /// rate ([`shape`]'s lone), or with `TWICE` at twice it through the decimator.
     #[inline(always)]
-    fn lone_steady_block<const SHAPE: u8>(
+    fn lone_steady_block<const SHAPE: u8, const TWICE: bool>(
         &mut self,
         out: &mut [f64],
         i: usize,
@@ -509,7 +525,7 @@ impl WaveguideBank {
             return;
         }
         self.body_asleep = false;
-        let voice = &mut self.voices[i];
+        let (voice, decimator) = (&mut self.voices[i], &mut self.decimator);
         voice.string.set_bow_position(bow.position_beta);
         let input = BowInput {
             velocity_m_per_s: bow.velocity_m_per_s,
@@ -523,16 +539,16 @@ impl WaveguideBank {
             ANY_STAGES
         };
         let last = match stages {
-            0 => lone_loop::<SHAPE, 0>(voice, input, out),
-            1 => lone_loop::<SHAPE, 1>(voice, input, out),
-            2 => lone_loop::<SHAPE, 2>(voice, input, out),
-            3 => lone_loop::<SHAPE, 3>(voice, input, out),
-            4 => lone_loop::<SHAPE, 4>(voice, input, out),
-            5 => lone_loop::<SHAPE, 5>(voice, input, out),
-            6 => lone_loop::<SHAPE, 6>(voice, input, out),
-            7 => lone_loop::<SHAPE, 7>(voice, input, out),
-            8 => lone_loop::<SHAPE, 8>(voice, input, out),
-            _ => lone_loop::<SHAPE, ANY_STAGES>(voice, input, out),
+            0 => lone_loop::<SHAPE, 0, TWICE>(voice, decimator, input, out),
+            1 => lone_loop::<SHAPE, 1, TWICE>(voice, decimator, input, out),
+            2 => lone_loop::<SHAPE, 2, TWICE>(voice, decimator, input, out),
+            3 => lone_loop::<SHAPE, 3, TWICE>(voice, decimator, input, out),
+            4 => lone_loop::<SHAPE, 4, TWICE>(voice, decimator, input, out),
+            5 => lone_loop::<SHAPE, 5, TWICE>(voice, decimator, input, out),
+            6 => lone_loop::<SHAPE, 6, TWICE>(voice, decimator, input, out),
+            7 => lone_loop::<SHAPE, 7, TWICE>(voice, decimator, input, out),
+            8 => lone_loop::<SHAPE, 8, TWICE>(voice, decimator, input, out),
+            _ => lone_loop::<SHAPE, ANY_STAGES, TWICE>(voice, decimator, input, out),
         };
         if i == probed {
             self.probe = (last.bow_point_velocity_m_per_s, last.friction_force_n);
