@@ -119,6 +119,7 @@ pub struct WaveguideBank {
     /// Whether quiet lifted strings sleep (the default; off only to measure the saving).
     skipping: bool,
     /// AVX2 detected at run time ([`samples_avx2`]).
+    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     wide_simd: bool,
     /// The strings [`StringBank::sample`] computes, in order: the awake ones (every one
     /// when not skipping), the first `computed_count` entries

@@ -68,6 +68,7 @@ pub struct Radiation {
     /// The sections' gains, multiplied together.
     gain: f64,
     /// AVX2 detected at run time ([`Radiation::block`]).
+    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     wide_simd: bool,
 }
 
