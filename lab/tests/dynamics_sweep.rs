@@ -265,6 +265,7 @@ fn mid_dynamics_force_map() {
     let law = match std::env::var("LAW").as_deref() {
         Ok("lugre") => FrictionModel::LuGre,
         Ok("elasto-plastic") => FrictionModel::ElastoPlastic,
+        Ok("hyperbolic") => FrictionModel::Hyperbolic,
         _ => FrictionModel::Stribeck,
     };
     let factors: Vec<f64> = std::env::var("F").map_or(vec![1.0, 0.7, 0.5, 0.35], |s| {
@@ -272,10 +273,15 @@ fn mid_dynamics_force_map() {
             .map(|x| x.parse().expect("F: factors"))
             .collect()
     });
-    let ccs = [53u8, 58, 64, 69, 74, 80, 85];
+    let ccs: Vec<u8> = std::env::var("CCS").map_or(vec![53, 58, 64, 69, 74, 80, 85], |s| {
+        s.split(',')
+            .map(|x| x.parse().expect("CCS: levels 0-127"))
+            .collect()
+    });
+    let step: usize = std::env::var("STEP").map_or(3, |s| s.parse().expect("STEP: semitones"));
     for kind in InstrumentKind::ALL {
         let (low, high) = kind.note_range();
-        let notes: Vec<u8> = (low..=high.min(low + 36)).step_by(3).collect();
+        let notes: Vec<u8> = (low..=high.min(low + 36)).step_by(step).collect();
         for &cc in &ccs {
             let s = 10f64
                 .powf(-colophony::performer::DYNAMICS_RANGE_DB * (1.0 - cc as f64 / 127.0) / 20.0);
