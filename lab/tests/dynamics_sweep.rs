@@ -251,10 +251,11 @@ fn play_bow(setup: &Setup, note: u8, bow: BowControl) -> (f64, f64, Option<Regim
 }
 
 /// The share of every note in Helmholtz motion at the middle dynamics with the force
-/// below the guard's: every third semitone as in [`dynamics_sweep_survey`], the static
-/// law (`LAW=lugre` for another), bowed directly (guard off) at the guard's speed and
-/// distance from the bridge for CC11 53-85 and `F` times the guard's force (`F=1,0.7,0.5,0.35`
-/// by default). Printed per instrument, level and force: notes in Helmholtz motion of 13
+/// below the guard's: every third semitone as in [`dynamics_sweep_survey`] (`STEP=1` for
+/// every semitone), the static law (`LAW=lugre`, `elasto-plastic` or `hyperbolic` for
+/// another), bowed directly (guard off) at the guard's speed and distance from the bridge
+/// for CC11 53-85 (`CCS=a,b,..` for other levels) and `F` times the force proportional
+/// to the speed (`F=1,0.7,0.5,0.35` by default). Printed per instrument, level and force: notes in Helmholtz motion of 13
 /// (any pitch: the intonation table is fitted for the guard's force), and the slip's
 /// negative damping `F |mu'(v_slip)|` over the reference string's `2 Z0` at the guard's
 /// force (`v_slip = v_b (1 - beta) / beta`). `cargo test --release -p colophony-lab --test
@@ -290,9 +291,7 @@ fn mid_dynamics_force_map() {
             let bow0 = BowControl::default();
             let (v, beta) = (bow0.velocity_m_per_s * speed, bow0.position_beta * away);
             let x = v * (1.0 - beta) / beta / 0.1;
-            let damping = bow0.force_n * speed * 0.2 * 2.0 * x * (-x * x).exp()
-                / 0.1
-                / (2.0 * colophony::dsp::vocabulary::WEIGHT_REFERENCE_Z0);
+            let damping = colophony::performer::slip_damping(law, speed, away);
             let setup = Setup {
                 instrument: kind,
                 point_law: Some(law),

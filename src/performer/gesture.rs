@@ -192,39 +192,41 @@ impl GuardedBow {
     };
 }
 
-/// The share of the guard's force (`speed` times the parameters' force) a Stribeck law
-/// plays at the guard's `speed` and drift `away`: the most that keeps the slip's negative
-/// damping at the parameters' defaults under [`STRIBECK_SLIP_DAMPING`] of `2 Z0`.
-fn stribeck_force_share(speed: f64, away: f64) -> f64 {
-    let friction = crate::dsp::friction::stribeck::StribeckFriction::default();
-    let (v_s, fall) = (friction.stribeck_m_per_s, friction.mu_s - friction.mu_d);
-    let slope = |v: f64| {
-        let x = v / v_s;
-        2.0 * fall * x * (-x * x).exp() / v_s
-    };
-    slip_force_share(speed, away, slope, STRIBECK_SLIP_DAMPING)
-}
-
-/// The share of the guard's force the hyperbolic law plays at the guard's `speed` and
-/// drift `away`: the most that keeps the slip's negative damping at the parameters'
-/// defaults under [`HYPERBOLIC_SLIP_DAMPING`] of `2 Z0`.
-fn hyperbolic_force_share(speed: f64, away: f64) -> f64 {
-    let friction = crate::dsp::friction::HyperbolicFriction::default();
-    let (v0, fall) = (friction.v0_m_per_s, friction.mu_s - friction.mu_d);
-    let slope = |v: f64| fall * v0 / ((v0 + v) * (v0 + v));
-    slip_force_share(speed, away, slope, HYPERBOLIC_SLIP_DAMPING)
-}
-
-/// The share of the guard's force (`speed` times the parameters' force) that keeps the
-/// slip's negative damping `F |mu'(v_slip)|` at the parameters' defaults, the bow at the
-/// guard's `speed` and drift `away`, under `bound` of the reference string's `2 Z0`;
-/// `slope` is the friction curve's `|mu'|` at a slip speed, s/m.
-fn slip_force_share(speed: f64, away: f64, slope: impl Fn(f64) -> f64, bound: f64) -> f64 {
+/// The slip's negative damping `F |mu'(v_slip)|` over the reference string's `2 Z0` with
+/// point law `law` at the parameters' defaults, the bow at the guard's `speed` (and its
+/// force proportional to it) and drift `away`: the Helmholtz slip speed `v_b (1 - beta) /
+/// beta` on the law's curve (paper A's Stribeck curve for the static, LuGre and
+/// elasto-plastic laws). The string weighting makes `F / Z0` the same on every string.
+pub fn slip_damping(law: FrictionModel, speed: f64, away: f64) -> f64 {
     let bow = BowControl::default();
     let beta = (bow.position_beta * away).clamp(MIN_NOTE_BETA, MAX_NOTE_BETA);
     let v_slip = bow.velocity_m_per_s * speed * (1.0 - beta) / beta;
-    let damping =
-        bow.force_n * speed * slope(v_slip) / (2.0 * crate::dsp::vocabulary::WEIGHT_REFERENCE_Z0);
+    let slope = match law {
+        FrictionModel::Hyperbolic => {
+            let friction = crate::dsp::friction::HyperbolicFriction::default();
+            let (v0, fall) = (friction.v0_m_per_s, friction.mu_s - friction.mu_d);
+            fall * v0 / ((v0 + v_slip) * (v0 + v_slip))
+        }
+        _ => {
+            let friction = crate::dsp::friction::stribeck::StribeckFriction::default();
+            let (v_s, fall) = (friction.stribeck_m_per_s, friction.mu_s - friction.mu_d);
+            let x = v_slip / v_s;
+            2.0 * fall * x * (-x * x).exp() / v_s
+        }
+    };
+    bow.force_n * speed * slope / (2.0 * crate::dsp::vocabulary::WEIGHT_REFERENCE_Z0)
+}
+
+/// The share of the guard's force (`speed` times the parameters' force) point law `law`
+/// plays at the guard's `speed` and drift `away`: the most that keeps its
+/// [`slip_damping`] under its bound ([`HYPERBOLIC_SLIP_DAMPING`],
+/// [`STRIBECK_SLIP_DAMPING`]).
+fn slip_force_share(law: FrictionModel, speed: f64, away: f64) -> f64 {
+    let bound = match law {
+        FrictionModel::Hyperbolic => HYPERBOLIC_SLIP_DAMPING,
+        _ => STRIBECK_SLIP_DAMPING,
+    };
+    let damping = slip_damping(law, speed, away);
     if damping > bound {
         bound / damping
     } else {
@@ -251,11 +253,7 @@ pub fn guarded_bow(law: Option<FrictionModel>, kind: InstrumentKind, scale: f64)
         };
     }
     let away = drift_from.powf(-DYNAMICS_DRIFT_EXPONENT);
-    let share = match law {
-        Some(FrictionModel::Hyperbolic) => hyperbolic_force_share(speed, away),
-        None => 1.0,
-        Some(_) => stribeck_force_share(speed, away),
-    };
+    let share = law.map_or(1.0, |law| slip_force_share(law, speed, away));
     GuardedBow {
         speed,
         force: speed * share,
