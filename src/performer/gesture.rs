@@ -71,7 +71,7 @@ pub const STRIBECK_SLIP_DAMPING: f64 = 0.15;
 /// as the dynamics fall, from 0.05 of `2 Z0` at full expression to 0.17 at CC11 64, and
 /// falls again below (0.07 at CC11 0, where the slip is slowest). With the window guard
 /// the hyperbolic law's force is held so that `F |mu'|` stays under this share of `2 Z0`:
-/// 0.40 of the speed's share at CC11 64, 0.65 at 21, 0.96 at 0. Measured
+/// 0.40 of the speed's share at CC11 64, 0.59 at 21, 0.96 at 0. Measured
 /// (`mid_dynamics_force_map` in `lab/tests/dynamics_sweep.rs`, `LAW=hyperbolic STEP=1`:
 /// every semitone of three octaves from each instrument's lowest string, bowed directly
 /// at CC11 0-106's speed and distance with 0.35-2 times the speed's share of the force,
@@ -850,7 +850,7 @@ mod tests {
     fn the_hyperbolic_law_keeps_helmholtz_motion_at_the_middle_dynamics() {
         // At CC11 21 and 64 the guard's bow slips at 0.2 and 1 times the hyperbolic
         // curve's v0, where it falls steeply: with the force falling only as fast as the
-        // speed these notes slip twice a period (the cello's D3 at CC11 64 is raucous);
+        // speed these notes slip twice a period (the cello's F#2 at CC11 64 rattles);
         // with the force held under the slip's damping bound they play Helmholtz
         // motion. (Of 31 such notes tried at these two levels, 20 missed with the
         // speed's force and 1 with the guard's.) At full expression and at CC11 0
