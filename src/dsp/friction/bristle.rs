@@ -885,13 +885,13 @@ impl FrictionContact for BristleFriction {
         };
         let partials = Cell::new(NO_TANGENT);
         let quick = self.newton_tolerance_m_per_s > RECIPROCALS_ABOVE_M_PER_S;
-        let (y, iterations) = match quick.then(|| curve.elastic_root(v_tilde, k1, z_tilde, k2)) {
-            Some(Some(y)) => {
-                partials.set([1.0, 0.0, k1 - 1.0]);
-                (y, Ok(1))
-            }
-            _ if quick => self.solve_y::<true>(&curve, v_tilde, k1, z_tilde, k2, start, &partials),
-            _ => self.solve_y::<false>(&curve, v_tilde, k1, z_tilde, k2, start, &partials),
+        let (y, iterations) = if !quick {
+            self.solve_y::<false>(&curve, v_tilde, k1, z_tilde, k2, start, &partials)
+        } else if let Some(y) = curve.elastic_root(v_tilde, k1, z_tilde, k2) {
+            partials.set([1.0, 0.0, k1 - 1.0]);
+            (y, Ok(1))
+        } else {
+            self.solve_y::<true>(&curve, v_tilde, k1, z_tilde, k2, start, &partials)
         };
         self.last_partials = partials.get();
         self.last_tilde = (v_tilde, z_tilde);
@@ -985,13 +985,6 @@ mod tests {
         }
     }
 
-    /// Over a grid of slip velocities and bristle displacements through every branch (the
-    /// elastic region, the transition, the plastic side, both signs), the curve through
-    /// reciprocals is the dividing one to rounding: each of the value and its partials
-    /// within 1e-13 of the size of the terms it is made of (a few ulps of each of a dozen
-    /// operations; `f = v - alpha z phi` and `df/dv = 1 - z (...)` are differences, so their
-    /// terms, not the difference, set the scale). The good quality's Newton tolerance is
-    /// 1e-4 m/s.
     /// Over a grid of load lines (free slip velocity `v~`, predicted displacement `z~`, the
     /// string's admittance at 48 kHz), the elastic region's closed-form root is the root
     /// the dividing Newton iteration finds at the reference tolerance, to 1e-12 m/s (the
@@ -1043,6 +1036,13 @@ mod tests {
         assert!(elastic_roots <= closed);
     }
 
+    /// Over a grid of slip velocities and bristle displacements through every branch (the
+    /// elastic region, the transition, the plastic side, both signs), the curve through
+    /// reciprocals is the dividing one to rounding: each of the value and its partials
+    /// within 1e-13 of the size of the terms it is made of (a few ulps of each of a dozen
+    /// operations; `f = v - alpha z phi` and `df/dv = 1 - z (...)` are differences, so their
+    /// terms, not the difference, set the scale). The good quality's Newton tolerance is
+    /// 1e-4 m/s.
     #[test]
     fn the_curve_through_reciprocals_is_the_dividing_curve_to_rounding() {
         for ep in [false, true] {
