@@ -111,6 +111,10 @@ pub struct InstrumentSpec {
     /// How many times [`INTERNAL_RATE_HZ`] each point-bow string runs at
     /// ([`InstrumentKind::point_oversampling`]).
     pub point_oversampling: [usize; STRINGS],
+    /// Where the body's radiation falls above the bridge's resonances, Hz: the corner of
+    /// a fourth-order Butterworth low-pass after the modes ([`super::body::TopFall`]),
+    /// or `None` where the measured body falls no faster than the violin's within 5 kHz.
+    pub top_fall_hz: Option<f64>,
 }
 
 /// Every instrument's data (docs/literature-values.md §1.4: the Desvages/NESS string sets;
@@ -128,6 +132,7 @@ pub const SPECS: [InstrumentSpec; InstrumentKind::COUNT] = [
         string_length_m: 0.32,
         body_scale: 1.0,
         point_oversampling: [2; STRINGS],
+        top_fall_hz: None,
     },
     InstrumentSpec {
         name: "viola",
@@ -139,6 +144,7 @@ pub const SPECS: [InstrumentSpec; InstrumentKind::COUNT] = [
         string_length_m: 0.38,
         body_scale: 0.8,
         point_oversampling: [2; STRINGS],
+        top_fall_hz: None,
     },
     InstrumentSpec {
         name: "cello",
@@ -150,6 +156,7 @@ pub const SPECS: [InstrumentSpec; InstrumentKind::COUNT] = [
         string_length_m: 0.69,
         body_scale: 0.42,
         point_oversampling: [1, 1, 1, 2],
+        top_fall_hz: Some(3450.0),
     },
     // Tension and linear density from Russo, Ducceschi and Zambon's double bass strings
     // (DAFx 2022, 1.06 m; docs/literature-values.md §1.4): Z0 = sqrt(T mu). Their strings
@@ -167,6 +174,7 @@ pub const SPECS: [InstrumentSpec; InstrumentKind::COUNT] = [
         string_length_m: 1.06,
         body_scale: 0.23,
         point_oversampling: [1; STRINGS],
+        top_fall_hz: None,
     },
 ];
 
