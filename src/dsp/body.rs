@@ -20,7 +20,7 @@ pub const MAX_BODY_MODES: usize = 6;
 
 /// A mute's mass over the bridge's effective mass in its rocking mode (the bridge hill).
 /// Chosen from SHARC's violin played open and muted (docs/articulations.md, "Measured
-/// mute"): through [`MuteLoad`], 1 puts the violin's loss over 2.5-5 kHz within 2 dB of
+/// mute"): through [`Biquad::mute_load`], 1 puts the violin's loss over 2.5-5 kHz within 2 dB of
 /// the recording's band by band (1.5, 2 and 3 deeper than it by 1-3, 3-5 and 6-9 dB); the
 /// same ratio for the larger instruments, whose mutes and bridges grow together.
 pub const MUTE_MASS_RATIO: f64 = 1.0;
@@ -29,33 +29,44 @@ pub const MUTE_MASS_RATIO: f64 = 1.0;
 /// ([`muted_bridge_mode`]).
 pub const BRIDGE_MODES_FROM_HZ: f64 = 1500.0;
 
-/// A mute on the bridge, as a filter on the force the bridge passes to the body.
-///
-/// The bridge hill is the bridge rocking on its feet: its top, where the strings press
-/// (mass `m`), on a spring `k` (its waist) into the body's resistance `c` at its feet
-/// (Woodhouse's bridge-hill model, reduced to one degree of freedom; docs/articulations.md).
-/// The force it passes to the body is then `w_b^2 / (s^2 + B s + w_b^2)`, with
-/// `w_b^2 = k / m` and `B = k / c`. A mute of mass `r m` clamped on the top lowers the
-/// resonance to `w_m = w_b / sqrt(1 + r)` and keeps `B`. The generic body already holds the
-/// open bridge's hill (its last mode, [`InstrumentKind::bridge_hill`]), so the mute
-/// multiplies what it radiates by the loaded transmission over the open one:
-/// `R(s) = (w_m^2 / w_b^2) (s^2 + B s + w_b^2) / (s^2 + B s + w_m^2)`: unity at DC,
-/// `1 / (1 + r)` far above the hill and deepest near it. Bilinear, each resonance
-/// pre-warped, so the digital filter keeps unity at DC and both resonances where they are.
-///
-/// [`InstrumentKind::bridge_hill`]: super::vocabulary::InstrumentKind::bridge_hill
+/// A biquad in transposed direct form II, `H(z) = (b0 + b1 z^-1 + b2 z^-2) / (1 + a1 z^-1
+/// + a2 z^-2)`: a mute's load on the bridge ([`Biquad::mute_load`]) and the sections of a
+/// body's fall above its bridge ([`TopFall`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct MuteLoad {
+pub struct Biquad {
     b: [f64; 3],
     a: [f64; 2],
     s: [f64; 2],
 }
 
-impl MuteLoad {
+impl Biquad {
+    /// Passes its input unchanged.
+    const PASS: Self = Self {
+        b: [1.0, 0.0, 0.0],
+        a: [0.0, 0.0],
+        s: [0.0; 2],
+    };
+
+    /// A mute on the bridge: a filter on the force the bridge passes to the body.
+    ///
+    /// The bridge hill is the bridge rocking on its feet: its top, where the strings press
+    /// (mass `m`), on a spring `k` (its waist) into the body's resistance `c` at its feet
+    /// (Woodhouse's bridge-hill model, reduced to one degree of freedom; docs/articulations.md).
+    /// The force it passes to the body is then `w_b^2 / (s^2 + B s + w_b^2)`, with
+    /// `w_b^2 = k / m` and `B = k / c`. A mute of mass `r m` clamped on the top lowers the
+    /// resonance to `w_m = w_b / sqrt(1 + r)` and keeps `B`. The generic body already holds the
+    /// open bridge's hill (its last mode, [`InstrumentKind::bridge_hill`]), so the mute
+    /// multiplies what it radiates by the loaded transmission over the open one:
+    /// `R(s) = (w_m^2 / w_b^2) (s^2 + B s + w_b^2) / (s^2 + B s + w_m^2)`: unity at DC,
+    /// `1 / (1 + r)` far above the hill and deepest near it. Bilinear, each resonance
+    /// pre-warped, so the digital filter keeps unity at DC and both resonances where they are.
+    ///
     /// The mute `mass_ratio` times the bridge's effective mass on the bridge `hill`, at
     /// `sample_rate_hz`. Resonances at or above 0.45 of the rate are taken there (the
     /// filter then passes everything unchanged if both are).
-    pub fn new(hill: BodyMode, mass_ratio: f64, sample_rate_hz: f64) -> Self {
+    ///
+    /// [`InstrumentKind::bridge_hill`]: super::vocabulary::InstrumentKind::bridge_hill
+    pub fn mute_load(hill: BodyMode, mass_ratio: f64, sample_rate_hz: f64) -> Self {
         let k = 2.0 * sample_rate_hz;
         let warp = |f: f64| k * (PI * (f / sample_rate_hz).min(0.45)).tan();
         let w_b = warp(hill.freq_hz);
@@ -73,6 +84,20 @@ impl MuteLoad {
         Self {
             b: [g * n[0], g * n[1], g * n[2]],
             a: [d[1] / d[0], d[2] / d[0]],
+            s: [0.0; 2],
+        }
+    }
+
+    /// A second-order low-pass at `corner_hz` of quality `q` (RBJ's cookbook: bilinear,
+    /// the corner pre-warped), at `sample_rate_hz`; below 0.45 of the rate.
+    fn low_pass(corner_hz: f64, q: f64, sample_rate_hz: f64) -> Self {
+        let (sin, cos) = (2.0 * PI * (corner_hz / sample_rate_hz)).sin_cos();
+        let alpha = sin / (2.0 * q);
+        let a0 = 1.0 + alpha;
+        let b1 = (1.0 - cos) / a0;
+        Self {
+            b: [b1 / 2.0, b1, b1 / 2.0],
+            a: [-2.0 * cos / a0, (1.0 - alpha) / a0],
             s: [0.0; 2],
         }
     }
@@ -117,33 +142,19 @@ impl MuteLoad {
 /// [`InstrumentSpec::top_fall_hz`]: super::vocabulary::InstrumentSpec::top_fall_hz
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TopFall {
-    sections: [MuteLoad; 2],
+    sections: [Biquad; 2],
 }
 
 impl TopFall {
     pub fn new(corner_hz: f64, sample_rate_hz: f64) -> Self {
-        let w = 2.0 * PI * (corner_hz / sample_rate_hz).min(0.45);
-        let (sin, cos) = w.sin_cos();
-        let pass = corner_hz >= 0.45 * sample_rate_hz;
+        if corner_hz >= 0.45 * sample_rate_hz {
+            return Self {
+                sections: [Biquad::PASS; 2],
+            };
+        }
         // Butterworth's pole angles, pi/8 and 3 pi/8 from the imaginary axis.
-        let sections = [1.0, 3.0].map(|k: f64| {
-            if pass {
-                return MuteLoad {
-                    b: [1.0, 0.0, 0.0],
-                    a: [0.0, 0.0],
-                    s: [0.0; 2],
-                };
-            }
-            let q = 0.5 / (k * PI / 8.0).sin();
-            let alpha = sin / (2.0 * q);
-            let a0 = 1.0 + alpha;
-            let b1 = (1.0 - cos) / a0;
-            MuteLoad {
-                b: [b1 / 2.0, b1, b1 / 2.0],
-                a: [-2.0 * cos / a0, (1.0 - alpha) / a0],
-                s: [0.0; 2],
-            }
-        });
+        let sections = [1.0, 3.0]
+            .map(|k: f64| Biquad::low_pass(corner_hz, 0.5 / (k * PI / 8.0).sin(), sample_rate_hz));
         Self { sections }
     }
 
@@ -205,7 +216,7 @@ pub const MUTE_FADE_S: f64 = 0.05;
 
 /// The body `kind` plays at `sample_rate_hz`: its `custom` modes (a fitted bridge's
 /// passive reduction, [`body_from_bridge`]; at most [`MAX_BODY_MODES`] are kept) or the
-/// generic ones, with a mute on the bridge ([`MuteLoad`], on the instrument's bridge hill)
+/// generic ones, with a mute on the bridge ([`Biquad::mute_load`], on the instrument's bridge hill)
 /// when `with_mute`.
 pub fn body_for(
     kind: super::vocabulary::InstrumentKind,
@@ -220,7 +231,7 @@ pub fn body_for(
         .top_fall_hz
         .map(|corner| TopFall::new(corner, sample_rate_hz));
     if with_mute {
-        body.mute = Some(MuteLoad::new(
+        body.mute = Some(Biquad::mute_load(
             kind.bridge_hill(),
             MUTE_MASS_RATIO,
             sample_rate_hz,
@@ -301,7 +312,7 @@ pub struct BodyModes {
     count: usize,
     direct_gain: f64,
     /// A mute on the bridge, filtering the body's output ([`body_for`]).
-    mute: Option<MuteLoad>,
+    mute: Option<Biquad>,
     /// The fall above the bridge's resonances, after the mute ([`body_for`]).
     top: Option<TopFall>,
 }
@@ -387,7 +398,7 @@ impl BodyModes {
             new.s = old.s;
         }
         if let (Some(new), Some(old)) = (&mut self.top, top) {
-            new.sections = [0, 1].map(|k| MuteLoad {
+            new.sections = [0, 1].map(|k| Biquad {
                 s: old.sections[k].s,
                 ..new.sections[k]
             });
@@ -485,7 +496,7 @@ mod tests {
     use crate::dsp::vocabulary::InstrumentKind;
 
     /// A mute on the bridge is the loaded bridge's transmission over the open one
-    /// (`R(s)` of [`MuteLoad`], written out here from the bridge-hill model): unity at
+    /// (`R(s)` of [`Biquad::mute_load`], written out here from the bridge-hill model): unity at
     /// low frequencies, `1 / (1 + r)` far above the hill and deepest near it, on every
     /// instrument and at 44.1-192 kHz; the body's modes below are the open body's.
     #[test]
@@ -502,7 +513,7 @@ mod tests {
         for kind in InstrumentKind::ALL {
             let hill = kind.bridge_hill();
             for fs in [44_100.0, 48_000.0, 96_000.0, 192_000.0] {
-                let mute = MuteLoad::new(hill, r, fs);
+                let mute = Biquad::mute_load(hill, r, fs);
                 // Unity at 10 Hz: the bridge is rigid far below its hill. 0.01 dB: the
                 // loaded resonance's own rise, `(f / f_m)^2` of it, is 1e-3 dB there.
                 let low = db(mute.gain_at(10.0, fs));

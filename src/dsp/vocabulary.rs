@@ -256,7 +256,7 @@ impl InstrumentKind {
 
     /// The bridge hill: the bridge rocking on its feet, the last of
     /// [`InstrumentKind::body_modes`] (its frequency and Q are what a mute loads,
-    /// [`super::body::MuteLoad`]).
+    /// [`super::body::Biquad::mute_load`]).
     pub fn bridge_hill(self) -> BodyMode {
         self.body_modes()[4]
     }

@@ -1077,7 +1077,7 @@ mod tests {
     /// against the low ones, and the strings are tuned for the bridge's phase delay, so the
     /// note keeps its pitch (within 3 cents, under what a player hears). The force on the
     /// bridge leaves through the instrument's body, which the mute loads as on the
-    /// point-bow instrument ([`crate::dsp::body::MuteLoad`]): measured -4.9 dB from
+    /// point-bow instrument ([`crate::dsp::body::Biquad::mute_load`]): measured -4.9 dB from
     /// 630 Hz against +0.2 dB below 315 Hz (the band starts below the cello's loaded hill,
     /// 742 Hz); the direction is asserted, the size documented.
     #[test]
