@@ -127,7 +127,9 @@ enum Command {
     /// Bowed (needs libstk-dev and g++); `thermal-constants` bows paper B's contact with
     /// candidate constant sets on probe notes across the window; `scenes` times what
     /// skipping silent strings saves; `playing-space --out DIR` maps Helmholtz motion over
-    /// the bowing window (see its options); `intonation --out FILE` measures the bowed
+    /// the bowing window (see its options); `window --out FILE [--models ..] [--instruments
+    /// ..]` measures the forces that hold Helmholtz motion on every string (the shipped
+    /// file: assets/measured-window.csv); `intonation --out FILE` measures the bowed
     /// intonation table (`--free`: the thermal strings' plucked rows); `timbre --out DIR [--models ..] [--rates ..] [--instruments ..]`
     /// compares each instrument's played notes with a real player's, band by band (default
     /// the hyperbolic law at 48 kHz; STK's Bowed on the same notes where libstk-dev is
@@ -177,8 +179,10 @@ enum Command {
         /// playing-space: how each note begins: `performer` (the default: the plugin's
         /// attack for a separate note at velocity 100, the bow from rest with the stroke's
         /// ramp and accent), `landing` (the bow lands at its speed and the cell's force)
-        /// or `catch` (at `F_max / 2` until the string slips regularly, then lowered to the
-        /// cell's force by 0.3 s: whether that force holds Helmholtz motion).
+        /// `catch` (at `F_max / 2` until the string slips regularly, then lowered to the
+        /// cell's force by 0.3 s: whether that force holds Helmholtz motion) or `hold` (as
+        /// `catch`, held up to 1 s and moved up as well as down, measured from 1.3 s: what
+        /// `bench window` plays).
         #[arg(long, default_value = "performer")]
         attack: String,
         /// playing-space: the point-bow strings' most dispersion sections (default the
@@ -460,7 +464,7 @@ fn main() -> ExitCode {
                 Some(dir) => colophony_lab::playing_space::Plan::from_options(quick, &rates, step, &models, &instruments)
                     .and_then(|mut plan| {
                         plan.attack = colophony_lab::playing_space::Attack::from_name(&attack)
-                            .ok_or_else(|| format!("unknown attack '{attack}': choose landing or catch"))?;
+                            .ok_or_else(|| format!("unknown attack '{attack}': choose performer, landing, catch or hold"))?;
                         plan.dispersion_stages = dispersion_stages;
                         colophony_lab::playing_space::run(&dir, &plan)
                     }),
@@ -474,6 +478,11 @@ fn main() -> ExitCode {
                     }),
                 None => Err("bench intonation needs --out FILE (the shipped one: assets/intonation.csv)".into()),
             },
+            "window" => match out {
+                Some(file) => colophony_lab::playing_space::Plan::from_options(false, &[], None, &models, &instruments)
+                    .and_then(|plan| colophony_lab::measured_window::run(&file, &plan.models, &plan.kinds)),
+                None => Err("bench window needs --out FILE (the shipped one: assets/measured-window.csv)".into()),
+            },
             "thermal-constants" => colophony_lab::thermal_constants::run(),
             "timbre" => match out {
                 // One model (the default law) at 48 kHz unless asked for more.
@@ -486,7 +495,7 @@ fn main() -> ExitCode {
                 None => Err("bench timbre needs --out DIR".into()),
             },
             other => Err(format!(
-                "unknown bench '{other}': choose friction, table1, scenes, peers, precision, playing-space, intonation, timbre or thermal-constants"
+                "unknown bench '{other}': choose friction, table1, scenes, peers, precision, playing-space, window, intonation, timbre or thermal-constants"
             )),
         }),
         Command::Presets => {

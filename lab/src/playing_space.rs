@@ -115,6 +115,9 @@ pub enum Bowing {
     Centre(f64),
     /// `F_max / 2` at this beta.
     HalfMax(f64),
+    /// A share of `F_max` at a beta (`OfMax(beta, share)`): the measured window's grid
+    /// ([`crate::measured_window`]).
+    OfMax(f64, f64),
 }
 
 impl Bowing {
@@ -125,6 +128,7 @@ impl Bowing {
             Bowing::TwiceMin(b) => format!("2Fmin@{b}"),
             Bowing::Centre(b) => format!("mid@{b}"),
             Bowing::HalfMax(b) => format!("Fmax/2@{b}"),
+            Bowing::OfMax(b, share) => format!("{share}Fmax@{b}"),
         }
     }
 
@@ -206,6 +210,13 @@ pub enum Attack {
     /// performer's catch ([`Catch`]) where the cell's force is light; what the plugin
     /// plays when a note lands.
     Performer,
+    /// Held: the bow lands at `F_max / 2`, stays there until the classifier calls the
+    /// probe Helmholtz motion (as [`Attack::Catch`], but for up to [`HOLD_MAX_S`]), and
+    /// then moves geometrically over [`HOLD_MOVE_S`] to the cell's force, lower or higher;
+    /// the cell is measured from [`HOLD_SETTLE_S`]. Whether a force *holds* the motion
+    /// once it is going, above `F_max / 2` as below: Schelleng's window as a stability
+    /// limit, measured ([`crate::measured_window`]).
+    Hold,
 }
 
 /// [`Attack::Performer`]: the note velocity (1..=127) the cells are played with.
@@ -217,13 +228,19 @@ impl Attack {
             Attack::Landing => "landing",
             Attack::Catch => "catch",
             Attack::Performer => "performer",
+            Attack::Hold => "hold",
         }
     }
 
     pub fn from_name(name: &str) -> Option<Self> {
-        [Attack::Landing, Attack::Catch, Attack::Performer]
-            .into_iter()
-            .find(|a| a.name().eq_ignore_ascii_case(name))
+        [
+            Attack::Landing,
+            Attack::Catch,
+            Attack::Performer,
+            Attack::Hold,
+        ]
+        .into_iter()
+        .find(|a| a.name().eq_ignore_ascii_case(name))
     }
 }
 
@@ -235,6 +252,15 @@ pub const CATCH_HOLD_MAX_S: f64 = 0.24;
 /// [`Attack::Catch`]: how long the force takes to fall to the cell's, s
 /// (`CATCH_HOLD_MAX_S + CATCH_FALL_S = SETTLE_S`).
 pub const CATCH_FALL_S: f64 = 0.06;
+/// [`Attack::Hold`]: the longest the catching force is held, s (the low strings near the
+/// bridge take up to about a second to find the motion: docs/playing-space.md).
+pub const HOLD_MAX_S: f64 = 1.0;
+/// [`Attack::Hold`]: how long the force takes to move to the cell's, s: a hundred
+/// periods of the cello's C string, slow against the motion's own adjustment.
+pub const HOLD_MOVE_S: f64 = 0.2;
+/// [`Attack::Hold`]: when the measurement starts, s (a tenth of a second after the
+/// latest the force can arrive).
+pub const HOLD_SETTLE_S: f64 = HOLD_MAX_S + HOLD_MOVE_S + 0.1;
 
 impl Cell {
     pub fn new(
@@ -260,7 +286,7 @@ impl Cell {
     ) -> Self {
         let beta = match bowing {
             Bowing::Defaults | Bowing::Middle => 0.1,
-            Bowing::TwiceMin(b) | Bowing::Centre(b) | Bowing::HalfMax(b) => b,
+            Bowing::TwiceMin(b) | Bowing::Centre(b) | Bowing::HalfMax(b) | Bowing::OfMax(b, _) => b,
         };
         let window = cell_window(model, kind, note, string, beta);
         let mut v = 0.1;
@@ -282,6 +308,7 @@ impl Cell {
             Bowing::Middle | Bowing::Centre(_) => (f_min * f_max).sqrt(),
             Bowing::TwiceMin(_) => 2.0 * f_min,
             Bowing::HalfMax(_) => 0.5 * f_max,
+            Bowing::OfMax(_, share) => share * f_max,
         };
         Self {
             model,
@@ -330,6 +357,16 @@ impl Cell {
             },
             expression: e,
             ..self
+        }
+    }
+
+    /// When the cell's measurement starts, s: [`HOLD_SETTLE_S`] for [`Attack::Hold`],
+    /// [`SETTLE_S`] otherwise.
+    pub fn settle_s(&self) -> f64 {
+        if self.attack == Attack::Hold {
+            HOLD_SETTLE_S
+        } else {
+            SETTLE_S
         }
     }
 
@@ -453,13 +490,21 @@ struct Catcher {
     fall_from: Option<usize>,
     max_hold: usize,
     fall: f64,
+    /// [`Attack::Hold`]: the force moves to the cell's from above or below; otherwise the
+    /// catch acts only where the cell's force is lighter than it.
+    both_ways: bool,
 }
 
 impl Catcher {
     fn new(cell: &Cell) -> Self {
         let catch = match cell.attack {
             Attack::Landing | Attack::Performer => 0.0,
-            Attack::Catch => 0.5 * cell.f_max_n,
+            Attack::Catch | Attack::Hold => 0.5 * cell.f_max_n,
+        };
+        let (hold, fall) = if cell.attack == Attack::Hold {
+            (HOLD_MAX_S, HOLD_MOVE_S)
+        } else {
+            (CATCH_HOLD_MAX_S, CATCH_FALL_S)
         };
         let stroke = (cell.attack == Attack::Performer).then(|| {
             let mut stroke = Stroke::new(cell.rate_hz);
@@ -500,9 +545,15 @@ impl Catcher {
             f0_hz: cell.nominal_hz(),
             next_check: Self::window(period),
             fall_from: None,
-            max_hold: (CATCH_HOLD_MAX_S * cell.rate_hz) as usize,
-            fall: CATCH_FALL_S * cell.rate_hz,
+            max_hold: (hold * cell.rate_hz) as usize,
+            fall: fall * cell.rate_hz,
+            both_ways: cell.attack == Attack::Hold,
         }
+    }
+
+    /// Whether the catching force acts on this cell at all.
+    fn catching(&self) -> bool {
+        self.catch > 0.0 && (self.catch > self.bow.force_n || self.both_ways)
     }
 
     /// Samples the classifier reads: [`CATCH_PERIODS`] periods and a half.
@@ -529,7 +580,7 @@ impl Catcher {
             };
         }
         let target = self.bow.force_n;
-        if self.catch <= target {
+        if !self.catching() {
             return self.bow;
         }
         let start = self.fall_from.unwrap_or(self.max_hold).min(self.max_hold);
@@ -552,10 +603,7 @@ impl Catcher {
         if let (Some(catch), Some(last)) = (&mut self.performer_catch, probe.last()) {
             catch.observe(last);
         }
-        if self.catch <= self.bow.force_n
-            || self.fall_from.is_some()
-            || probe.len() < self.next_check
-        {
+        if !self.catching() || self.fall_from.is_some() || probe.len() < self.next_check {
             return;
         }
         self.next_check += self.period.round().max(1.0) as usize;
@@ -573,7 +621,7 @@ pub fn measure(cell: &Cell) -> Result<Measured, String> {
     let (audio, probe) = render_cell(cell)?;
     let fs = cell.rate_hz;
     let f0 = cell.nominal_hz();
-    let start = ((SETTLE_S * fs) as usize).min(audio.len());
+    let start = ((cell.settle_s() * fs) as usize).min(audio.len());
     let period = fs / f0;
     // Whole periods of the note for the slip statistics.
     let periods = ((audio.len() - start) as f64 / period).floor();
@@ -752,6 +800,11 @@ impl Plan {
                         for &bowing in &self.bowings {
                             let mut cell = Cell::new(model, kind, note, rate, bowing, self.seconds);
                             cell.attack = self.attack;
+                            // A held cell is measured from HOLD_SETTLE_S: half a second
+                            // after it at least.
+                            if self.attack == Attack::Hold {
+                                cell.seconds = cell.seconds.max(HOLD_SETTLE_S + 0.5);
+                            }
                             cell.dispersion_stages = self.dispersion_stages;
                             cells.push(cell);
                         }
@@ -767,6 +820,13 @@ impl Plan {
 /// when `progress` is set.
 pub fn run_plan(plan: &Plan, progress: bool) -> Result<Vec<(Cell, Measured)>, String> {
     let cells = plan.cells();
+    let measured = measure_cells(&cells, progress)?;
+    Ok(cells.into_iter().zip(measured).collect())
+}
+
+/// Measures `cells` in parallel (rayon), in their order, with a progress bar on standard
+/// error when `progress` is set.
+pub fn measure_cells(cells: &[Cell], progress: bool) -> Result<Vec<Measured>, String> {
     let bar = if progress {
         indicatif::ProgressBar::new(cells.len() as u64)
     } else {
@@ -791,10 +851,7 @@ pub fn run_plan(plan: &Plan, progress: bool) -> Result<Vec<(Cell, Measured)>, St
         .collect();
     bar.finish_and_clear();
     results.sort_by_key(|r| r.0);
-    results
-        .into_iter()
-        .map(|(i, r)| r.map(|m| (cells[i], m)))
-        .collect()
+    results.into_iter().map(|(_, r)| r).collect()
 }
 
 /// A rough relative cost of a cell, for scheduling only.

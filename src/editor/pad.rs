@@ -32,6 +32,8 @@ pub const MIN_FORCE_COLOUR: Color32 = Color32::from_rgb(90, 170, 235);
 const WINDOW_FILL: Color32 = Color32::from_rgba_premultiplied(40, 90, 45, 90);
 const HANDLE_COLOUR: Color32 = Color32::from_rgb(250, 225, 90);
 /// The ring marking the bow as played.
+/// Where the model was measured to hold Helmholtz motion at no force of the window.
+pub const NO_WINDOW_TEXT: &str = "no force measured to hold Helmholtz motion";
 const PLAYED_COLOUR: Color32 = Color32::from_rgb(120, 200, 255);
 
 /// State of one pad across frames.
@@ -66,7 +68,10 @@ impl XyPad {
     }
 
     /// Draws the pad in `outer` (tick labels included) and handles the pointer. `window` is
-    /// the Schelleng window to draw behind, if the bow is on a string.
+    /// the Schelleng window to draw behind, if the bow is on a string, with the shares of
+    /// its `F_max` between which the model was measured to hold Helmholtz motion
+    /// (`played`: `None` where no force held it).
+    #[allow(clippy::too_many_arguments)]
     pub fn show(
         &mut self,
         ui: &mut Ui,
@@ -75,6 +80,7 @@ impl XyPad {
         velocity: &FloatParam,
         force: &FloatParam,
         window: Option<&SchellengWindow>,
+        played: Option<(f64, f64)>,
     ) -> Response {
         let rect = Rect::from_min_max(
             pos2(outer.left() + LEFT_MARGIN, outer.top()),
@@ -99,7 +105,7 @@ impl XyPad {
             info.current_text_value = Some(pad_value_text(v, f));
             info
         });
-        self.paint(ui, rect, window, v, f);
+        self.paint(ui, rect, window, played, v, f);
         // The bow as the performer plays it (the strokes, the dynamics and the MIDI
         // controllers move it away from the parameters): a ring where it differs from the
         // handle by more than a couple of pixels.
@@ -199,7 +205,15 @@ impl XyPad {
         }
     }
 
-    fn paint(&self, ui: &Ui, rect: Rect, window: Option<&SchellengWindow>, v: f32, f: f32) {
+    fn paint(
+        &self,
+        ui: &Ui,
+        rect: Rect,
+        window: Option<&SchellengWindow>,
+        played: Option<(f64, f64)>,
+        v: f32,
+        f: f32,
+    ) {
         let m = &self.mapping;
         let visuals = ui.visuals();
         let painter = ui.painter();
@@ -209,7 +223,7 @@ impl XyPad {
         painter.rect_filled(rect, 3.0, visuals.extreme_bg_color);
 
         if let Some(w) = window {
-            self.paint_window(ui, rect, w);
+            self.paint_window(ui, rect, w, played);
         }
 
         // Velocity grid every 0.5 m/s, the zero line stronger.
@@ -293,32 +307,51 @@ impl XyPad {
         );
     }
 
-    /// The Schelleng window: the band between F_min and F_max filled, both curves drawn.
-    fn paint_window(&self, ui: &Ui, rect: Rect, w: &SchellengWindow) {
+    /// The Schelleng window: both of its curves drawn thin, and the band the model was
+    /// measured to hold Helmholtz motion in (`played`, shares of `F_max`) filled between
+    /// its own two edges.
+    fn paint_window(&self, ui: &Ui, rect: Rect, w: &SchellengWindow, played: Option<(f64, f64)>) {
         let m = &self.mapping;
         let painter = ui.painter();
         let columns = (rect.width() / 2.0).ceil().max(2.0) as usize;
         let mut mesh = Mesh::default();
         let mut upper = Vec::with_capacity(columns + 1);
         let mut lower = Vec::with_capacity(columns + 1);
+        let mut played_upper = Vec::with_capacity(columns + 1);
+        let mut played_lower = Vec::with_capacity(columns + 1);
         for i in 0..=columns {
             let x = rect.left() + rect.width() * i as f32 / columns as f32;
             let vb = m.x_to_velocity(rect, x) as f64;
-            let y_max = m.force_to_y(rect, w.max_force_n(vb) as f32);
-            let y_min = m.force_to_y(rect, w.min_force_n(vb) as f32);
-            upper.push(pos2(x, y_max));
-            lower.push(pos2(x, y_min));
-            mesh.colored_vertex(pos2(x, y_max), WINDOW_FILL);
-            mesh.colored_vertex(pos2(x, y_min), WINDOW_FILL);
-            if i > 0 {
-                let k = 2 * i as u32;
-                mesh.add_triangle(k - 2, k - 1, k);
-                mesh.add_triangle(k - 1, k + 1, k);
+            let f_max = w.max_force_n(vb);
+            upper.push(pos2(x, m.force_to_y(rect, f_max as f32)));
+            lower.push(pos2(x, m.force_to_y(rect, w.min_force_n(vb) as f32)));
+            if let Some((lo, hi)) = played {
+                let y_hi = m.force_to_y(rect, (hi * f_max) as f32);
+                let y_lo = m.force_to_y(rect, (lo * f_max) as f32);
+                played_upper.push(pos2(x, y_hi));
+                played_lower.push(pos2(x, y_lo));
+                mesh.colored_vertex(pos2(x, y_hi), WINDOW_FILL);
+                mesh.colored_vertex(pos2(x, y_lo), WINDOW_FILL);
+                if i > 0 {
+                    let k = 2 * i as u32;
+                    mesh.add_triangle(k - 2, k - 1, k);
+                    mesh.add_triangle(k - 1, k + 1, k);
+                }
             }
         }
         painter.add(Shape::mesh(mesh));
-        painter.add(Shape::line(upper, Stroke::new(2.0, MAX_FORCE_COLOUR)));
-        painter.add(Shape::line(lower, Stroke::new(2.0, MIN_FORCE_COLOUR)));
+        painter.add(Shape::line(upper, Stroke::new(1.0, MAX_FORCE_COLOUR)));
+        painter.add(Shape::line(lower, Stroke::new(1.0, MIN_FORCE_COLOUR)));
+        if played.is_some() {
+            painter.add(Shape::line(
+                played_upper,
+                Stroke::new(2.0, MAX_FORCE_COLOUR),
+            ));
+            painter.add(Shape::line(
+                played_lower,
+                Stroke::new(2.0, MIN_FORCE_COLOUR),
+            ));
+        }
 
         // Curve and region names on the right half, where the curves are apart.
         let font = FontId::proportional(12.0);
@@ -366,14 +399,28 @@ impl XyPad {
                 );
             }
         }
-        if y_min - y_max > 30.0 {
-            painter.text(
-                pos2(at(f_max).x, (y_max + y_min) * 0.5),
-                Align2::CENTER_CENTER,
-                "Helmholtz",
-                font,
-                ui.visuals().strong_text_color(),
-            );
+        match played {
+            Some((lo, hi)) => {
+                let (y_hi, y_lo) = (at(hi * f_max).y, at(lo * f_max).y);
+                if y_lo - y_hi > 30.0 {
+                    painter.text(
+                        pos2(at(f_max).x, (y_hi + y_lo) * 0.5),
+                        Align2::CENTER_CENTER,
+                        "Helmholtz",
+                        font,
+                        ui.visuals().strong_text_color(),
+                    );
+                }
+            }
+            None => {
+                painter.text(
+                    pos2(at(f_max).x, (y_max + y_min) * 0.5),
+                    Align2::CENTER_CENTER,
+                    NO_WINDOW_TEXT,
+                    font,
+                    ui.visuals().weak_text_color(),
+                );
+            }
         }
     }
 }

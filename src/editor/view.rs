@@ -10,10 +10,11 @@ use super::nodes::{paint_slip_image, paint_temperature_profile, NodeRecord, RING
 use super::pad::{format_force, format_velocity, XyPad, MAX_FORCE_COLOUR, MIN_FORCE_COLOUR};
 use super::presets::PresetBar;
 use super::{EditorLink, EditorSize};
+use crate::dsp::intonation::TunedModel;
 use crate::dsp::vocabulary::{midi_to_hz, InstrumentKind};
 use crate::measure::contact::ContactSample;
 use crate::measure::regime::{classify_regime, Regime};
-use crate::measure::window::{model_coefficients, SchellengWindow};
+use crate::measure::window::{measured, model_coefficients, SchellengWindow};
 use crate::params::{ColophonyParams, FrictionChoice, QualityChoice, ResonatorChoice};
 use egui::{vec2, Color32, Layout, RichText, Ui};
 use nice_plug::context::gui::GuiContext;
@@ -180,6 +181,21 @@ impl EditorUi {
         ))
     }
 
+    /// The shares of `window`'s `F_max` between which the chosen model was measured to
+    /// hold Helmholtz motion on the window's string ([`measured`]; docs/playing-space.md),
+    /// `None` where no force held it.
+    pub fn played_shares(&self, window: &SchellengWindow) -> Option<(f64, f64)> {
+        let kind: InstrumentKind = self.params.instrument.value().into();
+        let string = self.window_string(kind, self.window_note(kind));
+        let model = self
+            .params
+            .friction_model
+            .value()
+            .point_law()
+            .map_or(TunedModel::Thermal, TunedModel::Point);
+        measured().shares(model, kind, string, window.beta)
+    }
+
     /// Draws one frame.
     pub fn ui(&mut self, ui: &mut Ui) {
         self.link.set_listening(self.live);
@@ -230,6 +246,7 @@ impl EditorUi {
             self.detected = None;
         }
         let window = self.window();
+        let played = window.as_ref().and_then(|w| self.played_shares(w));
         let available = ui.available_size();
         let thermal_height = if self.thermal_shown() {
             THERMAL_HEIGHT
@@ -252,6 +269,7 @@ impl EditorUi {
                 &params.bow_velocity,
                 &params.bow_force,
                 window.as_ref(),
+                played,
             );
             ui.add_space(8.0);
             ui.allocate_ui_with_layout(
@@ -471,6 +489,16 @@ impl EditorUi {
                 ui.label(RichText::new("F_min").color(MIN_FORCE_COLOUR));
                 ui.label(format!("{f_min:.4} N"));
                 ui.end_row();
+                ui.label("Measured");
+                ui.label(match self.played_shares(w) {
+                    Some((lo, hi)) => format!(
+                        "{:.3} to {:.3} N hold Helmholtz motion",
+                        lo * f_max,
+                        hi * f_max
+                    ),
+                    None => "no force held Helmholtz motion".into(),
+                });
+                ui.end_row();
                 ui.label("Bow");
                 ui.label(format_force(f));
                 ui.end_row();
@@ -481,7 +509,14 @@ impl EditorUi {
     fn regime_lines(&self, ui: &mut Ui, window: &SchellengWindow) {
         let v = self.params.bow_velocity.value() as f64;
         let f = self.params.bow_force.value() as f64;
-        let (text, colour) = predicted_regime(v, f, window.min_force_n(v), window.max_force_n(v));
+        let f_max = window.max_force_n(v);
+        let (text, colour) = match self.played_shares(window) {
+            Some((lo, hi)) => predicted_regime(v, f, lo * f_max, hi * f_max),
+            None => (
+                "no force measured to hold Helmholtz motion here",
+                MAX_FORCE_COLOUR,
+            ),
+        };
         ui.label(RichText::new(format!("Predicted: {text}")).color(colour));
         let weak = ui.visuals().weak_text_color();
         let (text, colour) = match (self.live, self.detected) {
@@ -520,16 +555,20 @@ pub fn describe_record(record: &NodeRecord) -> String {
     )
 }
 
-/// Where the bow sits relative to the window, as Schelleng's diagram names the regions.
+/// Where the bow sits relative to the window (`f_min` .. `f_max`: the forces measured to
+/// hold Helmholtz motion), as Schelleng's diagram names the regions.
 fn predicted_regime(v: f64, f: f64, f_min: f64, f_max: f64) -> (&'static str, Color32) {
     if f <= 0.0 {
         ("silent (bow lifted)", Color32::GRAY)
     } else if v == 0.0 {
         ("silent (bow at rest)", Color32::GRAY)
     } else if f > f_max {
-        ("raucous (above F_max)", MAX_FORCE_COLOUR)
+        ("raucous (above the measured window)", MAX_FORCE_COLOUR)
     } else if f < f_min {
-        ("multiple slips (below F_min)", MIN_FORCE_COLOUR)
+        (
+            "multiple slips (below the measured window)",
+            MIN_FORCE_COLOUR,
+        )
     } else {
         ("Helmholtz motion", HELMHOLTZ_COLOUR)
     }

@@ -19,8 +19,10 @@
 //! (Schoonderwaldt, Guettler and Askenfelt 2008). `mu_s` 0.4 and `mu_d` 0.2 are the defaults
 //! of the hyperbolic friction law (and of the bristle models).
 
+use crate::dsp::intonation::TunedModel;
 use crate::dsp::vocabulary::{InstrumentKind, STRINGS};
 use std::f64::consts::PI;
+use std::sync::OnceLock;
 
 /// Static friction coefficient of the hyperbolic law's defaults.
 pub const MU_S: f64 = 0.4;
@@ -139,6 +141,120 @@ impl SchellengWindow {
     }
 }
 
+/// Bow positions the window was measured at (the playing-space map's grid).
+pub const MEASURED_BETAS: [f64; 4] = [0.05, 0.08, 0.12, 0.18];
+
+/// The first line of the measured window's file.
+pub const MEASURED_WINDOW_HEADER: &str = "model,instrument,string,beta,low,high,held,regimes";
+
+/// The window each model plays, measured (`colophony bench window`, shipped as
+/// `assets/measured-window.csv`; method in docs/playing-space.md): for every model,
+/// instrument, string and beta of [`MEASURED_BETAS`], the lowest and highest share of
+/// Schelleng's `F_max` ([`SchellengWindow::max_force_n`] with the model's coefficients)
+/// that hold Helmholtz motion once it is going, or none where no force held it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeasuredWindows {
+    shares: [[[[Option<(f64, f64)>; MEASURED_BETAS.len()]; STRINGS]; InstrumentKind::COUNT];
+        TunedModel::COUNT],
+}
+
+impl MeasuredWindows {
+    /// Reads the file's text: the header, then one line a (model, instrument, string,
+    /// beta), every one present once.
+    pub fn parse(text: &str) -> Result<Self, String> {
+        let mut lines = text.lines();
+        if lines.next().map(str::trim) != Some(MEASURED_WINDOW_HEADER) {
+            return Err(format!(
+                "the measured window must begin with '{MEASURED_WINDOW_HEADER}'"
+            ));
+        }
+        let mut shares =
+            [[[[None; MEASURED_BETAS.len()]; STRINGS]; InstrumentKind::COUNT]; TunedModel::COUNT];
+        let mut seen =
+            [[[[false; MEASURED_BETAS.len()]; STRINGS]; InstrumentKind::COUNT]; TunedModel::COUNT];
+        for (n, line) in lines.enumerate().filter(|(_, l)| !l.trim().is_empty()) {
+            let bad = |what: &str| format!("measured window, line {}: {what}", n + 2);
+            let f: Vec<&str> = line.split(',').map(str::trim).collect();
+            if f.len() < 6 {
+                return Err(bad("fewer than six fields"));
+            }
+            let model = TunedModel::from_name(f[0]).ok_or_else(|| bad("unknown model"))?;
+            let kind = InstrumentKind::from_name(f[1]).ok_or_else(|| bad("unknown instrument"))?;
+            let string: usize = f[2]
+                .parse()
+                .ok()
+                .filter(|&s| s < STRINGS)
+                .ok_or_else(|| bad("string not 0-3"))?;
+            let beta: f64 = f[3].parse().map_err(|_| bad("beta not a number"))?;
+            let b = MEASURED_BETAS
+                .iter()
+                .position(|&g| (g - beta).abs() < 1e-9)
+                .ok_or_else(|| bad("beta not one of the measured ones"))?;
+            let window = match (f[4], f[5]) {
+                ("", "") => None,
+                (lo, hi) => {
+                    let lo: f64 = lo.parse().map_err(|_| bad("low share not a number"))?;
+                    let hi: f64 = hi.parse().map_err(|_| bad("high share not a number"))?;
+                    if !(lo > 0.0 && lo <= hi && hi.is_finite()) {
+                        return Err(bad("shares must satisfy 0 < low <= high"));
+                    }
+                    Some((lo, hi))
+                }
+            };
+            let slot = &mut seen[model.row()][kind.index()][string][b];
+            if *slot {
+                return Err(bad("a row given twice"));
+            }
+            *slot = true;
+            shares[model.row()][kind.index()][string][b] = window;
+        }
+        if seen.iter().flatten().flatten().flatten().any(|s| !s) {
+            return Err("the measured window lacks a (model, instrument, string, beta)".into());
+        }
+        Ok(Self { shares })
+    }
+
+    /// The lowest and highest share of `F_max` that hold the motion on string `string`
+    /// of `kind` bowed at `beta` with `model`: between two measured positions
+    /// interpolated in the logarithms of beta and of the shares; beyond them, the nearest
+    /// one's. `None` where the nearest measured position found no window (or where one of
+    /// the two around `beta` found none).
+    pub fn shares(
+        &self,
+        model: TunedModel,
+        kind: InstrumentKind,
+        string: usize,
+        beta: f64,
+    ) -> Option<(f64, f64)> {
+        let row = &self.shares[model.row()][kind.index()][string.min(STRINGS - 1)];
+        let last = MEASURED_BETAS.len() - 1;
+        if !(beta > MEASURED_BETAS[0]) {
+            return row[0];
+        }
+        if beta >= MEASURED_BETAS[last] {
+            return row[last];
+        }
+        let k = MEASURED_BETAS.iter().rposition(|&g| g <= beta).unwrap_or(0);
+        if beta == MEASURED_BETAS[k] {
+            return row[k];
+        }
+        let (a, b) = (row[k]?, row[k + 1]?);
+        let t = (beta / MEASURED_BETAS[k]).ln() / (MEASURED_BETAS[k + 1] / MEASURED_BETAS[k]).ln();
+        let mix = |x: f64, y: f64| (x.ln() * (1.0 - t) + y.ln() * t).exp();
+        Some((mix(a.0, b.0), mix(a.1, b.1)))
+    }
+}
+
+/// The shipped measured window (`assets/measured-window.csv`), parsed once. Call it off
+/// the audio thread first (the editor does, when built); later calls are a load.
+pub fn measured() -> &'static MeasuredWindows {
+    static TABLE: OnceLock<MeasuredWindows> = OnceLock::new();
+    TABLE.get_or_init(|| {
+        MeasuredWindows::parse(include_str!("../../assets/measured-window.csv"))
+            .expect("the shipped measured window parses (tested)")
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -229,5 +345,88 @@ mod tests {
         let g = SchellengWindow::for_note(InstrumentKind::Cello, 44, 0.1).unwrap();
         assert_eq!(g.z0_kg_per_s, 0.833);
         assert!(SchellengWindow::for_note(InstrumentKind::Violin, 40, 0.1).is_none());
+    }
+
+    /// A measured window's text with every row `low, high` but the ones `set` gives.
+    fn windows_text(set: &[(&str, &str, usize, f64, &str)]) -> String {
+        let mut text = format!("{MEASURED_WINDOW_HEADER}\n");
+        for model in TunedModel::all() {
+            for kind in InstrumentKind::ALL {
+                for string in 0..STRINGS {
+                    for beta in MEASURED_BETAS {
+                        let shares = set
+                            .iter()
+                            .find(|r| {
+                                (r.0, r.1, r.2, r.3) == (model.name(), kind.name(), string, beta)
+                            })
+                            .map_or("0.1,0.5", |r| r.4);
+                        text += &format!(
+                            "{},{},{string},{beta},{shares},,\n",
+                            model.name(),
+                            kind.name()
+                        );
+                    }
+                }
+            }
+        }
+        text
+    }
+
+    #[test]
+    fn the_shipped_measured_window_parses() {
+        // What it holds is tested against the model in lab/tests/measured_window.rs.
+        let text = include_str!("../../assets/measured-window.csv");
+        assert_eq!(MeasuredWindows::parse(text).as_ref(), Ok(measured()));
+    }
+
+    #[test]
+    fn the_measured_window_interpolates_in_log_beta_and_keeps_the_nearest_beyond() {
+        let text = windows_text(&[
+            ("hyperbolic", "cello", 2, 0.08, "0.02,0.25"),
+            ("hyperbolic", "cello", 2, 0.12, "0.08,1"),
+            ("hyperbolic", "cello", 2, 0.18, ","),
+        ]);
+        let m = MeasuredWindows::parse(&text).unwrap();
+        let law = TunedModel::Point(crate::dsp::friction::FrictionModel::Hyperbolic);
+        let at = |beta: f64| m.shares(law, InstrumentKind::Cello, 2, beta);
+        assert_eq!(at(0.08), Some((0.02, 0.25)));
+        // The geometric middle of 0.08 and 0.12 takes the geometric middle of the shares.
+        let (lo, hi) = at((0.08f64 * 0.12).sqrt()).unwrap();
+        assert!(
+            (lo - 0.04).abs() < 1e-12 && (hi - 0.5).abs() < 1e-12,
+            "{lo} {hi}"
+        );
+        // Beyond the grid the nearest row; toward a row with no window, none.
+        assert_eq!(at(0.02), Some((0.1, 0.5)));
+        assert_eq!(at(0.3), None);
+        assert_eq!(at(0.15), None);
+        // At a measured position, that row, whatever its neighbour holds.
+        assert_eq!(at(0.12), Some((0.08, 1.0)));
+    }
+
+    #[test]
+    fn a_broken_measured_window_is_refused_with_its_line() {
+        let good = windows_text(&[]);
+        assert!(MeasuredWindows::parse(&good).is_ok());
+        let missing: String = good.lines().take(10).map(|l| format!("{l}\n")).collect();
+        assert!(MeasuredWindows::parse(&missing)
+            .unwrap_err()
+            .contains("lacks"));
+        let twice = format!("{good}hyperbolic,cello,2,0.12,0.1,0.5,,\n");
+        assert!(MeasuredWindows::parse(&twice)
+            .unwrap_err()
+            .contains("twice"));
+        for bad in [
+            "hyperbolic,cello,2,0.12,0.5,0.1,,",
+            "hyperbolic,cello,2,0.1,0.1,0.5,,",
+            "nobody,cello,2,0.12,0.1,0.5,,",
+            "hyperbolic,cello,7,0.12,0.1,0.5,,",
+            "hyperbolic,cello,2,0.12,x,0.5,,",
+        ] {
+            let text = good.replacen("hyperbolic,cello,2,0.12,0.1,0.5,,", bad, 1);
+            let err = MeasuredWindows::parse(&text).unwrap_err();
+            assert!(err.contains("line"), "{bad}: {err}");
+        }
+        assert!(MeasuredWindows::parse("").is_err());
     }
 }

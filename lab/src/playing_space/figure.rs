@@ -69,6 +69,10 @@ pub fn draw(
                 "Colophony playing space: {} (caught at F_max/2, then held at each force)",
                 model.name()
             ),
+            super::Attack::Hold => format!(
+                "Colophony playing space: {} (held at F_max/2 until caught, then moved to each force)",
+                model.name()
+            ),
             super::Attack::Performer => format!(
                 "Colophony playing space: {} (the performer's attack, velocity {})",
                 model.name(),

@@ -1,0 +1,289 @@
+//! The window each model plays, measured (`colophony bench window --out FILE`; the
+//! shipped one is `assets/measured-window.csv`, read by
+//! [`colophony::measure::window::measured`]).
+//!
+//! **Method.** For every model, instrument, open string and grid beta
+//! ([`GRID_BETAS`]), the string is bowed at 0.1 m/s (slower where `F_max / 2` would pass
+//! the plugin's 10 N, as the map bows) and held in Helmholtz motion at `F_max / 2`
+//! ([`Attack::Hold`]: up to [`HOLD_MAX_S`] for the motion to form), then the force moves
+//! geometrically over [`HOLD_MOVE_S`] to each share of Schelleng's `F_max` in [`SHARES`],
+//! and the probe is read from [`HOLD_SETTLE_S`] to the cell's end. A force **holds** the
+//! motion ([`holds`]) when the editor's classifier calls it one slip a period, the string
+//! sticks at the bow (within [`STICK_TOLERANCE`]) and it slips for at least
+//! `1 - SLIP_FRACTION_TOLERANCE` of beta: longer slips are Cremer's corner rounding,
+//! which grows toward the lower edge; a shorter one is the point-bow string's short pulse
+//! (docs/playing-space.md), not Helmholtz motion.
+//!
+//! **The window** of a (model, string, beta) is the run of consecutive shares that hold
+//! the motion and contain `F_max / 2` (or, where `F_max / 2` itself does not, the longest
+//! run): its lowest and highest share. The true edges lie between those and the next
+//! shares out. Where no share holds, the window is not found. Schelleng's limits scale
+//! with the bow speed, so the shares do too: the window at another speed is the same
+//! shares of that speed's `F_max`.
+
+use crate::playing_space::{
+    measure_cells, regime_name, Attack, Bowing, Cell, Measured, Model, GRID_BETAS, HOLD_SETTLE_S,
+    SLIP_FRACTION_TOLERANCE, STICK_TOLERANCE,
+};
+#[cfg(doc)]
+use crate::playing_space::{HOLD_MAX_S, HOLD_MOVE_S};
+use colophony::dsp::vocabulary::{InstrumentKind, STRINGS};
+use colophony::measure::regime::Regime;
+use colophony::measure::window::{MeasuredWindows, MEASURED_WINDOW_HEADER};
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// The forces tried, as shares of Schelleng's `F_max`: from about `F_min` (at beta 0.05
+/// with `Q1` 500 `F_min` is `F_max / 64`; at 0.18, `F_max / 229`) to above `F_max`.
+pub const SHARES: [f64; 10] = [
+    1.0 / 128.0,
+    1.0 / 64.0,
+    1.0 / 32.0,
+    1.0 / 16.0,
+    1.0 / 8.0,
+    0.25,
+    0.5,
+    0.7,
+    1.0,
+    1.4,
+];
+
+/// The share the motion is caught at and from which the window is grown.
+const CATCH_SHARE: usize = 6;
+
+/// Seconds a cell lasts: half a second measured after [`HOLD_SETTLE_S`].
+pub const SECONDS: f64 = HOLD_SETTLE_S + 0.5;
+
+/// The host rate the window is measured at, Hz (every host rate plays the same internal
+/// strings: docs/models.md).
+pub const RATE_HZ: f64 = 48_000.0;
+
+/// One (model, instrument, string, beta): the cells of [`SHARES`] in order.
+fn cells_of(model: Model, kind: InstrumentKind, string: usize, beta: f64) -> Vec<Cell> {
+    let note = kind.open_notes()[string];
+    SHARES
+        .iter()
+        .map(|&share| {
+            let mut cell = Cell::on_string(
+                model,
+                kind,
+                note,
+                Some(string),
+                RATE_HZ,
+                Bowing::OfMax(beta, share),
+                SECONDS,
+            );
+            cell.attack = Attack::Hold;
+            cell
+        })
+        .collect()
+}
+
+/// Whether a cell's force held the motion (see the module doc).
+pub fn holds(cell: &Cell, m: &Measured) -> bool {
+    let beta = cell.bow.position_beta;
+    let v_b = cell.bow.velocity_m_per_s;
+    m.regime == Some(Regime::Helmholtz)
+        && (m.stick_velocity_m_per_s - v_b).abs() <= STICK_TOLERANCE * v_b.abs()
+        && m.slip_fraction >= (1.0 - SLIP_FRACTION_TOLERANCE) * beta
+}
+
+/// The window from which shares hold (see the module doc): indices into [`SHARES`] of its
+/// lowest and highest, `None` where none holds.
+pub fn window_of(held: &[bool]) -> Option<(usize, usize)> {
+    let mut runs: Vec<(usize, usize)> = Vec::new();
+    for (i, &h) in held.iter().enumerate() {
+        match runs.last_mut() {
+            Some(run) if h && run.1 + 1 == i => run.1 = i,
+            _ if h => runs.push((i, i)),
+            _ => {}
+        }
+    }
+    let distance = |r: &(usize, usize)| r.0.abs_diff(CATCH_SHARE).min(r.1.abs_diff(CATCH_SHARE));
+    runs.iter()
+        .find(|r| (r.0..=r.1).contains(&CATCH_SHARE))
+        .or_else(|| {
+            runs.iter().max_by(|a, b| {
+                (a.1 - a.0)
+                    .cmp(&(b.1 - b.0))
+                    // Equal lengths: the one nearer the catching share.
+                    .then(distance(b).cmp(&distance(a)))
+            })
+        })
+        .copied()
+}
+
+/// One measured row.
+#[derive(Debug, Clone)]
+pub struct Row {
+    pub model: Model,
+    pub kind: InstrumentKind,
+    pub string: usize,
+    pub beta: f64,
+    /// Whether each share of [`SHARES`] held the motion, and what the classifier read.
+    pub held: Vec<bool>,
+    pub regimes: Vec<String>,
+}
+
+impl Row {
+    /// The window's lowest and highest share of `F_max`.
+    pub fn shares(&self) -> Option<(f64, f64)> {
+        window_of(&self.held).map(|(lo, hi)| (SHARES[lo], SHARES[hi]))
+    }
+}
+
+/// A row's key: model, instrument, string (0 = the lowest), beta.
+pub type Key = (Model, InstrumentKind, usize, f64);
+
+/// Measures every row of `models` x `kinds` (rayon; a progress bar on standard error when
+/// `progress` is set).
+pub fn run_rows(
+    models: &[Model],
+    kinds: &[InstrumentKind],
+    progress: bool,
+) -> Result<Vec<Row>, String> {
+    let mut keys = Vec::new();
+    for &model in models {
+        for &kind in kinds {
+            for string in 0..STRINGS {
+                for beta in GRID_BETAS {
+                    keys.push((model, kind, string, beta));
+                }
+            }
+        }
+    }
+    run_keys(&keys, progress)
+}
+
+/// Measures the rows `keys` (rayon; a progress bar on standard error when `progress` is
+/// set).
+pub fn run_keys(keys: &[Key], progress: bool) -> Result<Vec<Row>, String> {
+    let cells: Vec<Cell> = keys
+        .iter()
+        .flat_map(|&(m, k, s, b)| cells_of(m, k, s, b))
+        .collect();
+    let measured = measure_cells(&cells, progress)?;
+    Ok(keys
+        .iter()
+        .enumerate()
+        .map(|(k, &(model, kind, string, beta))| {
+            let span = k * SHARES.len()..(k + 1) * SHARES.len();
+            Row {
+                model,
+                kind,
+                string,
+                beta,
+                held: span
+                    .clone()
+                    .map(|i| holds(&cells[i], &measured[i]))
+                    .collect(),
+                regimes: span.map(|i| regime_name(measured[i].regime)).collect(),
+            }
+        })
+        .collect())
+}
+
+/// The shipped file's text: the header, then one line a row (the window's lowest and
+/// highest share, empty where not found; then what each share did, `1` held and `0` not,
+/// for the record).
+pub fn csv(rows: &[Row]) -> String {
+    let mut s = format!("{MEASURED_WINDOW_HEADER}\n");
+    for r in rows {
+        let (lo, hi) = r
+            .shares()
+            .map_or((String::new(), String::new()), |(lo, hi)| {
+                (format!("{lo}"), format!("{hi}"))
+            });
+        let held: String = r.held.iter().map(|&h| if h { '1' } else { '0' }).collect();
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{lo},{hi},{held},{}",
+            r.model.name(),
+            r.kind.name(),
+            r.string,
+            r.beta,
+            r.regimes.join(" ")
+        );
+    }
+    s
+}
+
+/// The summary: per model, how many rows found a window, and the median of their highest
+/// and lowest shares, per beta.
+pub fn summary(rows: &[Row]) -> String {
+    let mut s = String::from(
+        "| model | beta | windows found | highest share of F_max: median, range | lowest share: median, range |\n|---|---|---|---|---|\n",
+    );
+    let mut models: Vec<Model> = rows.iter().map(|r| r.model).collect();
+    models.dedup();
+    for model in models {
+        for beta in GRID_BETAS {
+            let of: Vec<&Row> = rows
+                .iter()
+                .filter(|r| r.model == model && r.beta == beta)
+                .collect();
+            let found: Vec<(f64, f64)> = of.iter().filter_map(|r| r.shares()).collect();
+            let stat = |mut v: Vec<f64>| -> String {
+                if v.is_empty() {
+                    return "-".into();
+                }
+                v.sort_by(f64::total_cmp);
+                format!("{:.3}, {:.3}-{:.3}", v[v.len() / 2], v[0], v[v.len() - 1])
+            };
+            let _ = writeln!(
+                s,
+                "| {} | {beta} | {} of {} | {} | {} |",
+                model.name(),
+                found.len(),
+                of.len(),
+                stat(found.iter().map(|w| w.1).collect()),
+                stat(found.iter().map(|w| w.0).collect()),
+            );
+        }
+    }
+    s
+}
+
+/// `colophony bench window --out FILE`: measures, writes the file and checks that it
+/// reads back as the plugin reads it.
+pub fn run(out: &Path, models: &[Model], kinds: &[InstrumentKind]) -> Result<String, String> {
+    let t = std::time::Instant::now();
+    let rows = run_rows(models, kinds, true)?;
+    let text = csv(&rows);
+    // A whole table must read back as the plugin reads it; a part of one is for study.
+    if models.len() == Model::COUNT && kinds.len() == InstrumentKind::COUNT {
+        MeasuredWindows::parse(&text)?;
+    }
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    }
+    std::fs::write(out, &text).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+    Ok(format!(
+        "{} rows ({} cells) in {:.0} s\n\n{}\nwrote {}",
+        rows.len(),
+        rows.len() * SHARES.len(),
+        t.elapsed().as_secs_f64(),
+        summary(&rows),
+        out.display()
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_window_is_the_run_of_held_shares_through_the_catching_force() {
+        let h = |s: &str| s.chars().map(|c| c == '1').collect::<Vec<bool>>();
+        // The run through F_max / 2 (index 6), though a longer one lies below it.
+        assert_eq!(window_of(&h("1111011100")), Some((5, 7)));
+        assert_eq!(window_of(&h("0011111100")), Some((2, 7)));
+        assert_eq!(window_of(&h("1110001100")), Some((6, 7)));
+        // F_max / 2 does not hold: the longest run, and of equal ones the nearer.
+        assert_eq!(window_of(&h("1111000111")), Some((0, 3)));
+        assert_eq!(window_of(&h("1110000000")), Some((0, 2)));
+        assert_eq!(window_of(&h("0110000110")), Some((7, 8)));
+        assert_eq!(window_of(&h("0000000000")), None);
+    }
+}
