@@ -2,8 +2,8 @@
 //! shipped one is `assets/measured-window.csv`, read by
 //! [`colophony::measure::window::measured`]).
 //!
-//! **Method.** For every model, instrument, open string and grid beta
-//! ([`GRID_BETAS`]), the string is bowed at 0.1 m/s (slower where `F_max / 2` would pass
+//! **Method.** For every model, instrument, open string and beta of
+//! [`MEASURED_BETAS`] (the map's grid, 0.1 and 0.15), the string is bowed at 0.1 m/s (slower where `F_max / 2` would pass
 //! the plugin's 10 N, as the map bows) and held in Helmholtz motion at `F_max / 2`
 //! ([`Attack::Hold`]: up to [`HOLD_MAX_S`] for the motion to form), then the force moves
 //! geometrically over [`HOLD_MOVE_S`] to each share of Schelleng's `F_max` in [`SHARES`],
@@ -22,14 +22,14 @@
 //! shares of that speed's `F_max`.
 
 use crate::playing_space::{
-    measure_cells, regime_name, Attack, Bowing, Cell, Measured, Model, GRID_BETAS, HOLD_SETTLE_S,
+    measure_cells, regime_name, Attack, Bowing, Cell, Measured, Model, HOLD_SETTLE_S,
     SLIP_FRACTION_TOLERANCE, STICK_TOLERANCE,
 };
 #[cfg(doc)]
 use crate::playing_space::{HOLD_MAX_S, HOLD_MOVE_S};
 use colophony::dsp::vocabulary::{InstrumentKind, STRINGS};
 use colophony::measure::regime::Regime;
-use colophony::measure::window::{MeasuredWindows, MEASURED_WINDOW_HEADER};
+use colophony::measure::window::{MeasuredWindows, MEASURED_BETAS, MEASURED_WINDOW_HEADER};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -58,9 +58,21 @@ pub const SECONDS: f64 = HOLD_SETTLE_S + 0.5;
 /// strings: docs/models.md).
 pub const RATE_HZ: f64 = 48_000.0;
 
-/// One (model, instrument, string, beta): the cells of [`SHARES`] in order.
+/// One (model, instrument, string, beta): the cells of [`SHARES`] in order, on the open
+/// string.
 fn cells_of(model: Model, kind: InstrumentKind, string: usize, beta: f64) -> Vec<Cell> {
-    let note = kind.open_notes()[string];
+    note_cells(model, kind, string, kind.open_notes()[string], beta)
+}
+
+/// The cells of [`SHARES`] in order for `note` played on `string` (a stopped note where
+/// it lies above the open string).
+pub fn note_cells(
+    model: Model,
+    kind: InstrumentKind,
+    string: usize,
+    note: u8,
+    beta: f64,
+) -> Vec<Cell> {
     SHARES
         .iter()
         .map(|&share| {
@@ -146,7 +158,7 @@ pub fn run_rows(
     for &model in models {
         for &kind in kinds {
             for string in 0..STRINGS {
-                for beta in GRID_BETAS {
+                for beta in MEASURED_BETAS {
                     keys.push((model, kind, string, beta));
                 }
             }
@@ -217,7 +229,7 @@ pub fn summary(rows: &[Row]) -> String {
     let mut models: Vec<Model> = rows.iter().map(|r| r.model).collect();
     models.dedup();
     for model in models {
-        for beta in GRID_BETAS {
+        for beta in MEASURED_BETAS {
             let of: Vec<&Row> = rows
                 .iter()
                 .filter(|r| r.model == model && r.beta == beta)

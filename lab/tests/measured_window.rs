@@ -5,7 +5,8 @@
 use colophony::dsp::friction::FrictionModel;
 use colophony::dsp::vocabulary::{InstrumentKind, STRINGS};
 use colophony::measure::window::{measured, MEASURED_BETAS};
-use colophony_lab::measured_window::{run_keys, Key, SHARES};
+use colophony_lab::measured_window::{holds, note_cells, run_keys, Key, SHARES};
+use colophony_lab::playing_space::measure_cells;
 use colophony_lab::playing_space::Model;
 
 /// The shipped file's line for a row: its `held` field.
@@ -102,4 +103,117 @@ fn every_measured_window_lies_between_schellengs_bounds() {
         }
     }
     assert!(found > 0, "no window measured at all");
+}
+
+#[test]
+#[ignore = "survey: cargo test --release -p colophony-lab --test measured_window stopped -- --ignored --nocapture"]
+fn stopped_notes_against_their_open_strings_window() {
+    // The shipped window is measured on the open strings and read for every note of a
+    // string. Stopped a fifth and an octave up (hyperbolic law, beta 0.08 and 0.12, every
+    // string of every instrument), how often does each share's verdict agree with the
+    // open string's shipped one?
+    let law = Model::Point(FrictionModel::Hyperbolic);
+    let mut cells = Vec::new();
+    let mut keys = Vec::new();
+    for kind in InstrumentKind::ALL {
+        for string in 0..STRINGS {
+            for up in [7, 12] {
+                for beta in [0.08, 0.12] {
+                    let note = kind.open_notes()[string] + up;
+                    cells.extend(note_cells(law, kind, string, note, beta));
+                    keys.push((kind, string, up, beta));
+                }
+            }
+        }
+    }
+    let measured = measure_cells(&cells, false).expect("the cells measure");
+    let (mut agree, mut total) = (0, 0);
+    for (k, &(kind, string, up, beta)) in keys.iter().enumerate() {
+        let span = k * SHARES.len()..(k + 1) * SHARES.len();
+        let held: String = span
+            .map(|i| {
+                if holds(&cells[i], &measured[i]) {
+                    '1'
+                } else {
+                    '0'
+                }
+            })
+            .collect();
+        let shipped = shipped_held(law, kind, string, beta);
+        let same = held
+            .chars()
+            .zip(shipped.chars())
+            .filter(|(a, b)| a == b)
+            .count();
+        agree += same;
+        total += SHARES.len();
+        println!(
+            "{} string {string} +{up} beta {beta}: stopped {held}, open {shipped} ({same} of {})",
+            kind.name(),
+            SHARES.len()
+        );
+    }
+    println!("shares agreeing: {agree} of {total}");
+    assert!(total > 0);
+}
+
+#[test]
+#[ignore = "survey: cargo test --release -p colophony-lab --test measured_window dynamics -- --ignored --nocapture"]
+fn the_dynamics_guards_bow_against_the_measured_window() {
+    // Where the Dynamics Guard puts each open string's bow (the plugin's defaults at
+    // CC11 0 .. 127: speed, force and the drift from the bridge) against the window
+    // measured there: the force as a share of F_max at the drifted beta, and whether it
+    // lies inside the measured shares. No rendering: the guard's arithmetic and the file.
+    use colophony::measure::window::SchellengWindow;
+    use colophony_lab::playing_space::{Bowing, Cell};
+    let m = measured();
+    for model in Model::ALL {
+        let (mut inside, mut above, mut below, mut none) = (0, 0, 0, 0);
+        for kind in InstrumentKind::ALL {
+            for string in 0..STRINGS {
+                let note = kind.open_notes()[string];
+                for cc in [0u8, 21, 42, 64, 85, 106, 127] {
+                    let cell = Cell::on_string(
+                        model,
+                        kind,
+                        note,
+                        Some(string),
+                        48_000.0,
+                        Bowing::Defaults,
+                        1.0,
+                    )
+                    .at_expression(cc as f64 / 127.0);
+                    let bow = cell.bow;
+                    let window = SchellengWindow::for_model(
+                        kind,
+                        string,
+                        bow.position_beta,
+                        model == Model::Thermal,
+                        false,
+                    );
+                    let share = bow.force_n / window.max_force_n(bow.velocity_m_per_s);
+                    match m.shares(model, kind, string, bow.position_beta) {
+                        None => none += 1,
+                        Some((_, hi)) if share > hi => above += 1,
+                        Some((lo, _)) if share < lo => below += 1,
+                        Some(_) => inside += 1,
+                    }
+                    if model == Model::Point(FrictionModel::Hyperbolic)
+                        && kind == InstrumentKind::Cello
+                    {
+                        println!(
+                            "hyperbolic cello string {string} CC11 {cc}: beta {:.3}, {:.3} F_max, measured {:?}",
+                            bow.position_beta,
+                            share,
+                            m.shares(model, kind, string, bow.position_beta)
+                        );
+                    }
+                }
+            }
+        }
+        println!(
+            "{}: of 112 (string, level) bows, {inside} inside the measured window, {above} above it, {below} below, {none} where none was measured",
+            model.name()
+        );
+    }
 }

@@ -141,8 +141,9 @@ impl SchellengWindow {
     }
 }
 
-/// Bow positions the window was measured at (the playing-space map's grid).
-pub const MEASURED_BETAS: [f64; 4] = [0.05, 0.08, 0.12, 0.18];
+/// Bow positions the window was measured at: the playing-space map's grid, the
+/// defaults' 0.1, and 0.15, where the Dynamics Guard takes the bow at the softest.
+pub const MEASURED_BETAS: [f64; 6] = [0.05, 0.08, 0.1, 0.12, 0.15, 0.18];
 
 /// The first line of the measured window's file.
 pub const MEASURED_WINDOW_HEADER: &str = "model,instrument,string,beta,low,high,held,regimes";
@@ -382,16 +383,16 @@ mod tests {
     #[test]
     fn the_measured_window_interpolates_in_log_beta_and_keeps_the_nearest_beyond() {
         let text = windows_text(&[
-            ("hyperbolic", "cello", 2, 0.08, "0.02,0.25"),
-            ("hyperbolic", "cello", 2, 0.12, "0.08,1"),
+            ("hyperbolic", "cello", 2, 0.12, "0.02,0.25"),
+            ("hyperbolic", "cello", 2, 0.15, "0.08,1"),
             ("hyperbolic", "cello", 2, 0.18, ","),
         ]);
         let m = MeasuredWindows::parse(&text).unwrap();
         let law = TunedModel::Point(crate::dsp::friction::FrictionModel::Hyperbolic);
         let at = |beta: f64| m.shares(law, InstrumentKind::Cello, 2, beta);
-        assert_eq!(at(0.08), Some((0.02, 0.25)));
-        // The geometric middle of 0.08 and 0.12 takes the geometric middle of the shares.
-        let (lo, hi) = at((0.08f64 * 0.12).sqrt()).unwrap();
+        assert_eq!(at(0.12), Some((0.02, 0.25)));
+        // The geometric middle of 0.12 and 0.15 takes the geometric middle of the shares.
+        let (lo, hi) = at((0.12f64 * 0.15).sqrt()).unwrap();
         assert!(
             (lo - 0.04).abs() < 1e-12 && (hi - 0.5).abs() < 1e-12,
             "{lo} {hi}"
@@ -399,9 +400,9 @@ mod tests {
         // Beyond the grid the nearest row; toward a row with no window, none.
         assert_eq!(at(0.02), Some((0.1, 0.5)));
         assert_eq!(at(0.3), None);
-        assert_eq!(at(0.15), None);
+        assert_eq!(at(0.16), None);
         // At a measured position, that row, whatever its neighbour holds.
-        assert_eq!(at(0.12), Some((0.08, 1.0)));
+        assert_eq!(at(0.15), Some((0.08, 1.0)));
     }
 
     #[test]
