@@ -255,8 +255,8 @@ pub const CATCH_FALL_S: f64 = 0.06;
 /// [`Attack::Hold`]: the longest the catching force is held, s (the low strings near the
 /// bridge take up to about a second to find the motion: docs/playing-space.md).
 pub const HOLD_MAX_S: f64 = 1.0;
-/// [`Attack::Hold`]: how long the force takes to move to the cell's, s: a hundred
-/// periods of the cello's C string, slow against the motion's own adjustment.
+/// [`Attack::Hold`]: how long the force takes to move to the cell's, s (13 periods of
+/// the cello's C string, more of every higher one).
 pub const HOLD_MOVE_S: f64 = 0.2;
 /// [`Attack::Hold`]: when the measurement starts, s (a tenth of a second after the
 /// latest the force can arrive).

@@ -246,8 +246,8 @@ impl MeasuredWindows {
     }
 }
 
-/// The shipped measured window (`assets/measured-window.csv`), parsed once. Call it off
-/// the audio thread first (the editor does, when built); later calls are a load.
+/// The shipped measured window (`assets/measured-window.csv`), parsed on first use; the
+/// editor reads it, the audio thread never does.
 pub fn measured() -> &'static MeasuredWindows {
     static TABLE: OnceLock<MeasuredWindows> = OnceLock::new();
     TABLE.get_or_init(|| {
