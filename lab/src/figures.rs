@@ -43,7 +43,7 @@ pub fn draw(name: &str, out: &Path) -> Result<String, String> {
         "maestre-fig7" => maestre_fig7(out),
         "maestre-fig8" => maestre_fig8(out),
         other => Err(format!(
-            "unknown figure '{other}': choose serafin-fig7, serafin-modal, maestre-fig6, maestre-fig7, maestre-fig8 or bridge-fit"
+            "unknown figure '{other}': choose serafin-fig7, serafin-modal, maestre-fig6, maestre-fig7, maestre-fig8, bridge-fit or measured-window"
         )),
     }
 }

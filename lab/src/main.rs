@@ -107,12 +107,13 @@ enum Command {
         #[arg(long)]
         bridge: Option<PathBuf>,
     },
-    /// Draw a figure as PNG: serafin-fig7, serafin-modal, maestre-fig6, maestre-fig7, maestre-fig8, bridge-fit.
+    /// Draw a figure as PNG: serafin-fig7, serafin-modal, maestre-fig6, maestre-fig7, maestre-fig8, bridge-fit,
+    /// measured-window (--in the measured window's file).
     Figure {
         name: String,
         #[arg(long)]
         out: PathBuf,
-        /// Measured admittance CSV (bridge-fit).
+        /// Measured admittance CSV (bridge-fit); the measured window's file (measured-window).
         #[arg(long = "in")]
         input: Option<PathBuf>,
         /// Fitted bridge JSON (bridge-fit).
@@ -421,6 +422,13 @@ fn main() -> ExitCode {
             input,
             fit,
         } => report(match name.as_str() {
+            "measured-window" => match input {
+                Some(input) => std::fs::read_to_string(&input)
+                    .map_err(|e| format!("cannot read {}: {e}", input.display()))
+                    .and_then(|text| colophony_lab::measured_window::draw(&text, &out))
+                    .map(|()| format!("wrote {}", out.display())),
+                None => Err("measured-window needs --in FILE (assets/measured-window.csv)".into()),
+            },
             "bridge-fit" => match (input, fit) {
                 (Some(input), Some(fit)) => {
                     colophony_lab::admittance_fit::draw_figure(&input, &fit, &out)

@@ -271,14 +271,137 @@ pub fn run(out: &Path, models: &[Model], kinds: &[InstrumentKind]) -> Result<Str
             .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
     }
     std::fs::write(out, &text).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+    let png = out.with_extension("png");
+    draw(&text, &png)?;
     Ok(format!(
-        "{} rows ({} cells) in {:.0} s\n\n{}\nwrote {}",
+        "{} rows ({} cells) in {:.0} s\n\n{}\nwrote {} and {}",
         rows.len(),
         rows.len() * SHARES.len(),
         t.elapsed().as_secs_f64(),
         summary(&rows),
-        out.display()
+        out.display(),
+        png.display()
     ))
+}
+
+/// The measured window as a PNG (`out`) from the file's text: a panel per model, the
+/// shares of `F_max` down (1.4 at the top), each string's six bow positions across,
+/// grouped by instrument and string; a cell green where the share held the motion, pale
+/// green where the classifier read one slip a period that did not count (the short
+/// pulse, or the string not sticking at the bow), blue for multiple slips, red raucous,
+/// grey sliding.
+pub fn draw(text: &str, out: &Path) -> Result<(), String> {
+    use plotters::prelude::*;
+    use plotters::style::text_anchor::{HPos, Pos, VPos};
+    const CELL_W: i32 = 9;
+    const CELL_H: i32 = 11;
+    const GAP: i32 = 5;
+    const LABEL_W: i32 = 70;
+    const HEADER_H: i32 = 34;
+    const LEGEND_H: i32 = 36;
+    crate::figures::fonts();
+    let err = |e: &dyn std::fmt::Display| e.to_string();
+    let mut lines = text.lines();
+    if lines.next().map(str::trim) != Some(MEASURED_WINDOW_HEADER) {
+        return Err(format!(
+            "the measured window must begin with '{MEASURED_WINDOW_HEADER}'"
+        ));
+    }
+    // (model, instrument, string, beta) -> (held, regimes)
+    let rows: Vec<Vec<&str>> = lines
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| l.split(',').collect())
+        .filter(|f: &Vec<&str>| f.len() == 8)
+        .collect();
+    let group_w = MEASURED_BETAS.len() as i32 * CELL_W + GAP;
+    let groups = (InstrumentKind::COUNT * STRINGS) as i32;
+    let panel_h = HEADER_H + SHARES.len() as i32 * CELL_H + 6;
+    let width = (LABEL_W + groups * group_w + 10) as u32;
+    let height = (LEGEND_H + Model::COUNT as i32 * panel_h + 10) as u32;
+    let root = BitMapBackend::new(out, (width, height)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(&e))?;
+    let font = |size: i32| ("sans-serif", size).into_font().color(&BLACK);
+    for (i, line) in [
+        "Colophony, the measured window: held in Helmholtz motion at F_max/2, then moved to each share of F_max (down); each string's beta 0.05-0.18 across",
+        "green held; pale green one slip a period not counted (short slip, or not sticking at the bow); blue multiple slips; red raucous; grey sliding",
+    ]
+    .iter()
+    .enumerate()
+    {
+        root.draw(&Text::new(line.to_string(), (6, 4 + 14 * i as i32), font(12)))
+            .map_err(|e| err(&e))?;
+    }
+    for (p, model) in Model::ALL.iter().enumerate() {
+        let y0 = LEGEND_H + p as i32 * panel_h;
+        root.draw(&Text::new(model.name().to_string(), (6, y0 + 2), font(13)))
+            .map_err(|e| err(&e))?;
+        for (row, share) in SHARES.iter().enumerate().rev() {
+            let y = y0 + HEADER_H + (SHARES.len() - 1 - row) as i32 * CELL_H;
+            let label = if *share >= 0.25 {
+                format!("{share}")
+            } else {
+                format!("1/{}", (1.0 / share).round())
+            };
+            root.draw(&Text::new(
+                label,
+                (LABEL_W - 4, y + CELL_H / 2),
+                font(9).pos(Pos::new(HPos::Right, VPos::Center)),
+            ))
+            .map_err(|e| err(&e))?;
+        }
+        for (k, kind) in InstrumentKind::ALL.iter().enumerate() {
+            for string in 0..STRINGS {
+                let g = (k * STRINGS + string) as i32;
+                let x0 = LABEL_W + g * group_w;
+                let abbrev = match kind {
+                    InstrumentKind::Violin => "vn",
+                    InstrumentKind::Viola => "va",
+                    InstrumentKind::Cello => "vc",
+                    InstrumentKind::DoubleBass => "db",
+                };
+                root.draw(&Text::new(
+                    format!(
+                        "{abbrev} {}",
+                        crate::playing_space::figure::note_name(kind.open_notes()[string])
+                    ),
+                    (x0 + group_w / 2, y0 + HEADER_H - 3),
+                    font(9).pos(Pos::new(HPos::Center, VPos::Bottom)),
+                ))
+                .map_err(|e| err(&e))?;
+                for (b, beta) in MEASURED_BETAS.iter().enumerate() {
+                    let key = [
+                        model.name().to_string(),
+                        kind.name().to_string(),
+                        string.to_string(),
+                        beta.to_string(),
+                    ];
+                    let Some(f) = rows.iter().find(|f| (0..4).all(|i| f[i] == key[i])) else {
+                        continue;
+                    };
+                    let (held, regimes): (Vec<char>, Vec<&str>) =
+                        (f[6].chars().collect(), f[7].split(' ').collect());
+                    for row in 0..SHARES.len().min(held.len()).min(regimes.len()) {
+                        let colour = match (held[row], regimes[row]) {
+                            ('1', _) => RGBColor(90, 190, 90),
+                            (_, "helmholtz") => RGBColor(200, 230, 140),
+                            (_, "raucous") => RGBColor(230, 100, 90),
+                            (_, "sliding") => RGBColor(170, 170, 170),
+                            (_, r) if r.starts_with("slips") => RGBColor(110, 150, 230),
+                            _ => RGBColor(60, 60, 60),
+                        };
+                        let x = x0 + b as i32 * CELL_W;
+                        let y = y0 + HEADER_H + (SHARES.len() - 1 - row) as i32 * CELL_H;
+                        root.draw(&Rectangle::new(
+                            [(x, y), (x + CELL_W - 1, y + CELL_H - 1)],
+                            colour.filled(),
+                        ))
+                        .map_err(|e| err(&e))?;
+                    }
+                }
+            }
+        }
+    }
+    root.present().map_err(|e| err(&e))
 }
 
 #[cfg(test)]

@@ -30,7 +30,8 @@ fn colour(m: &Measured) -> RGBColor {
     }
 }
 
-fn note_name(note: u8) -> String {
+/// A MIDI note's name, C4 = 60.
+pub(crate) fn note_name(note: u8) -> String {
     const NAMES: [&str; 12] = [
         "C", "C#", "D", "D#", "E", "F", "F#", "G", "G#", "A", "A#", "B",
     ];
