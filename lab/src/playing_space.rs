@@ -188,6 +188,10 @@ pub struct Cell {
     /// [`colophony::dsp::waveguide::DEFAULT_DISPERSION_STAGES`]; 0: strings without
     /// stiffness). A research knob: what the strings' stiffness does to the map.
     pub dispersion_stages: Option<usize>,
+    /// Whether the point-bow strings keep their torsion and the bow's hair (the plugin's:
+    /// both). A research knob: what each does to the impedance the bow sees.
+    pub torsion: bool,
+    pub hair: bool,
 }
 
 /// How a cell's note begins.
@@ -332,6 +336,8 @@ impl Cell {
             expression: 1.0,
             performer_catch: true,
             dispersion_stages: None,
+            torsion: true,
+            hair: true,
         }
     }
 
@@ -442,6 +448,12 @@ fn point_engine(cell: &Cell, law: FrictionModel) -> Instrument {
     engine.set_dynamics(cell.expression);
     if let Some(stages) = cell.dispersion_stages {
         engine.set_dispersion_cap(stages);
+    }
+    if !cell.torsion {
+        engine.set_torsion(false);
+    }
+    if !cell.hair {
+        engine.set_bow_hair(false);
     }
     engine
 }

@@ -6,8 +6,8 @@ use colophony::dsp::friction::FrictionModel;
 use colophony::dsp::vocabulary::{InstrumentKind, STRINGS};
 use colophony::measure::window::{measured, MEASURED_BETAS};
 use colophony_lab::measured_window::{holds, note_cells, run_keys, Key, SHARES};
-use colophony_lab::playing_space::measure_cells;
 use colophony_lab::playing_space::Model;
+use colophony_lab::playing_space::{measure_cells, Cell, Measured};
 
 /// The shipped file's line for a row: its `held` field.
 fn shipped_held(model: Model, kind: InstrumentKind, string: usize, beta: f64) -> String {
@@ -18,6 +18,18 @@ fn shipped_held(model: Model, kind: InstrumentKind, string: usize, beta: f64) ->
         .find(|l| l.starts_with(&key))
         .unwrap_or_else(|| panic!("no row {key}"));
     line.split(',').nth(6).expect("a held field").to_string()
+}
+
+/// The verdicts of `cells[span]` as the file writes them: `1` held, `0` not.
+fn verdicts(cells: &[Cell], measured: &[Measured], span: std::ops::Range<usize>) -> String {
+    span.map(|i| {
+        if holds(&cells[i], &measured[i]) {
+            '1'
+        } else {
+            '0'
+        }
+    })
+    .collect()
 }
 
 #[test]
@@ -130,15 +142,7 @@ fn stopped_notes_against_their_open_strings_window() {
     let (mut agree, mut total) = (0, 0);
     for (k, &(kind, string, up, beta)) in keys.iter().enumerate() {
         let span = k * SHARES.len()..(k + 1) * SHARES.len();
-        let held: String = span
-            .map(|i| {
-                if holds(&cells[i], &measured[i]) {
-                    '1'
-                } else {
-                    '0'
-                }
-            })
-            .collect();
+        let held = verdicts(&cells, &measured, span);
         let shipped = shipped_held(law, kind, string, beta);
         let same = held
             .chars()
@@ -216,4 +220,69 @@ fn the_dynamics_guards_bow_against_the_measured_window() {
             model.name()
         );
     }
+}
+
+#[test]
+#[ignore = "survey: cargo test --release -p colophony-lab --test measured_window torsion -- --ignored --nocapture"]
+fn the_held_window_without_torsion_or_the_hair() {
+    // Torsion and the bow's hair are admittances beside the string's at the contact: how
+    // far does each move the measured window's top? The hyperbolic law on the violin's
+    // and cello's strings and the elasto-plastic law on the cello's, beta 0.08, 0.1 and
+    // 0.12, with torsion off, the hair off and both off, against the shipped rows.
+    let variants = [(false, true), (true, false), (false, false)];
+    let mut keys = Vec::new();
+    for (law, kinds) in [
+        (
+            FrictionModel::Hyperbolic,
+            &[InstrumentKind::Violin, InstrumentKind::Cello][..],
+        ),
+        (FrictionModel::ElastoPlastic, &[InstrumentKind::Cello][..]),
+    ] {
+        for &kind in kinds {
+            for string in 0..STRINGS {
+                for beta in [0.08, 0.1, 0.12] {
+                    keys.push((Model::Point(law), kind, string, beta));
+                }
+            }
+        }
+    }
+    let mut cells = Vec::new();
+    for &(torsion, hair) in &variants {
+        for &(model, kind, string, beta) in &keys {
+            for mut cell in note_cells(model, kind, string, kind.open_notes()[string], beta) {
+                cell.torsion = torsion;
+                cell.hair = hair;
+                cells.push(cell);
+            }
+        }
+    }
+    let measured = measure_cells(&cells, false).expect("the cells measure");
+    let top = |held: &str| -> Option<f64> {
+        let bits: Vec<bool> = held.chars().map(|c| c == '1').collect();
+        colophony_lab::measured_window::window_of(&bits).map(|w| SHARES[w.1])
+    };
+    for (v, &(torsion, hair)) in variants.iter().enumerate() {
+        let (mut higher, mut same, mut lower) = (0, 0, 0);
+        for (k, &(model, kind, string, beta)) in keys.iter().enumerate() {
+            let base = (v * keys.len() + k) * SHARES.len();
+            let held = verdicts(&cells, &measured, base..base + SHARES.len());
+            let shipped = shipped_held(model, kind, string, beta);
+            let (now, was) = (top(&held), top(&shipped));
+            match now.partial_cmp(&was) {
+                Some(std::cmp::Ordering::Greater) => higher += 1,
+                Some(std::cmp::Ordering::Less) => lower += 1,
+                _ => same += 1,
+            }
+            println!(
+                "torsion {torsion} hair {hair}: {} {} string {string} beta {beta}: {held} (top {now:?}) against {shipped} (top {was:?})",
+                model.name(),
+                kind.name()
+            );
+        }
+        println!(
+            "torsion {torsion} hair {hair}: the top share higher in {higher}, the same in {same}, lower in {lower} of {} rows",
+            keys.len()
+        );
+    }
+    assert!(!keys.is_empty());
 }
