@@ -381,13 +381,14 @@ pub fn draw(text: &str, out: &Path) -> Result<(), String> {
                     let (held, regimes): (Vec<char>, Vec<&str>) =
                         (f[6].chars().collect(), f[7].split(' ').collect());
                     for row in 0..SHARES.len().min(held.len()).min(regimes.len()) {
+                        use crate::playing_space::figure as palette;
                         let colour = match (held[row], regimes[row]) {
-                            ('1', _) => RGBColor(90, 190, 90),
-                            (_, "helmholtz") => RGBColor(200, 230, 140),
-                            (_, "raucous") => RGBColor(230, 100, 90),
-                            (_, "sliding") => RGBColor(170, 170, 170),
-                            (_, r) if r.starts_with("slips") => RGBColor(110, 150, 230),
-                            _ => RGBColor(60, 60, 60),
+                            ('1', _) => palette::HELMHOLTZ,
+                            (_, "helmholtz") => palette::ONE_SLIP,
+                            (_, "raucous") => palette::RAUCOUS,
+                            (_, "sliding") => palette::SLIDING,
+                            (_, r) if r.starts_with("slips") => palette::MULTIPLE,
+                            _ => palette::SILENT,
                         };
                         let x = x0 + b as i32 * CELL_W;
                         let y = y0 + HEADER_H + (SHARES.len() - 1 - row) as i32 * CELL_H;

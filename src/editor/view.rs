@@ -281,7 +281,9 @@ impl EditorUi {
                     egui::ScrollArea::vertical()
                         .max_height(pad_size.y)
                         .auto_shrink([false, true])
-                        .show(ui, |ui| self.side_panel(ui, &setter, window.as_ref()));
+                        .show(ui, |ui| {
+                            self.side_panel(ui, &setter, window.as_ref(), played)
+                        });
                 },
             );
         });
@@ -380,7 +382,15 @@ impl EditorUi {
         paint_friction_loop(ui, Self::plot_pair(rect)[1], samples);
     }
 
-    fn side_panel(&self, ui: &mut Ui, setter: &ParamSetter, window: Option<&SchellengWindow>) {
+    /// `played`: the window's measured shares ([`Self::played_shares`]), looked up once a
+    /// frame.
+    fn side_panel(
+        &self,
+        ui: &mut Ui,
+        setter: &ParamSetter,
+        window: Option<&SchellengWindow>,
+        played: Option<(f64, f64)>,
+    ) {
         let p = &self.params;
         ui.label(RichText::new("Bow").strong());
         egui::Grid::new("bow-sliders")
@@ -425,7 +435,7 @@ impl EditorUi {
             return;
         };
         ui.label(RichText::new("Regime").strong());
-        self.regime_lines(ui, w);
+        self.regime_lines(ui, w, played);
         ui.add_space(4.0);
         ui.separator();
         ui.label(RichText::new("Schelleng window").strong());
@@ -490,7 +500,7 @@ impl EditorUi {
                 ui.label(format!("{f_min:.4} N"));
                 ui.end_row();
                 ui.label("Measured");
-                ui.label(match self.played_shares(w) {
+                ui.label(match played {
                     Some((lo, hi)) => format!(
                         "{:.3} to {:.3} N hold Helmholtz motion",
                         lo * f_max,
@@ -506,11 +516,11 @@ impl EditorUi {
     }
 
     /// The regime the window predicts for the bow and the one detected in the simulation.
-    fn regime_lines(&self, ui: &mut Ui, window: &SchellengWindow) {
+    fn regime_lines(&self, ui: &mut Ui, window: &SchellengWindow, played: Option<(f64, f64)>) {
         let v = self.params.bow_velocity.value() as f64;
         let f = self.params.bow_force.value() as f64;
         let f_max = window.max_force_n(v);
-        let (text, colour) = match self.played_shares(window) {
+        let (text, colour) = match played {
             Some((lo, hi)) => predicted_regime(v, f, lo * f_max, hi * f_max),
             None => (
                 "no force measured to hold Helmholtz motion here",

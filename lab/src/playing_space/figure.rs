@@ -20,15 +20,23 @@ const LEGEND_H: i32 = 48;
 /// raucous, grey sliding, dark silent, white refused.
 fn colour(m: &Measured) -> RGBColor {
     match m.regime {
-        Some(Regime::Helmholtz) if m.helmholtz => RGBColor(90, 190, 90),
-        Some(Regime::Helmholtz) => RGBColor(200, 230, 140),
-        Some(Regime::MultipleSlips(_)) => RGBColor(110, 150, 230),
-        Some(Regime::Raucous) => RGBColor(230, 100, 90),
-        Some(Regime::Sliding) => RGBColor(170, 170, 170),
-        Some(Regime::Silent) => RGBColor(60, 60, 60),
+        Some(Regime::Helmholtz) if m.helmholtz => HELMHOLTZ,
+        Some(Regime::Helmholtz) => ONE_SLIP,
+        Some(Regime::MultipleSlips(_)) => MULTIPLE,
+        Some(Regime::Raucous) => RAUCOUS,
+        Some(Regime::Sliding) => SLIDING,
+        Some(Regime::Silent) => SILENT,
         None => WHITE,
     }
 }
+
+/// The maps' palette (shared with the measured window's figure).
+pub(crate) const HELMHOLTZ: RGBColor = RGBColor(90, 190, 90);
+pub(crate) const ONE_SLIP: RGBColor = RGBColor(200, 230, 140);
+pub(crate) const MULTIPLE: RGBColor = RGBColor(110, 150, 230);
+pub(crate) const RAUCOUS: RGBColor = RGBColor(230, 100, 90);
+pub(crate) const SLIDING: RGBColor = RGBColor(170, 170, 170);
+pub(crate) const SILENT: RGBColor = RGBColor(60, 60, 60);
 
 /// A MIDI note's name, C4 = 60.
 pub(crate) fn note_name(note: u8) -> String {
