@@ -491,6 +491,11 @@ fn main() -> ExitCode {
                     .and_then(|plan| colophony_lab::measured_window::run(&file, &plan.models, &plan.kinds)),
                 None => Err("bench window needs --out FILE (the shipped one: assets/measured-window.csv)".into()),
             },
+            "guard-window" => match out {
+                Some(file) => colophony_lab::playing_space::Plan::from_options(false, &[], None, &models, &instruments)
+                    .and_then(|plan| colophony_lab::measured_window::run_guard(&file, &plan.models, &plan.kinds)),
+                None => Err("bench guard-window needs --out FILE (the shipped one: assets/guard-window.csv)".into()),
+            },
             "thermal-constants" => colophony_lab::thermal_constants::run(),
             "timbre" => match out {
                 // One model (the default law) at 48 kHz unless asked for more.
@@ -503,7 +508,7 @@ fn main() -> ExitCode {
                 None => Err("bench timbre needs --out DIR".into()),
             },
             other => Err(format!(
-                "unknown bench '{other}': choose friction, table1, scenes, peers, precision, playing-space, window, intonation, timbre or thermal-constants"
+                "unknown bench '{other}': choose friction, table1, scenes, peers, precision, playing-space, window, guard-window, intonation, timbre or thermal-constants"
             )),
         }),
         Command::Presets => {

@@ -29,7 +29,9 @@ use crate::playing_space::{
 use crate::playing_space::{HOLD_MAX_S, HOLD_MOVE_S};
 use colophony::dsp::vocabulary::{InstrumentKind, STRINGS};
 use colophony::measure::regime::Regime;
-use colophony::measure::window::{MeasuredWindows, MEASURED_BETAS, MEASURED_WINDOW_HEADER};
+use colophony::measure::window::{
+    MeasuredWindows, SchellengWindow, MEASURED_BETAS, MEASURED_WINDOW_HEADER,
+};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -174,25 +176,51 @@ pub fn run_keys(keys: &[Key], progress: bool) -> Result<Vec<Row>, String> {
         .iter()
         .flat_map(|&(m, k, s, b)| cells_of(m, k, s, b))
         .collect();
-    let measured = measure_cells(&cells, progress)?;
     Ok(keys
         .iter()
-        .enumerate()
-        .map(|(k, &(model, kind, string, beta))| {
-            let span = k * SHARES.len()..(k + 1) * SHARES.len();
-            Row {
-                model,
-                kind,
-                string,
-                beta,
-                held: span
-                    .clone()
-                    .map(|i| holds(&cells[i], &measured[i]))
-                    .collect(),
-                regimes: span.map(|i| regime_name(measured[i].regime)).collect(),
-            }
+        .zip(measure_rows(&cells, progress)?)
+        .map(|(&(model, kind, string, beta), (held, regimes))| Row {
+            model,
+            kind,
+            string,
+            beta,
+            held,
+            regimes,
         })
         .collect())
+}
+
+/// Measures `cells`, [`SHARES`] a row in order: each row's verdicts ([`holds`]) and what
+/// the classifier read.
+fn measure_rows(cells: &[Cell], progress: bool) -> Result<Vec<(Vec<bool>, Vec<String>)>, String> {
+    let measured = measure_cells(cells, progress)?;
+    Ok(cells
+        .chunks(SHARES.len())
+        .zip(measured.chunks(SHARES.len()))
+        .map(|(cells, measured)| {
+            (
+                cells
+                    .iter()
+                    .zip(measured)
+                    .map(|(c, m)| holds(c, m))
+                    .collect(),
+                measured.iter().map(|m| regime_name(m.regime)).collect(),
+            )
+        })
+        .collect())
+}
+
+/// A row's window and verdicts as the files write them: the lowest and highest held
+/// share (empty where none), and `1` held, `0` not, a share.
+fn window_fields(shares: Option<(f64, f64)>, held: &[bool]) -> (String, String, String) {
+    let (lo, hi) = shares.map_or((String::new(), String::new()), |(lo, hi)| {
+        (format!("{lo}"), format!("{hi}"))
+    });
+    (
+        lo,
+        hi,
+        held.iter().map(|&h| if h { '1' } else { '0' }).collect(),
+    )
 }
 
 /// The shipped file's text: the header, then one line a row (the window's lowest and
@@ -201,12 +229,7 @@ pub fn run_keys(keys: &[Key], progress: bool) -> Result<Vec<Row>, String> {
 pub fn csv(rows: &[Row]) -> String {
     let mut s = format!("{MEASURED_WINDOW_HEADER}\n");
     for r in rows {
-        let (lo, hi) = r
-            .shares()
-            .map_or((String::new(), String::new()), |(lo, hi)| {
-                (format!("{lo}"), format!("{hi}"))
-            });
-        let held: String = r.held.iter().map(|&h| if h { '1' } else { '0' }).collect();
+        let (lo, hi, held) = window_fields(r.shares(), &r.held);
         let _ = writeln!(
             s,
             "{},{},{},{},{lo},{hi},{held},{}",
@@ -422,4 +445,183 @@ mod tests {
         assert_eq!(window_of(&h("0110000110")), Some((7, 8)));
         assert_eq!(window_of(&h("0000000000")), None);
     }
+}
+
+/// The dynamics levels (CC11, 0-127) the window at the Dynamics Guard's bows is measured
+/// at (127, full expression, is the parameters' own bow).
+pub const GUARD_LEVELS: [u8; 6] = [0, 21, 42, 64, 85, 106];
+
+/// The first line of the guard's window's file.
+pub const GUARD_WINDOW_HEADER: &str =
+    "model,instrument,string,level,velocity,beta,low,high,held,regimes";
+
+/// The cells of [`SHARES`] at the Dynamics Guard's bow for CC11 `level` on `string`'s
+/// open note: the speed and the drift from the bridge the guard plays there (the
+/// parameters' defaults), the force a share of Schelleng's `F_max` at that speed and
+/// position, held as [`note_cells`] hold theirs.
+pub fn guard_cells(model: Model, kind: InstrumentKind, string: usize, level: u8) -> Vec<Cell> {
+    let note = kind.open_notes()[string];
+    let expression = level as f64 / 127.0;
+    let guard = Cell::on_string(
+        model,
+        kind,
+        note,
+        Some(string),
+        RATE_HZ,
+        Bowing::Defaults,
+        SECONDS,
+    )
+    .at_expression(expression);
+    let (v, beta) = (guard.bow.velocity_m_per_s, guard.bow.position_beta);
+    note_cells(model, kind, string, note, beta)
+        .into_iter()
+        .map(|mut cell| {
+            let k = v / cell.bow.velocity_m_per_s;
+            cell.bow.velocity_m_per_s = v;
+            cell.bow.force_n *= k;
+            cell.f_max_n *= k;
+            cell.f_min_n *= k;
+            cell.expression = expression;
+            cell
+        })
+        .collect()
+}
+
+/// The guard's bow's share of `F_max` at CC11 `level` on `string` (the parameters'
+/// defaults, String Weight on).
+pub fn guard_share(model: Model, kind: InstrumentKind, string: usize, level: u8) -> f64 {
+    let law = match model {
+        Model::Point(law) => Some(law),
+        Model::Thermal => None,
+    };
+    let scale =
+        10f64.powf(-colophony::performer::DYNAMICS_RANGE_DB * (1.0 - level as f64 / 127.0) / 20.0);
+    let g = colophony::performer::guarded_bow(law, kind, scale);
+    let defaults = colophony::dsp::vocabulary::BowControl::default();
+    let beta = (defaults.position_beta * g.away).clamp(
+        colophony::dsp::vocabulary::MIN_NOTE_BETA,
+        colophony::dsp::vocabulary::MAX_NOTE_BETA,
+    );
+    let window = SchellengWindow::for_model(kind, string, beta, model == Model::Thermal, true);
+    defaults.force_n * g.force / window.max_force_n(defaults.velocity_m_per_s * g.speed)
+}
+
+/// One row of the guard's window: a (model, instrument, string, level) and what each
+/// share of [`SHARES`] did at the guard's speed and position there.
+#[derive(Debug, Clone)]
+pub struct GuardRow {
+    pub model: Model,
+    pub kind: InstrumentKind,
+    pub string: usize,
+    pub level: u8,
+    pub velocity_m_per_s: f64,
+    pub beta: f64,
+    pub held: Vec<bool>,
+    pub regimes: Vec<String>,
+}
+
+impl GuardRow {
+    /// The window's lowest and highest share of `F_max`.
+    pub fn shares(&self) -> Option<(f64, f64)> {
+        window_of(&self.held).map(|(lo, hi)| (SHARES[lo], SHARES[hi]))
+    }
+}
+
+/// Measures the guard's window for every (model, instrument, string) of `models` x
+/// `kinds` at every level of [`GUARD_LEVELS`] (rayon; a progress bar when `progress`).
+pub fn run_guard_rows(
+    models: &[Model],
+    kinds: &[InstrumentKind],
+    progress: bool,
+) -> Result<Vec<GuardRow>, String> {
+    let mut keys = Vec::new();
+    for &model in models {
+        for &kind in kinds {
+            for string in 0..STRINGS {
+                for level in GUARD_LEVELS {
+                    keys.push((model, kind, string, level));
+                }
+            }
+        }
+    }
+    let cells: Vec<Cell> = keys
+        .iter()
+        .flat_map(|&(m, k, s, l)| guard_cells(m, k, s, l))
+        .collect();
+    Ok(keys
+        .iter()
+        .zip(cells.chunks(SHARES.len()))
+        .zip(measure_rows(&cells, progress)?)
+        .map(
+            |((&(model, kind, string, level), row), (held, regimes))| GuardRow {
+                model,
+                kind,
+                string,
+                level,
+                velocity_m_per_s: row[0].bow.velocity_m_per_s,
+                beta: row[0].bow.position_beta,
+                held,
+                regimes,
+            },
+        )
+        .collect())
+}
+
+/// The guard's window file's text (as [`csv`], with the level, speed and position).
+pub fn guard_csv(rows: &[GuardRow]) -> String {
+    let mut s = format!("{GUARD_WINDOW_HEADER}\n");
+    for r in rows {
+        let (lo, hi, held) = window_fields(r.shares(), &r.held);
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{},{},{lo},{hi},{held},{}",
+            r.model.name(),
+            r.kind.name(),
+            r.string,
+            r.level,
+            r.velocity_m_per_s,
+            r.beta,
+            r.regimes.join(" ")
+        );
+    }
+    s
+}
+
+/// `colophony bench guard-window --out FILE` (docs/playing-space/guard-window.csv):
+/// measures the window at the Dynamics Guard's own bows and writes the file, with a
+/// count of where the guard puts its bow against it (docs/testing.md, "Dynamics").
+pub fn run_guard(out: &Path, models: &[Model], kinds: &[InstrumentKind]) -> Result<String, String> {
+    let t = std::time::Instant::now();
+    let rows = run_guard_rows(models, kinds, true)?;
+    let text = guard_csv(&rows);
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    }
+    std::fs::write(out, &text).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+    let mut report = format!(
+        "{} rows ({} cells) in {:.0} s\n\n| model | guard bows inside | above | below | no window |\n|---|---|---|---|---|\n",
+        rows.len(),
+        rows.len() * SHARES.len(),
+        t.elapsed().as_secs_f64()
+    );
+    for &model in models {
+        let (mut inside, mut above, mut below, mut none) = (0, 0, 0, 0);
+        for r in rows.iter().filter(|r| r.model == model) {
+            let share = guard_share(model, r.kind, r.string, r.level);
+            match r.shares() {
+                None => none += 1,
+                Some((_, hi)) if share > hi => above += 1,
+                Some((lo, _)) if share < lo => below += 1,
+                Some(_) => inside += 1,
+            }
+        }
+        let _ = writeln!(
+            report,
+            "| {} | {inside} | {above} | {below} | {none} |",
+            model.name()
+        );
+    }
+    let _ = write!(report, "\nwrote {}", out.display());
+    Ok(report)
 }

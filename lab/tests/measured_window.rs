@@ -5,7 +5,9 @@
 use colophony::dsp::friction::FrictionModel;
 use colophony::dsp::vocabulary::{InstrumentKind, STRINGS};
 use colophony::measure::window::{measured, MEASURED_BETAS};
-use colophony_lab::measured_window::{holds, note_cells, run_keys, Key, SHARES};
+use colophony_lab::measured_window::{
+    guard_cells, holds, note_cells, run_keys, Key, GUARD_WINDOW_HEADER, SHARES,
+};
 use colophony_lab::playing_space::Model;
 use colophony_lab::playing_space::{measure_cells, Cell, Measured};
 
@@ -32,6 +34,17 @@ fn verdicts(cells: &[Cell], measured: &[Measured], span: std::ops::Range<usize>)
     .collect()
 }
 
+/// Whether this is the kind of machine the files were measured on: x86-64 with FMA and
+/// AVX2. glibc picks its `sin`, `exp` and `pow` variants by those features, and a
+/// last-bit difference can flip a chaotic cell (tests/golden.rs): elsewhere one share of
+/// each row may differ.
+fn same_machine() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    return std::is_x86_feature_detected!("fma") && std::is_x86_feature_detected!("avx2");
+    #[cfg(not(target_arch = "x86_64"))]
+    return false;
+}
+
 #[test]
 fn rows_of_the_shipped_window_measured_again_give_the_same_verdicts() {
     // One row of each point law, on four instruments and four strings, at all four
@@ -54,14 +67,7 @@ fn rows_of_the_shipped_window_measured_again_give_the_same_verdicts() {
         .map(|&(law, kind, string, beta)| (Model::Point(law), kind, string, beta))
         .collect();
     let measured_now = run_keys(&keys, false).expect("the rows measure");
-    // The file was measured on x86-64 with FMA and AVX2. glibc picks its `sin`, `exp` and
-    // `pow` variants by those features, and a last-bit difference can flip a chaotic cell
-    // (tests/golden.rs): elsewhere one share of each row may differ.
-    #[cfg(target_arch = "x86_64")]
-    let same_machine =
-        std::is_x86_feature_detected!("fma") && std::is_x86_feature_detected!("avx2");
-    #[cfg(not(target_arch = "x86_64"))]
-    let same_machine = false;
+    let same_machine = same_machine();
     if !same_machine {
         eprintln!("not the machine the window was measured on: one share a row may differ");
     }
@@ -85,6 +91,41 @@ fn rows_of_the_shipped_window_measured_again_give_the_same_verdicts() {
             law.name(),
             kind.name(),
             measured_now.regimes
+        );
+    }
+}
+
+#[test]
+fn rows_of_the_window_at_the_guards_bows_measured_again_give_the_same_verdicts() {
+    // docs/playing-space/guard-window.csv (`colophony bench guard-window`) is what the
+    // model holds at the Dynamics Guard's own speed and position: two of its rows (the
+    // hyperbolic cello's A string at CC11 0, the static law's violin E string at 42)
+    // measured again must match share by share, as the shipped window's rows do above.
+    let text = include_str!("../../docs/playing-space/guard-window.csv");
+    assert_eq!(text.lines().next(), Some(GUARD_WINDOW_HEADER));
+    let same_machine = same_machine();
+    for (law, kind, string, level) in [
+        (FrictionModel::Hyperbolic, InstrumentKind::Cello, 3, 0u8),
+        (FrictionModel::Stribeck, InstrumentKind::Violin, 3, 42),
+    ] {
+        let model = Model::Point(law);
+        let cells = guard_cells(model, kind, string, level);
+        let measured_now = measure_cells(&cells, false).expect("the row measures");
+        let held = verdicts(&cells, &measured_now, 0..cells.len());
+        let key = format!("{},{},{string},{level},", model.name(), kind.name());
+        let line = text
+            .lines()
+            .find(|l| l.starts_with(&key))
+            .unwrap_or_else(|| panic!("no row {key}"));
+        let shipped = line.split(',').nth(8).expect("a held field");
+        let differ = held
+            .chars()
+            .zip(shipped.chars())
+            .filter(|(a, b)| a != b)
+            .count();
+        assert!(
+            shipped.len() == held.len() && (differ == 0 || (!same_machine && differ <= 1)),
+            "{key}: measured {held}, shipped {shipped}"
         );
     }
 }
