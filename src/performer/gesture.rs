@@ -461,7 +461,7 @@ impl Performer {
     /// [`guarded_bow`] for the source at the dynamics' bow scale `scale`. A rubbed object
     /// is no string: the slip's damping bound, set for the strings at the parameters'
     /// defaults, does not apply, and its force follows the speed.
-    fn guarded_bow(&self, scale: f64) -> GuardedBow {
+    pub(super) fn guarded_bow(&self, scale: f64) -> GuardedBow {
         let guarded = guarded_bow(self.bow_law(), self.setup.instrument, scale);
         match self.source {
             Source::Rubbed(_) => GuardedBow {
@@ -726,6 +726,69 @@ mod tests {
         p.set_controller(11, e);
         p.note_on(note, 0.8);
         played(&mut p, &setup, note, bow, 1.6, 1.2)
+    }
+
+    #[test]
+    fn a_law_or_instrument_chosen_at_rest_dynamics_plays_its_own_guarded_bow() {
+        // The guard's bow belongs to the law and the instrument (the Stribeck laws' bow
+        // stops at their slowest speed, the hyperbolic law's does not; each instrument
+        // has its own floor): chosen while the dynamics rest at CC11 0, the new law's or
+        // instrument's guarded speed and drift are played from the next sample, as by a
+        // performer set up with them from the start; so is the guard turned off.
+        let bow = BowControl::default();
+        let scale = 10f64.powf(-DYNAMICS_RANGE_DB / 20.0);
+        let start = Setup {
+            instrument: InstrumentKind::Cello,
+            point_law: Some(FrictionModel::Hyperbolic),
+            ..Setup::default()
+        };
+        let switches = [
+            Setup {
+                point_law: Some(FrictionModel::Stribeck),
+                ..start
+            },
+            Setup {
+                instrument: InstrumentKind::DoubleBass,
+                point_law: Some(FrictionModel::LuGre),
+                ..start
+            },
+            Setup {
+                dynamics_guard: false,
+                ..start
+            },
+        ];
+        for switched in switches {
+            let mut p = Performer::new(start.instrument);
+            p.activate(&start, FS).unwrap();
+            p.configure(&start);
+            p.set_controller(11, 0.0);
+            p.note_on(50, 0.5);
+            for _ in 0..(0.3 * FS) as usize {
+                p.tick(bow);
+            }
+            p.configure(&switched);
+            p.tick(bow);
+            let wanted = if switched.dynamics_guard {
+                guarded_bow(switched.point_law, switched.instrument, scale)
+            } else {
+                // Without the guard only the speed follows the dynamics.
+                GuardedBow {
+                    speed: scale,
+                    force: 1.0,
+                    away: 1.0,
+                }
+            };
+            let played = p.bow();
+            // The stroke is settled (speed +-1): the speed is the guard's to rounding.
+            assert!(
+                (played.velocity_m_per_s.abs() - bow.velocity_m_per_s * wanted.speed).abs() < 1e-12,
+                "{switched:?}: speed {} against {}",
+                played.velocity_m_per_s,
+                bow.velocity_m_per_s * wanted.speed
+            );
+            let beta = (bow.position_beta * wanted.away).clamp(MIN_NOTE_BETA, MAX_NOTE_BETA);
+            assert!((played.position_beta - beta).abs() < 1e-12, "{switched:?}");
+        }
     }
 
     #[test]

@@ -131,6 +131,10 @@ impl Performer {
         self.follow_tremolo();
         self.apply_mute();
         self.apply_source(wanted);
+        // The guard's bow belongs to the law and the instrument, and the gesture's steady
+        // factors to the guard: both worked out again from the next sample.
+        self.gesture.guarded = self.guarded_bow(self.gesture.bow_scale);
+        self.steady = None;
         for engine in self.engines() {
             engine.update_sleep();
         }
