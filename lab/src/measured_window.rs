@@ -473,15 +473,29 @@ pub fn guard_cells(model: Model, kind: InstrumentKind, string: usize, level: u8)
     )
     .at_expression(expression);
     let (v, beta) = (guard.bow.velocity_m_per_s, guard.bow.position_beta);
-    note_cells(model, kind, string, note, beta)
+    speed_cells(model, kind, string, beta, v)
+        .into_iter()
+        .map(|cell| Cell { expression, ..cell })
+        .collect()
+}
+
+/// [`note_cells`] on `string`'s open note at `beta` with the bow at `speed_m_per_s`
+/// instead of the window's 0.1 m/s: each force the same share of `F_max` at that speed.
+pub fn speed_cells(
+    model: Model,
+    kind: InstrumentKind,
+    string: usize,
+    beta: f64,
+    speed_m_per_s: f64,
+) -> Vec<Cell> {
+    note_cells(model, kind, string, kind.open_notes()[string], beta)
         .into_iter()
         .map(|mut cell| {
-            let k = v / cell.bow.velocity_m_per_s;
-            cell.bow.velocity_m_per_s = v;
+            let k = speed_m_per_s / cell.bow.velocity_m_per_s;
+            cell.bow.velocity_m_per_s = speed_m_per_s;
             cell.bow.force_n *= k;
             cell.f_max_n *= k;
             cell.f_min_n *= k;
-            cell.expression = expression;
             cell
         })
         .collect()

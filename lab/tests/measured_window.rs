@@ -6,7 +6,7 @@ use colophony::dsp::friction::FrictionModel;
 use colophony::dsp::vocabulary::{InstrumentKind, STRINGS};
 use colophony::measure::window::{measured, MEASURED_BETAS};
 use colophony_lab::measured_window::{
-    guard_cells, holds, note_cells, run_keys, Key, GUARD_WINDOW_HEADER, SHARES,
+    guard_cells, holds, note_cells, run_keys, speed_cells, Key, GUARD_WINDOW_HEADER, SHARES,
 };
 use colophony_lab::playing_space::Model;
 use colophony_lab::playing_space::{measure_cells, Cell, Measured};
@@ -326,4 +326,92 @@ fn the_held_window_without_torsion_or_the_hair() {
         );
     }
     assert!(!keys.is_empty());
+}
+
+#[test]
+#[ignore = "survey: cargo test --release -p colophony-lab --test measured_window speeds -- --ignored --nocapture"]
+fn the_held_window_at_other_bow_speeds() {
+    // Schelleng's limits both scale with the bow's speed, so in shares of F_max his
+    // window is the same at every speed; the friction laws have speeds of their own (the
+    // hyperbolic v0, the Stribeck v_s, the thermal bow's heating), so the model's need
+    // not be. The shipped rows at beta 0.1 (0.1 m/s) against the same rows at 0.01, 0.03
+    // and 0.3 m/s (SPEEDS=a,b,.. for others).
+    let speeds: Vec<f64> = std::env::var("SPEEDS")
+        .ok()
+        .and_then(|l| l.split(',').map(|x| x.trim().parse().ok()).collect())
+        .unwrap_or_else(|| vec![0.01, 0.03, 0.3]);
+    let beta = 0.1;
+    let mut keys = Vec::new();
+    let mut cells = Vec::new();
+    for model in Model::ALL {
+        for kind in InstrumentKind::ALL {
+            for string in 0..STRINGS {
+                for &v in &speeds {
+                    keys.push((model, kind, string, v));
+                    cells.extend(speed_cells(model, kind, string, beta, v));
+                }
+            }
+        }
+    }
+    let measured_now = measure_cells(&cells, true).expect("the cells measure");
+    let m = measured();
+    let n = SHARES.len();
+    let median = |mut v: Vec<f64>| -> String {
+        if v.is_empty() {
+            return "-".into();
+        }
+        v.sort_by(f64::total_cmp);
+        format!("{:.3}", v[v.len() / 2])
+    };
+    println!("| model | speed, m/s | rows as at 0.1 m/s | top higher / lower | no window | median top | median floor |");
+    println!("|---|---|---|---|---|---|---|");
+    for model in Model::ALL {
+        let shipped: Vec<Option<(f64, f64)>> = keys
+            .iter()
+            .filter(|k| k.0 == model && k.3 == speeds[0])
+            .map(|&(_, kind, string, _)| m.shares(model, kind, string, beta))
+            .collect();
+        println!(
+            "| {} | 0.1 (shipped) | - | - | {} | {} | {} |",
+            model.name(),
+            shipped.iter().filter(|w| w.is_none()).count(),
+            median(shipped.iter().flatten().map(|w| w.1).collect()),
+            median(shipped.iter().flatten().map(|w| w.0).collect()),
+        );
+        for &v in &speeds {
+            let (mut same, mut higher, mut lower, mut none) = (0, 0, 0, 0);
+            let (mut tops, mut floors) = (Vec::new(), Vec::new());
+            for (k, &(_, kind, string, _)) in keys
+                .iter()
+                .enumerate()
+                .filter(|(_, k)| k.0 == model && k.3 == v)
+            {
+                let held: Vec<bool> = (k * n..(k + 1) * n)
+                    .map(|i| holds(&cells[i], &measured_now[i]))
+                    .collect();
+                let window = colophony_lab::measured_window::window_of(&held)
+                    .map(|(lo, hi)| (SHARES[lo], SHARES[hi]));
+                let shipped = m.shares(model, kind, string, beta);
+                match (window, shipped) {
+                    (None, _) => none += 1,
+                    (Some(w), Some(s)) if w.1 > s.1 => higher += 1,
+                    (Some(w), Some(s)) if w.1 < s.1 => lower += 1,
+                    _ => {}
+                }
+                if window == shipped {
+                    same += 1;
+                }
+                if let Some((lo, hi)) = window {
+                    tops.push(hi);
+                    floors.push(lo);
+                }
+            }
+            println!(
+                "| {} | {v} | {same} of 16 | {higher} / {lower} | {none} | {} | {} |",
+                model.name(),
+                median(tops),
+                median(floors)
+            );
+        }
+    }
 }
