@@ -45,6 +45,18 @@ fn same_machine() -> bool {
     return false;
 }
 
+/// Whether verdicts measured now agree with a file's, share by share: a verdict for every
+/// share, all the same on the machine the file was measured on, one allowed to differ
+/// elsewhere ([`same_machine`]).
+fn agrees(held: &str, shipped: &str, same_machine: bool) -> bool {
+    let differ = held
+        .chars()
+        .zip(shipped.chars())
+        .filter(|(a, b)| a != b)
+        .count();
+    held.len() == shipped.len() && (differ == 0 || (!same_machine && differ <= 1))
+}
+
 #[test]
 fn rows_of_the_shipped_window_measured_again_give_the_same_verdicts() {
     // One row of each point law, on four instruments and four strings, at all four
@@ -79,14 +91,8 @@ fn rows_of_the_shipped_window_measured_again_give_the_same_verdicts() {
             .map(|&h| if h { '1' } else { '0' })
             .collect();
         let shipped = shipped_held(model, kind, string, beta);
-        assert_eq!(shipped.len(), held.len(), "a verdict for every share");
-        let differ = held
-            .chars()
-            .zip(shipped.chars())
-            .filter(|(a, b)| a != b)
-            .count();
         assert!(
-            differ == 0 || (!same_machine && differ <= 1),
+            agrees(&held, &shipped, same_machine),
             "{} {} string {string} beta {beta}: measured {held} ({:?}), shipped {shipped}",
             law.name(),
             kind.name(),
@@ -118,13 +124,8 @@ fn rows_of_the_window_at_the_guards_bows_measured_again_give_the_same_verdicts()
             .find(|l| l.starts_with(&key))
             .unwrap_or_else(|| panic!("no row {key}"));
         let shipped = line.split(',').nth(8).expect("a held field");
-        let differ = held
-            .chars()
-            .zip(shipped.chars())
-            .filter(|(a, b)| a != b)
-            .count();
         assert!(
-            shipped.len() == held.len() && (differ == 0 || (!same_machine && differ <= 1)),
+            agrees(&held, shipped, same_machine),
             "{key}: measured {held}, shipped {shipped}"
         );
     }
