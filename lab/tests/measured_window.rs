@@ -416,3 +416,51 @@ fn the_held_window_at_other_bow_speeds() {
         }
     }
 }
+
+#[test]
+#[ignore = "survey: cargo test --release -p colophony-lab --test measured_window guards_bows_against -- --ignored --nocapture"]
+fn the_guards_bows_against_the_window_at_their_own_speed() {
+    // docs/playing-space/guard-window.csv against where the guard puts its bow (no
+    // rendering): inside the held window; above its top but under the next share of the
+    // grid, which did not hold (the grid cannot say); or beyond that share (and the same
+    // below the floor).
+    use colophony_lab::measured_window::guard_share;
+    let text = include_str!("../../docs/playing-space/guard-window.csv");
+    for model in Model::ALL {
+        let (mut inside, mut gap, mut beyond, mut none) = (0, 0, 0, 0);
+        for line in text.lines().skip(1) {
+            let f: Vec<&str> = line.split(',').collect();
+            if f[0] != model.name() {
+                continue;
+            }
+            let kind = InstrumentKind::from_name(f[1]).expect("an instrument");
+            let string: usize = f[2].parse().expect("a string");
+            let level: u8 = f[3].parse().expect("a level");
+            let share = guard_share(model, kind, string, level);
+            let (Ok(lo), Ok(hi)) = (f[6].parse::<f64>(), f[7].parse::<f64>()) else {
+                none += 1;
+                continue;
+            };
+            let at = |x: f64| SHARES.iter().position(|&s| (s - x).abs() < 1e-9);
+            let (l, h) = (at(lo).expect("a grid share"), at(hi).expect("a grid share"));
+            let next_up = SHARES.get(h + 1).copied().unwrap_or(f64::INFINITY);
+            let next_down = if l > 0 { SHARES[l - 1] } else { 0.0 };
+            if share >= lo && share <= hi {
+                inside += 1;
+            } else if share < next_up && share > next_down {
+                gap += 1;
+            } else {
+                beyond += 1;
+                println!(
+                    "{} {} string {string} CC11 {level}: guard {share:.3} F_max, held {lo}-{hi}",
+                    model.name(),
+                    kind.name()
+                );
+            }
+        }
+        println!(
+            "{}: inside {inside}, outside by less than a grid step {gap}, beyond it {beyond}, no window {none}",
+            model.name()
+        );
+    }
+}
