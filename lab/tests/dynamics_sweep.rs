@@ -409,7 +409,8 @@ fn attack_short_slip_survey() {
 /// criterion or more than 10 cents from its pitch, with its cents, its slip fraction over
 /// beta and its slips a period. `LAW=static|lugre|elasto-plastic|hyperbolic` (LuGre
 /// without), `CCS=80,85` for the levels, `LANDING=1` for the map's landing instead,
-/// `NO_CATCH=1` for the performer's attack without its catch. Also printed: when lasting
+/// `NO_CATCH=1` for the performer's attack without its catch, `FORCE=0.5` for that share
+/// of the guard's force (the speed and position kept). Also printed: when lasting
 /// Helmholtz motion began, median and 90th percentile over the notes. `cargo test --release -p colophony-lab --test dynamics_sweep short_slip_map --
 /// --ignored --nocapture` (about 15 s).
 #[test]
@@ -445,6 +446,9 @@ fn short_slip_map() {
                             .at_expression(cc / 127.0);
                     cell.attack = attack;
                     cell.performer_catch = std::env::var("NO_CATCH").is_err();
+                    if let Ok(share) = std::env::var("FORCE") {
+                        cell.bow.force_n *= share.parse::<f64>().expect("FORCE: a factor");
+                    }
                     let m = measure_cell(&cell).expect("measure");
                     let off = (!m.helmholtz || m.cents.abs() > 10.0).then(|| {
                         format!(
