@@ -279,6 +279,15 @@ pub fn summary(rows: &[Row]) -> String {
     s
 }
 
+/// Writes `text` to `out`, making its folder where it is missing.
+fn write_file(out: &Path, text: &str) -> Result<(), String> {
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    }
+    std::fs::write(out, text).map_err(|e| format!("cannot write {}: {e}", out.display()))
+}
+
 /// `colophony bench window --out FILE`: measures, writes the file and checks that it
 /// reads back as the plugin reads it.
 pub fn run(out: &Path, models: &[Model], kinds: &[InstrumentKind]) -> Result<String, String> {
@@ -289,11 +298,7 @@ pub fn run(out: &Path, models: &[Model], kinds: &[InstrumentKind]) -> Result<Str
     if models.len() == Model::COUNT && kinds.len() == InstrumentKind::COUNT {
         MeasuredWindows::parse(&text)?;
     }
-    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir)
-            .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
-    }
-    std::fs::write(out, &text).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+    write_file(out, &text)?;
     let png = out.with_extension("png");
     draw(&text, &png)?;
     Ok(format!(
@@ -460,23 +465,30 @@ pub const GUARD_WINDOW_HEADER: &str =
 /// parameters' defaults), the force a share of Schelleng's `F_max` at that speed and
 /// position, held as [`note_cells`] hold theirs.
 pub fn guard_cells(model: Model, kind: InstrumentKind, string: usize, level: u8) -> Vec<Cell> {
-    let note = kind.open_notes()[string];
-    let expression = level as f64 / 127.0;
-    let guard = Cell::on_string(
+    let guard = guard_cell(model, kind, string, level);
+    let (v, beta) = (guard.bow.velocity_m_per_s, guard.bow.position_beta);
+    speed_cells(model, kind, string, beta, v)
+        .into_iter()
+        .map(|cell| Cell {
+            expression: guard.expression,
+            ..cell
+        })
+        .collect()
+}
+
+/// `string`'s open note bowed as the Dynamics Guard bows it at CC11 `level` (the
+/// parameters' defaults, String Weight on: [`Cell::at_expression`]).
+pub fn guard_cell(model: Model, kind: InstrumentKind, string: usize, level: u8) -> Cell {
+    Cell::on_string(
         model,
         kind,
-        note,
+        kind.open_notes()[string],
         Some(string),
         RATE_HZ,
         Bowing::Defaults,
         SECONDS,
     )
-    .at_expression(expression);
-    let (v, beta) = (guard.bow.velocity_m_per_s, guard.bow.position_beta);
-    speed_cells(model, kind, string, beta, v)
-        .into_iter()
-        .map(|cell| Cell { expression, ..cell })
-        .collect()
+    .at_expression(level as f64 / 127.0)
 }
 
 /// [`note_cells`] on `string`'s open note at `beta` with the bow at `speed_m_per_s`
@@ -501,23 +513,18 @@ pub fn speed_cells(
         .collect()
 }
 
-/// The guard's bow's share of `F_max` at CC11 `level` on `string` (the parameters'
-/// defaults, String Weight on).
+/// The guard's bow's share of Schelleng's `F_max` (the model's coefficients) at CC11
+/// `level` on `string` ([`guard_cell`]; its force is the string's own, weighted).
 pub fn guard_share(model: Model, kind: InstrumentKind, string: usize, level: u8) -> f64 {
-    let law = match model {
-        Model::Point(law) => Some(law),
-        Model::Thermal => None,
-    };
-    let scale =
-        10f64.powf(-colophony::performer::DYNAMICS_RANGE_DB * (1.0 - level as f64 / 127.0) / 20.0);
-    let g = colophony::performer::guarded_bow(law, kind, scale);
-    let defaults = colophony::dsp::vocabulary::BowControl::default();
-    let beta = (defaults.position_beta * g.away).clamp(
-        colophony::dsp::vocabulary::MIN_NOTE_BETA,
-        colophony::dsp::vocabulary::MAX_NOTE_BETA,
+    let bow = guard_cell(model, kind, string, level).bow;
+    let window = SchellengWindow::for_model(
+        kind,
+        string,
+        bow.position_beta,
+        model == Model::Thermal,
+        false,
     );
-    let window = SchellengWindow::for_model(kind, string, beta, model == Model::Thermal, true);
-    defaults.force_n * g.force / window.max_force_n(defaults.velocity_m_per_s * g.speed)
+    bow.force_n / window.max_force_n(bow.velocity_m_per_s)
 }
 
 /// One row of the guard's window: a (model, instrument, string, level) and what each
@@ -607,12 +614,7 @@ pub fn guard_csv(rows: &[GuardRow]) -> String {
 pub fn run_guard(out: &Path, models: &[Model], kinds: &[InstrumentKind]) -> Result<String, String> {
     let t = std::time::Instant::now();
     let rows = run_guard_rows(models, kinds, true)?;
-    let text = guard_csv(&rows);
-    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir)
-            .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
-    }
-    std::fs::write(out, &text).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+    write_file(out, &guard_csv(&rows))?;
     let mut report = format!(
         "{} rows ({} cells) in {:.0} s\n\n| model | guard bows inside | above | below | no window |\n|---|---|---|---|---|\n",
         rows.len(),

@@ -210,34 +210,15 @@ fn the_dynamics_guards_bow_against_the_measured_window() {
     // CC11 0 .. 127: speed, force and the drift from the bridge) against the window
     // measured there: the force as a share of F_max at the drifted beta, and whether it
     // lies inside the measured shares. No rendering: the guard's arithmetic and the file.
-    use colophony::measure::window::SchellengWindow;
-    use colophony_lab::playing_space::{Bowing, Cell};
+    use colophony_lab::measured_window::{guard_cell, guard_share};
     let m = measured();
     for model in Model::ALL {
         let (mut inside, mut above, mut below, mut none) = (0, 0, 0, 0);
         for kind in InstrumentKind::ALL {
             for string in 0..STRINGS {
-                let note = kind.open_notes()[string];
                 for cc in [0u8, 21, 42, 64, 85, 106, 127] {
-                    let cell = Cell::on_string(
-                        model,
-                        kind,
-                        note,
-                        Some(string),
-                        48_000.0,
-                        Bowing::Defaults,
-                        1.0,
-                    )
-                    .at_expression(cc as f64 / 127.0);
-                    let bow = cell.bow;
-                    let window = SchellengWindow::for_model(
-                        kind,
-                        string,
-                        bow.position_beta,
-                        model == Model::Thermal,
-                        false,
-                    );
-                    let share = bow.force_n / window.max_force_n(bow.velocity_m_per_s);
+                    let bow = guard_cell(model, kind, string, cc).bow;
+                    let share = guard_share(model, kind, string, cc);
                     match m.shares(model, kind, string, bow.position_beta) {
                         None => none += 1,
                         Some((_, hi)) if share > hi => above += 1,
