@@ -192,11 +192,26 @@ impl GuardedBow {
     };
 }
 
+/// The slip speeds over which a Stribeck law's slip damping is taken, as a share of the
+/// Helmholtz slip speed: from this share of it up to it (the largest `|mu'|` over them).
+/// Taken at the Helmholtz speed alone, the bound lets go above CC11 74 (the slip passes
+/// `v_s` there) and the guard's force leaps from 0.23 `F_max` at CC11 74 to 0.57 at 85,
+/// where the performer's attack leaves the static, LuGre and elasto-plastic laws' notes
+/// in a short slip (0.62-0.71 beta, one a period, 10-25 cents sharp; docs/testing.md,
+/// "Dynamics"); with half that force none does (`short_slip_map` with `FORCE=0.5` in
+/// `lab/tests/dynamics_sweep.rs`). From 0.7 of the speed the bound holds the force to
+/// 0.31 of the speed's at CC11 85 and lets go at CC11 95, so that the force rises between
+/// two of the intonation table's soft rows (CC11 85 and 95), which interpolates the pitch
+/// between them; below CC11 53 (a slip slower than `v_s / sqrt(2)`, the curve's
+/// steepest) it changes nothing.
+pub const STRIBECK_SLIP_SPAN: f64 = 0.7;
+
 /// The slip's negative damping `F |mu'(v_slip)|` over the reference string's `2 Z0` with
 /// point law `law` at the parameters' defaults, the bow at the guard's `speed` (and its
 /// force proportional to it) and drift `away`: the Helmholtz slip speed `v_b (1 - beta) /
 /// beta` on the law's curve (paper A's Stribeck curve for the static, LuGre and
-/// elasto-plastic laws). The string weighting makes `F / Z0` the same on every string.
+/// elasto-plastic laws, its steepest over [`STRIBECK_SLIP_SPAN`] of that speed up to it).
+/// The string weighting makes `F / Z0` the same on every string.
 pub fn slip_damping(law: FrictionModel, speed: f64, away: f64) -> f64 {
     let bow = BowControl::default();
     let beta = (bow.position_beta * away).clamp(MIN_NOTE_BETA, MAX_NOTE_BETA);
@@ -210,8 +225,16 @@ pub fn slip_damping(law: FrictionModel, speed: f64, away: f64) -> f64 {
         _ => {
             let friction = crate::dsp::friction::stribeck::StribeckFriction::default();
             let (v_s, fall) = (friction.stribeck_m_per_s, friction.mu_s - friction.mu_d);
+            // `x exp(-x^2)` rises to x = 1 / sqrt(2) and falls after: its largest over
+            // `[span x, x]` is at one end or at that peak.
             let x = v_slip / v_s;
-            2.0 * fall * x * (-x * x).exp() / v_s
+            let steepest = std::f64::consts::FRAC_1_SQRT_2;
+            let at = if x <= steepest {
+                x
+            } else {
+                (STRIBECK_SLIP_SPAN * x).max(steepest)
+            };
+            2.0 * fall * at * (-at * at).exp() / v_s
         }
     };
     bow.force_n * speed * slope / (2.0 * crate::dsp::vocabulary::WEIGHT_REFERENCE_Z0)
@@ -631,6 +654,26 @@ mod tests {
         )
     }
 
+    /// `p` (its note on) bowed with `bow` for `seconds`, `setup` configured every 256
+    /// samples as the plugin's blocks do: the probe at the bow, sample by sample.
+    fn probed(
+        p: &mut Performer,
+        setup: &Setup,
+        bow: BowControl,
+        seconds: f64,
+    ) -> Vec<ContactSample> {
+        let n = (seconds * FS) as usize;
+        let mut probe = Vec::with_capacity(n);
+        for i in 0..n {
+            if i % 256 == 0 {
+                p.configure(setup);
+            }
+            let frame = p.tick(bow);
+            probe.push(ContactSample::new(&frame, &p.bow()));
+        }
+        probe
+    }
+
     #[test]
     fn without_the_window_guard_a_soft_dynamic_under_a_heavy_bow_turns_raucous() {
         // Expression 0.25 is 26 dB down: with the guard the force follows the velocity
@@ -646,16 +689,8 @@ mod tests {
         let mut p = cello_with(&setup);
         p.set_controller(11, 0.25);
         p.note_on(50, 0.8);
-        let bow = BowControl::default();
-        let n = (2.0 * FS) as usize;
-        let mut probe = Vec::with_capacity(n);
-        for i in 0..n {
-            if i % 256 == 0 {
-                p.configure(&setup);
-            }
-            let frame = p.tick(bow);
-            probe.push(ContactSample::new(&frame, &p.bow()));
-        }
+        let probe = probed(&mut p, &setup, BowControl::default(), 2.0);
+        let n = probe.len();
         let played = p.bow();
         assert_eq!(played.force_n, 1.0, "the force is the parameter's");
         assert_eq!(played.position_beta, 0.1, "no drift without the guard");
@@ -715,6 +750,19 @@ mod tests {
         e: f32,
         bow: BowControl,
     ) -> (f64, Option<Regime>) {
+        let (mut p, setup) = note_on_at(kind, law, note, e);
+        played(&mut p, &setup, note, bow, 1.6, 1.2)
+    }
+
+    /// A performer for `kind` with point law `law` (`None`: paper B's thermal model) at
+    /// the defaults, the expression at `e`, and `note` on at velocity 0.8 (the
+    /// performer's accent and catch); with its setup.
+    fn note_on_at(
+        kind: InstrumentKind,
+        law: Option<FrictionModel>,
+        note: u8,
+        e: f32,
+    ) -> (Performer, Setup) {
         let setup = Setup {
             instrument: kind,
             point_law: law,
@@ -725,7 +773,7 @@ mod tests {
         p.configure(&setup);
         p.set_controller(11, e);
         p.note_on(note, 0.8);
-        played(&mut p, &setup, note, bow, 1.6, 1.2)
+        (p, setup)
     }
 
     #[test]
@@ -916,6 +964,79 @@ mod tests {
                 assert_eq!(guarded, Some(Regime::Helmholtz), "{kind:?} {law:?} {note}");
             }
         }
+    }
+
+    /// `note` on `kind` with point law `law` at expression `e` (sent before the note,
+    /// velocity 0.8: the performer's accent and catch) and the parameters' bow `bow`:
+    /// the slip fraction over beta as played and the regime, over the last 8 periods of
+    /// 1.6 s.
+    fn slip_over_beta(
+        kind: InstrumentKind,
+        law: FrictionModel,
+        note: u8,
+        e: f32,
+        bow: BowControl,
+    ) -> (f64, Option<Regime>) {
+        let (mut p, setup) = note_on_at(kind, Some(law), note, e);
+        let probe = probed(&mut p, &setup, bow, 1.6);
+        let played = p.bow();
+        let f0 = midi_to_hz(note as f64);
+        let tail = &probe[probe.len() - (8.0 * FS / f0) as usize..];
+        let v: Vec<f64> = tail.iter().map(|s| s.string_velocity as f64).collect();
+        let v_b = played.velocity_m_per_s.abs();
+        // 0.05 v_b as the playing-space map measures a cell (lab/src/playing_space.rs).
+        let stats = crate::analysis::slip_stats(&v, v_b, FS, f0, 0.05 * v_b);
+        (
+            stats.slip_fraction / played.position_beta,
+            classify_regime(tail, FS as f32, f0 as f32),
+        )
+    }
+
+    #[test]
+    fn the_stribeck_laws_slip_for_the_whole_beta_from_a_players_attack_at_cc11_85() {
+        // At CC11 85 the Helmholtz slip passes 2 v_s, past the Stribeck curve's steep
+        // part, and the slip's damping at that speed alone no longer holds the force:
+        // with the force the speed alone gives, the performer's attack leaves some of
+        // the LuGre law's notes in one short slip a period (0.62-0.71 beta,
+        // docs/testing.md, "Dynamics"); taken over the slip's speeds from
+        // STRIBECK_SLIP_SPAN of it, the bound holds the force lighter and every note
+        // of the violin's, viola's and cello's 13 slips for beta (short: under 0.85 of
+        // it, the map's criterion being 15 %).
+        let e = 85.0 / 127.0;
+        let scale = 10f64.powf(-DYNAMICS_RANGE_DB * (1.0 - e) / 20.0);
+        let law = FrictionModel::LuGre;
+        let d = BowControl::default();
+        let (mut held_short, mut unheld_short) = (Vec::new(), Vec::new());
+        for kind in [
+            InstrumentKind::Violin,
+            InstrumentKind::Viola,
+            InstrumentKind::Cello,
+        ] {
+            let g = guarded_bow(Some(law), kind, scale);
+            assert!(g.force < 0.6 * g.speed, "{kind:?}: {g:?}");
+            // The parameters' force raised so that the guard plays the speed's force.
+            let unheld = BowControl {
+                force_n: d.force_n * g.speed / g.force,
+                ..d
+            };
+            let (low, _) = kind.note_range();
+            for note in (low..=low + 36).step_by(3) {
+                let (held, _) = slip_over_beta(kind, law, note, e as f32, d);
+                let (short, _) = slip_over_beta(kind, law, note, e as f32, unheld);
+                println!("{kind:?} {note}: {held:.3} beta held, {short:.3} at the speed's force");
+                if held < 0.85 {
+                    held_short.push((kind, note));
+                }
+                if short < 0.85 {
+                    unheld_short.push((kind, note));
+                }
+            }
+        }
+        assert!(held_short.is_empty(), "{held_short:?}");
+        // 11 of the 39 slip short at the speed's force on the machine this was measured
+        // on; 6 asked, as a short slip is a regime the attack picks, which an FMA-less
+        // machine's rounding may tip on a few notes.
+        assert!(unheld_short.len() >= 6, "{unheld_short:?}");
     }
 
     #[test]
