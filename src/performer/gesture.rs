@@ -5,6 +5,7 @@
 use super::midi::RPN_NULL;
 use super::*;
 use crate::dsp::fingering::DYNAMICS_INTONATION_STEP;
+use crate::dsp::intonation::SOFT_EXPRESSIONS;
 
 /// The dynamics' range: expression 0 (CC11, CC2 or channel pressure at 0) plays the bow
 /// this many dB below expression 1 (the default, and the parameters' own bow). The
@@ -257,6 +258,38 @@ fn slip_force_share(law: FrictionModel, speed: f64, away: f64) -> f64 {
     }
 }
 
+/// The share of the guard's force a Stribeck law (`law`) plays on `kind` at the dynamics'
+/// bow scale `scale`: [`slip_force_share`] at the intonation table's soft levels
+/// ([`SOFT_EXPRESSIONS`] and full expression), interpolated linearly in the expression
+/// between them, as the table interpolates the pitch. The table's rows are fitted at the
+/// levels' own force; between two rows where the bound lets go (CC11 85 to 95) the bound's
+/// own force rises faster than a line, and the notes there sat 5-11 cents over the pitch
+/// the rows interpolate (docs/testing.md, "Dynamics").
+fn stribeck_force_share(law: FrictionModel, kind: InstrumentKind, scale: f64) -> f64 {
+    let expression = (1.0 + 20.0 * scale.log10() / DYNAMICS_RANGE_DB).clamp(0.0, 1.0);
+    let at = |e: f64| {
+        let s = 10f64.powf(-DYNAMICS_RANGE_DB * (1.0 - e) / 20.0);
+        let speed = s.max(STRIBECK_SLOWEST_SCALE[kind.index()]);
+        if speed >= 1.0 {
+            return 1.0;
+        }
+        slip_force_share(law, speed, speed.powf(-DYNAMICS_DRIFT_EXPONENT))
+    };
+    let levels = SOFT_EXPRESSIONS.iter().copied().chain(std::iter::once(1.0));
+    let mut below = 0.0;
+    for level in levels {
+        if level >= expression {
+            if level == below {
+                return at(level);
+            }
+            let t = (expression - below) / (level - below);
+            return at(below) + t * (at(level) - at(below));
+        }
+        below = level;
+    }
+    1.0
+}
+
 /// The bow the Dynamics Guard plays at the dynamics' bow scale `scale` (0..=1) with
 /// `law` (`None`: paper B's thermal bow) on `kind`: the factor on the parameters' speed
 /// and force (no lower than [`slowest_bow_scale`]; a Stribeck law's force held under
@@ -276,7 +309,11 @@ pub fn guarded_bow(law: Option<FrictionModel>, kind: InstrumentKind, scale: f64)
         };
     }
     let away = drift_from.powf(-DYNAMICS_DRIFT_EXPONENT);
-    let share = law.map_or(1.0, |law| slip_force_share(law, speed, away));
+    let share = match law {
+        None => 1.0,
+        Some(FrictionModel::Hyperbolic) => slip_force_share(FrictionModel::Hyperbolic, speed, away),
+        Some(law) => stribeck_force_share(law, kind, scale),
+    };
     GuardedBow {
         speed,
         force: speed * share,
