@@ -1070,7 +1070,7 @@ mod tests {
             }
         }
         assert!(held_short.is_empty(), "{held_short:?}");
-        // 11 of the 39 slip short at the speed's force on the machine this was measured
+        // 10 of the 39 slip short at the speed's force on the machine this was measured
         // on; 6 asked, as a short slip is a regime the attack picks, which an FMA-less
         // machine's rounding may tip on a few notes.
         assert!(unheld_short.len() >= 6, "{unheld_short:?}");
