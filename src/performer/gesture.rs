@@ -266,28 +266,45 @@ fn slip_force_share(law: FrictionModel, speed: f64, away: f64) -> f64 {
 /// own force rises faster than a line, and the notes there sat 5-11 cents over the pitch
 /// the rows interpolate (docs/testing.md, "Dynamics").
 fn stribeck_force_share(law: FrictionModel, kind: InstrumentKind, scale: f64) -> f64 {
-    let expression = (1.0 + 20.0 * scale.log10() / DYNAMICS_RANGE_DB).clamp(0.0, 1.0);
-    let at = |e: f64| {
-        let s = 10f64.powf(-DYNAMICS_RANGE_DB * (1.0 - e) / 20.0);
-        let speed = s.max(STRIBECK_SLOWEST_SCALE[kind.index()]);
-        if speed >= 1.0 {
-            return 1.0;
-        }
-        slip_force_share(law, speed, speed.powf(-DYNAMICS_DRIFT_EXPONENT))
+    let expression = expression_at(scale);
+    let at = |e: f64| match speed_and_away(Some(law), kind, bow_scale_at(e)) {
+        (speed, _) if speed >= 1.0 => 1.0,
+        (speed, away) => slip_force_share(law, speed, away),
     };
     let levels = SOFT_EXPRESSIONS.iter().copied().chain(std::iter::once(1.0));
-    let mut below = 0.0;
-    for level in levels {
+    let (mut below, mut share_below) = (0.0, at(0.0));
+    for level in levels.skip_while(|&l| l == 0.0) {
         if level >= expression {
-            if level == below {
-                return at(level);
-            }
             let t = (expression - below) / (level - below);
-            return at(below) + t * (at(level) - at(below));
+            return share_below + t * (at(level) - share_below);
         }
-        below = level;
+        (below, share_below) = (level, at(level));
     }
     1.0
+}
+
+/// The dynamics' bow scale at expression `e` (0..=1): `10^(-range (1 - e) / 20)`.
+pub fn bow_scale_at(e: f64) -> f64 {
+    10f64.powf(-DYNAMICS_RANGE_DB * (1.0 - e.clamp(0.0, 1.0)) / 20.0)
+}
+
+/// The expression (0..=1) whose bow scale is `scale` ([`bow_scale_at`]'s inverse).
+fn expression_at(scale: f64) -> f64 {
+    (1.0 + 20.0 * scale.log10() / DYNAMICS_RANGE_DB).clamp(0.0, 1.0)
+}
+
+/// The guard's factors on the parameters' speed and on the bow's distance from the
+/// bridge at the dynamics' bow scale `scale` ([`guarded_bow`]).
+fn speed_and_away(law: Option<FrictionModel>, kind: InstrumentKind, scale: f64) -> (f64, f64) {
+    let slowest = slowest_bow_scale(law, kind);
+    let speed = slowest.map_or(scale, |s| scale.max(s));
+    let drift_from = if law.is_some() { speed } else { scale };
+    let away = if drift_from == 1.0 {
+        1.0
+    } else {
+        drift_from.powf(-DYNAMICS_DRIFT_EXPONENT)
+    };
+    (speed, away)
 }
 
 /// The bow the Dynamics Guard plays at the dynamics' bow scale `scale` (0..=1) with
@@ -298,17 +315,14 @@ fn stribeck_force_share(law: FrictionModel, kind: InstrumentKind, scale: f64) ->
 /// the bridge (`s^-`[`DYNAMICS_DRIFT_EXPONENT`]; the thermal bow's drifts on below its
 /// slowest speed, the Stribeck laws' stops there).
 pub fn guarded_bow(law: Option<FrictionModel>, kind: InstrumentKind, scale: f64) -> GuardedBow {
-    let slowest = slowest_bow_scale(law, kind);
-    let speed = slowest.map_or(scale, |s| scale.max(s));
-    let drift_from = if law.is_some() { speed } else { scale };
-    if drift_from == 1.0 {
+    let (speed, away) = speed_and_away(law, kind, scale);
+    if away == 1.0 {
         return GuardedBow {
             speed,
             force: speed,
-            away: 1.0,
+            away,
         };
     }
-    let away = drift_from.powf(-DYNAMICS_DRIFT_EXPONENT);
     let share = match law {
         None => 1.0,
         Some(FrictionModel::Hyperbolic) => slip_force_share(FrictionModel::Hyperbolic, speed, away),
@@ -350,7 +364,7 @@ impl Gesture {
     }
 
     pub(super) fn set_expression(&mut self, e: f64) {
-        self.target = 10f64.powf(-DYNAMICS_RANGE_DB * (1.0 - e.clamp(0.0, 1.0)) / 20.0);
+        self.target = bow_scale_at(e);
     }
 }
 
@@ -557,11 +571,7 @@ impl Performer {
     /// intonation follows it): every [`DYNAMICS_INTONATION_STEP`] of a move, and where the
     /// dynamics come to rest.
     fn follow_dynamics(&mut self, scale: f64) {
-        let expression = if scale < 1.0 {
-            (1.0 + 20.0 * scale.log10() / DYNAMICS_RANGE_DB).max(0.0)
-        } else {
-            1.0
-        };
+        let expression = expression_at(scale);
         let sent = self.gesture.intonation_expression;
         let settled = self.gesture.bow_scale == self.gesture.target;
         if (expression - sent).abs() >= DYNAMICS_INTONATION_STEP || (settled && expression != sent)
