@@ -29,7 +29,9 @@ use colophony_lab::midi_file::{perform_probed, MidiEvent, Performance, Timed};
 use rayon::prelude::*;
 
 /// A part: (MIDI note, beats) pairs at `tempo` beats a minute, each note ending where the
-/// next begins (legato, one bow) unless a rest (note 0) comes between.
+/// next begins or at a rest (note 0). The note-off goes before the next note-on at the
+/// same sample, as a sequencer sends abutting notes: no key is held when the next lands,
+/// so every note starts its own stroke (détaché, the bow changing direction).
 struct Part {
     name: &'static str,
     /// Two notes a second or slower, legato: the parts every model plays in tune
@@ -257,7 +259,7 @@ fn play(part: &Part, law: Option<FrictionModel>, fs: f64) -> Vec<Note> {
         });
         spans.push((note, start as usize, end as usize));
     }
-    // Offs before ons at the same sample: legato, one bow.
+    // Offs before ons at the same sample: each note its own stroke.
     events.sort_by_key(|e| (e.sample, matches!(e.event, MidiEvent::NoteOn(..))));
     let how = Performance::plugin_defaults(part.kind, law, fs);
     let (audio, probe) = perform_probed(&events, &how).expect("the part plays");

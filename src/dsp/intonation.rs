@@ -72,13 +72,17 @@ fn rows() -> impl Iterator<Item = (usize, &'static str)> {
 }
 
 /// The expressions below full (1) the table may hold corrections for: the dynamics at 0,
-/// then every twelfth from a quarter (CC11 0, 32, 42, 53, 64, 74, 85, 95, 106, 116). The
-/// Stribeck-type laws' bowed pitch moves by up to 30 cents between a third and two thirds
-/// and not along a line (docs/testing.md, "Dynamics"), so they are fitted at every level;
-/// the hyperbolic law's moves little and is fitted at 0, 1/3 and 2/3 only. Below a
-/// quarter the Stribeck laws' guard holds the violin's and viola's bow at its slowest
-/// (`STRIBECK_SLOWEST_SCALE`), so nothing lies between 0 and 1/4 to fit.
-pub const SOFT_EXPRESSIONS: [f64; 10] = [
+/// then every twelfth from a quarter, and 17/24 between two thirds and three quarters
+/// (CC11 0, 32, 42, 53, 64, 74, 85, 90, 95, 106, 116). The Stribeck-type laws' bowed
+/// pitch moves by up to 30 cents between a third and two thirds and not along a line
+/// (docs/testing.md, "Dynamics"), so they are fitted at every level; between CC11 85 and
+/// 95 the Dynamics Guard lets their force go from 0.31 of the speed's to all of it, and
+/// with no row between, their notes at CC11 90 sat up to 9 cents off the line the two
+/// rows interpolate, hence 17/24. The hyperbolic law's pitch moves little and is fitted
+/// at 0, 1/3 and 2/3 only. Below a quarter the Stribeck laws' guard holds the violin's
+/// and viola's bow at its slowest (`STRIBECK_SLOWEST_SCALE`), so nothing lies between 0
+/// and 1/4 to fit.
+pub const SOFT_EXPRESSIONS: [f64; 11] = [
     0.0,
     3.0 / 12.0,
     4.0 / 12.0,
@@ -86,6 +90,7 @@ pub const SOFT_EXPRESSIONS: [f64; 10] = [
     6.0 / 12.0,
     7.0 / 12.0,
     8.0 / 12.0,
+    17.0 / 24.0,
     9.0 / 12.0,
     10.0 / 12.0,
     11.0 / 12.0,
