@@ -62,7 +62,7 @@ use colophony::measure::regime::{classify_regime, helmholtz_since, Regime};
 use colophony::measure::window::{model_coefficients, SchellengWindow};
 use colophony::performer::catch::{catches, Catch, CatchRule};
 use colophony::performer::stroke::{Stroke, StrokeMode};
-use colophony::performer::{guarded_bow, DYNAMICS_RANGE_DB};
+use colophony::performer::{bow_scale_at, guarded_bow};
 use colophony::quality::{Quality, GOOD_NODES};
 use rayon::prelude::*;
 use std::fmt::Write as _;
@@ -342,13 +342,13 @@ impl Cell {
     }
 
     /// The cell at the dynamics' `expression` (0..=1) as the performer plays it with the
-    /// Dynamics Guard on: at the scale `10^(-range (1 - e) / 20)` ([`DYNAMICS_RANGE_DB`]),
+    /// Dynamics Guard on: at the scale `10^(-range (1 - e) / 20)` ([`bow_scale_at`]),
     /// the bow's speed and force scaled and the bow moved from the bridge as
     /// [`guarded_bow`] says (no slower than the model's slowest bow), and the engine's
     /// intonation told the expression.
     pub fn at_expression(self, expression: f64) -> Self {
         let e = expression.clamp(0.0, 1.0);
-        let scale = 10f64.powf(-DYNAMICS_RANGE_DB * (1.0 - e) / 20.0);
+        let scale = bow_scale_at(e);
         let law = match self.model {
             Model::Point(law) => Some(law),
             Model::Thermal => None,

@@ -77,8 +77,8 @@ fn rows() -> impl Iterator<Item = (usize, &'static str)> {
 /// pitch moves by up to 30 cents between a third and two thirds and not along a line
 /// (docs/testing.md, "Dynamics"), so they are fitted at every level; between CC11 85 and
 /// 95 the Dynamics Guard lets their force go from 0.31 of the speed's to all of it, and
-/// with no row between, their notes at CC11 90 sat up to 9 cents off the line the two
-/// rows interpolate, hence 17/24. The hyperbolic law's pitch moves little and is fitted
+/// with no row between, the static law's notes at CC11 88-92 sat 5-19 cents off the line
+/// the two rows interpolate, hence 17/24. The hyperbolic law's pitch moves little and is fitted
 /// at 0, 1/3 and 2/3 only. Below a quarter the Stribeck laws' guard holds the violin's
 /// and viola's bow at its slowest (`STRIBECK_SLOWEST_SCALE`), so nothing lies between 0
 /// and 1/4 to fit.
