@@ -357,6 +357,78 @@ fn first_slip_after_the_bow_drags_the_string() {
     println!("3 N at 2 m/s^2, spans between slips up to the lasting motion (periods): {spans}");
 }
 
+/// The first slip along Guettler's rays, in periods. Dragged from rest by a bow
+/// accelerating at `a` with force `F`, the string first slips at `t1 = sqrt(2 mu_s F / (K
+/// a))` ([`first_slip_after_the_bow_drags_the_string`]). If that slip is to launch a corner
+/// as tall as Helmholtz motion's at the bow's speed then, `F = rho F_max(a t1)` with `rho`
+/// near 1 (Schelleng's `F_max = 2 Z0 v / (beta (mu_s - mu_d))` is the force whose friction
+/// drop makes the jump `v / beta`); with `K = T / (beta (1 - beta) L)` and `Z0 = T / c`
+/// the two give `t1 = 2 rho (1 - beta) mu_s / (mu_s - mu_d)` periods of the note: 3.6
+/// `rho` for paper A's coefficients at beta 0.1, whatever the string. The bare cello
+/// (hyperbolic law, beta 0.1, 0.1 m/s) on rays of constant `F / a`: the bow reaches its
+/// speed in `k T / r` (`T` the period) at `r F_max(0.1 m/s)`, so `rho = sqrt(k / 3.6)`
+/// at the first slip; printed per note, the first slip / Helmholtz motion that lasts to
+/// 0.6 s, both in periods from the bow's start; then the same rays on [`MinimalString`]
+/// (cello D3), with its loss at the bridge and at the nut. `cargo test --release -p colophony-lab
+/// --test attack_survey rays -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn first_slip_along_guettlers_rays_survey() {
+    use colophony::measure::regime::{helmholtz_since, slip_onsets};
+    use colophony::measure::window::SchellengWindow;
+    let (beta, speed) = (0.1, 0.1);
+    let notes = [36u8, 40, 43, 47, 50, 53, 57, 60, 64, 69];
+    let n = (0.6 * FS) as usize;
+    println!(
+        "cello, notes {notes:?}; first slip / lasting Helmholtz motion, periods from the bow's start"
+    );
+    for k in [1.0, 2.0, 4.0, 9.0] {
+        for r in [0.5, 0.7, 0.85] {
+            let mut line = format!("k {k:>3}, r {r:.2} (rho {:.2}):", (k / 3.6f64).sqrt());
+            let mut within_four = 0;
+            for &note in &notes {
+                let f0 = midi_to_hz(note as f64);
+                let f_max = SchellengWindow::for_note(InstrumentKind::Cello, note, beta)
+                    .expect("a cello note")
+                    .max_force_n(speed);
+                let ramp = k / f0 / r * FS;
+                let probe = bare_cello_probe(note, r * f_max, beta, n, true, |i| {
+                    speed * (i as f64 / ramp).min(1.0)
+                });
+                let periods = |i: usize| i as f64 * f0 / FS;
+                let first = slip_onsets(&probe)
+                    .first()
+                    .map_or(f64::NAN, |&i| periods(i));
+                let lasting = helmholtz_since(&probe, FS as f32, f0 as f32).map(periods);
+                within_four += usize::from(lasting.is_some_and(|p| p <= 4.0));
+                let lasting = lasting.map_or("never".into(), |p| format!("{p:.1}"));
+                line += &format!(" {:>10}", format!("{first:.1}/{lasting}"));
+            }
+            println!("{line}; lasting within 4 periods: {within_four}");
+        }
+    }
+    // The same rays on the bare digital waveguide (cello D3, `F_max` 5.06 N).
+    let f0 = midi_to_hz(50.0);
+    for at_bridge in [true, false] {
+        let mut line = format!(
+            "minimal string, loss at the {}:",
+            if at_bridge { "bridge" } else { "nut" }
+        );
+        for k in [1.0, 2.0, 4.0, 9.0] {
+            for r in [0.5, 0.7, 0.85] {
+                let ramp = k / f0 / r * FS;
+                let mut s = MinimalString::new(f0, beta, at_bridge);
+                let probe: Vec<ContactSample> = (0..n)
+                    .map(|i| s.tick(speed * (i as f64 / ramp).min(1.0), r * 5.06))
+                    .collect();
+                line += &helmholtz_since(&probe, FS as f32, f0 as f32)
+                    .map_or(" never".into(), |i| format!(" {:.1}", i as f64 * f0 / FS));
+            }
+        }
+        println!("{line} (periods to lasting Helmholtz motion, rays as above in order)");
+    }
+}
+
 /// The slip against the bow position, landed: the violin's open D string (D4) on the bare
 /// instrument (no performer), 0.1 m/s and 0.84 N (`F_max / 2` at beta 0.18), 1.2 s at
 /// 48 kHz; the slip fraction (the map's `slip_stats`, over the last 0.6 s) and its ratio
