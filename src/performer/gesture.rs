@@ -5,7 +5,6 @@
 use super::midi::RPN_NULL;
 use super::*;
 use crate::dsp::fingering::DYNAMICS_INTONATION_STEP;
-use crate::dsp::intonation::SOFT_EXPRESSIONS;
 
 /// The dynamics' range: expression 0 (CC11, CC2 or channel pressure at 0) plays the bow
 /// this many dB below expression 1 (the default, and the parameters' own bow). The
@@ -157,6 +156,8 @@ pub(super) struct Gesture {
     /// last looked at for it ([`Performer::shape`]).
     pub(super) intonation_expression: f64,
     pub(super) intonation_scale: f64,
+    /// The guard's Stribeck force shares for the law and instrument played.
+    pub(super) force_shares: ForceShares,
 }
 
 /// [`THERMAL_SLOWEST_SCALE`] for `kind`.
@@ -258,42 +259,91 @@ fn slip_force_share(law: FrictionModel, speed: f64, away: f64) -> f64 {
     }
 }
 
+/// The expression levels between which the guard's force share for the Stribeck laws
+/// goes on lines ([`stribeck_force_share`]): the intonation table's soft levels
+/// ([`crate::dsp::intonation::SOFT_EXPRESSIONS`]) that fall on a twelfth of the
+/// expression, and full expression. The table's row at 17/24 tunes the pitch only: the
+/// force is not worked out there.
+const FORCE_LEVELS: [f64; 11] = {
+    let soft = crate::dsp::intonation::SOFT_EXPRESSIONS;
+    let mut levels = [1.0; 11];
+    let (mut i, mut n) = (0, 0);
+    while i < soft.len() {
+        let twelfths = soft[i] * 12.0;
+        if (twelfths - (twelfths + 0.5) as u32 as f64).abs() < 1e-9 {
+            levels[n] = soft[i];
+            n += 1;
+        }
+        i += 1;
+    }
+    // Every place but the last holds a twelfth; the last stays at full expression.
+    assert!(n == levels.len() - 1);
+    levels
+};
+
 /// The share of the guard's force a Stribeck law (`law`) plays on `kind` at the dynamics'
-/// bow scale `scale`: [`slip_force_share`] at the intonation table's soft levels on a
-/// twelfth of the expression ([`SOFT_EXPRESSIONS`] but 17/24, and full expression),
-/// interpolated linearly in the expression between them, as the table interpolates the
-/// pitch. Where the bound lets go (CC11 85 to 95) its own force rises faster than a
-/// line; played there, the static law's notes sat 5-11 cents over the pitch the rows
-/// interpolate, and at CC11 88-92 that force (about half the speed's) puts the cello's
-/// and double bass's lowest notes into raucous motion at whichever level it falls. The
-/// force therefore goes on a line from CC11 85 to 95, and the table's row at 17/24 (CC11
-/// 90) is fitted at the line's force: it tunes the pitch, not the force
-/// (docs/testing.md, "Dynamics").
+/// bow scale `scale`: [`slip_force_share`] at [`FORCE_LEVELS`], interpolated linearly in
+/// the expression between them, as the intonation table interpolates the pitch. Where the
+/// bound lets go (CC11 85 to 95) its own force rises faster than a line; played there,
+/// the static law's notes sat 5-11 cents over the pitch the rows interpolate, and at CC11
+/// 88-92 that force (about half the speed's) puts the cello's and double bass's lowest
+/// notes into raucous motion at whichever level it falls. The force therefore goes on a
+/// line from CC11 85 to 95, and the table's row at 17/24 (CC11 90) is fitted at the
+/// line's force: it tunes the pitch, not the force (docs/testing.md, "Dynamics").
 fn stribeck_force_share(law: FrictionModel, kind: InstrumentKind, scale: f64) -> f64 {
-    let expression = expression_at(scale);
-    let at = |e: f64| match speed_and_away(Some(law), kind, bow_scale_at(e)) {
+    share_between_levels(expression_at(scale), |i| {
+        stribeck_share_at(law, kind, FORCE_LEVELS[i])
+    })
+}
+
+/// [`slip_force_share`] of Stribeck law `law` on `kind` at expression `e`, as the guard
+/// plays it there.
+fn stribeck_share_at(law: FrictionModel, kind: InstrumentKind, e: f64) -> f64 {
+    match speed_and_away(Some(law), kind, bow_scale_at(e)) {
         (speed, _) if speed >= 1.0 => 1.0,
         (speed, away) => slip_force_share(law, speed, away),
-    };
-    // The two levels either side are found first and only they are evaluated: this runs
-    // every sample while the dynamics glide.
-    let twelfths = SOFT_EXPRESSIONS
-        .iter()
-        .copied()
-        .filter(|l| (l * 12.0 - (l * 12.0).round()).abs() < 1e-9);
-    let mut below = 0.0;
-    for level in twelfths
-        .chain(std::iter::once(1.0))
-        .skip_while(|&l| l == 0.0)
-    {
+    }
+}
+
+/// The share at `expression` on the line between the two [`FORCE_LEVELS`] either side,
+/// with `share_at(i)` the share at level `i` (only those two are asked for).
+fn share_between_levels(expression: f64, share_at: impl Fn(usize) -> f64) -> f64 {
+    for i in 1..FORCE_LEVELS.len() {
+        let (below, level) = (FORCE_LEVELS[i - 1], FORCE_LEVELS[i]);
         if level >= expression {
-            let share_below = at(below);
+            let share_below = share_at(i - 1);
             let t = (expression - below) / (level - below);
-            return share_below + t * (at(level) - share_below);
+            return share_below + t * (share_at(i) - share_below);
         }
-        below = level;
     }
     1.0
+}
+
+/// A performer's Stribeck force shares at [`FORCE_LEVELS`] for the law and instrument it
+/// plays, worked out once for them: while the dynamics glide the guard's bow is asked for
+/// every sample, and each level's share costs a few `powf` and `exp`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct ForceShares {
+    of: Option<(FrictionModel, InstrumentKind)>,
+    shares: [f64; FORCE_LEVELS.len()],
+}
+
+impl ForceShares {
+    pub(super) const EMPTY: Self = Self {
+        of: None,
+        shares: [1.0; FORCE_LEVELS.len()],
+    };
+
+    /// The shares of `law` on `kind`, worked out if they are not those held.
+    fn of(&mut self, law: FrictionModel, kind: InstrumentKind) -> &[f64; FORCE_LEVELS.len()] {
+        if self.of != Some((law, kind)) {
+            for (share, &e) in self.shares.iter_mut().zip(&FORCE_LEVELS) {
+                *share = stribeck_share_at(law, kind, e);
+            }
+            self.of = Some((law, kind));
+        }
+        &self.shares
+    }
 }
 
 /// The dynamics' bow scale at expression `e` (0..=1): `10^(-range (1 - e) / 20)`.
@@ -328,6 +378,19 @@ fn speed_and_away(law: Option<FrictionModel>, kind: InstrumentKind, scale: f64) 
 /// the bridge (`s^-`[`DYNAMICS_DRIFT_EXPONENT`]; the thermal bow's drifts on below its
 /// slowest speed, the Stribeck laws' stops there).
 pub fn guarded_bow(law: Option<FrictionModel>, kind: InstrumentKind, scale: f64) -> GuardedBow {
+    guarded_bow_with(law, kind, scale, |law| {
+        stribeck_force_share(law, kind, scale)
+    })
+}
+
+/// [`guarded_bow`], with a Stribeck law's force share from `stribeck_share`.
+#[inline]
+fn guarded_bow_with(
+    law: Option<FrictionModel>,
+    kind: InstrumentKind,
+    scale: f64,
+    stribeck_share: impl FnOnce(FrictionModel) -> f64,
+) -> GuardedBow {
     let (speed, away) = speed_and_away(law, kind, scale);
     if away == 1.0 {
         return GuardedBow {
@@ -339,7 +402,7 @@ pub fn guarded_bow(law: Option<FrictionModel>, kind: InstrumentKind, scale: f64)
     let share = match law {
         None => 1.0,
         Some(FrictionModel::Hyperbolic) => slip_force_share(FrictionModel::Hyperbolic, speed, away),
-        Some(law) => stribeck_force_share(law, kind, scale),
+        Some(law) => stribeck_share(law),
     };
     GuardedBow {
         speed,
@@ -373,6 +436,7 @@ impl Gesture {
             countdown: 0,
             intonation_expression: 1.0,
             intonation_scale: 1.0,
+            force_shares: ForceShares::EMPTY,
         }
     }
 
@@ -548,8 +612,13 @@ impl Performer {
     /// [`guarded_bow`] for the source at the dynamics' bow scale `scale`. A rubbed object
     /// is no string: the slip's damping bound, set for the strings at the parameters'
     /// defaults, does not apply, and its force follows the speed.
-    pub(super) fn guarded_bow(&self, scale: f64) -> GuardedBow {
-        let guarded = guarded_bow(self.bow_law(), self.setup.instrument, scale);
+    pub(super) fn guarded_bow(&mut self, scale: f64) -> GuardedBow {
+        let (law, kind) = (self.bow_law(), self.setup.instrument);
+        let shares = &mut self.gesture.force_shares;
+        let guarded = guarded_bow_with(law, kind, scale, |law| {
+            let shares = shares.of(law, kind);
+            share_between_levels(expression_at(scale), |i| shares[i])
+        });
         match self.source {
             Source::Rubbed(_) => GuardedBow {
                 force: guarded.speed,
@@ -563,7 +632,7 @@ impl Performer {
     /// guard, no lower than the source's slowest bow scale.
     fn dynamics_velocity_scale(&self, scale: f64) -> f64 {
         if self.setup.dynamics_guard {
-            self.guarded_bow(scale).speed
+            speed_and_away(self.bow_law(), self.setup.instrument, scale).0
         } else {
             scale
         }
@@ -842,6 +911,51 @@ mod tests {
         p.set_controller(11, e);
         p.note_on(note, 0.8);
         (p, setup)
+    }
+
+    #[test]
+    fn the_force_levels_are_the_intonation_tables_twelfths_and_full_expression() {
+        // The table's levels on a twelfth: 0, then every twelfth from a quarter (its
+        // 17/24 row is not one).
+        let expected: Vec<f64> = std::iter::once(0.0)
+            .chain((3..12).map(|k| k as f64 / 12.0))
+            .chain(std::iter::once(1.0))
+            .collect();
+        for (level, want) in FORCE_LEVELS.iter().zip(&expected) {
+            assert!((level - want).abs() < 1e-15, "{level} against {want}");
+        }
+        assert_eq!(FORCE_LEVELS.len(), expected.len());
+    }
+
+    #[test]
+    fn the_performers_kept_force_shares_give_the_guards_bow_to_the_bit() {
+        // The shares a performer keeps for its law and instrument give the bow the guard
+        // works out afresh, exactly, across the dynamics, on every law and instrument and
+        // after the law is switched on the same performer.
+        for kind in InstrumentKind::ALL {
+            let mut p = Performer::new(kind);
+            let setup = |law| Setup {
+                instrument: kind,
+                point_law: Some(law),
+                ..Setup::default()
+            };
+            p.activate(&setup(FrictionModel::Hyperbolic), FS).unwrap();
+            for law in FrictionModel::ALL
+                .into_iter()
+                .chain([FrictionModel::Stribeck])
+            {
+                p.configure(&setup(law));
+                for k in 0..=240 {
+                    let scale = bow_scale_at(k as f64 / 240.0);
+                    assert_eq!(
+                        p.guarded_bow(scale),
+                        guarded_bow(Some(law), kind, scale),
+                        "{kind:?}, {}, scale {scale}",
+                        law.name()
+                    );
+                }
+            }
+        }
     }
 
     #[test]
