@@ -429,6 +429,46 @@ fn first_slip_along_guettlers_rays_survey() {
     }
 }
 
+/// Guettler's own attacks: the bow accelerating at a constant rate the whole time (no
+/// speed to settle at) with a constant force, on the bare cello's D3 (hyperbolic law, beta
+/// 0.1), with the string's stiffness (the nut's dispersion sections) and without; printed:
+/// the first slip / the first of six slips one period apart ([`first_helmholtz_run`]), in
+/// periods from the bow's start. A perfect attack has the two equal. `cargo test
+/// --release -p colophony-lab --test attack_survey constant_acceleration -- --ignored
+/// --nocapture`.
+#[test]
+#[ignore]
+fn guettlers_constant_acceleration_with_and_without_stiffness_survey() {
+    use colophony::measure::regime::slip_onsets;
+    let (note, beta) = (50u8, 0.1);
+    let f0 = midi_to_hz(note as f64);
+    let n = (0.5 * FS) as usize;
+    let accels = [0.25, 0.5, 1.0, 2.0, 4.0, 8.0];
+    for stiff in [true, false] {
+        println!(
+            "cello D3, {}: rows force (N), columns acceleration {accels:?} (m/s^2)",
+            if stiff {
+                "as played"
+            } else {
+                "without stiffness"
+            }
+        );
+        for force_n in [0.5, 1.0, 1.5, 2.5, 3.5, 5.0, 7.5] {
+            let mut row = format!("{force_n:>4}");
+            for &a in &accels {
+                let probe = bare_cello_probe(note, force_n, beta, n, stiff, |i| a * i as f64 / FS);
+                let periods = |i: usize| format!("{:.1}", i as f64 * f0 / FS);
+                let first = slip_onsets(&probe)
+                    .first()
+                    .map_or("-".into(), |&i| periods(i));
+                let six = first_helmholtz_run(&probe, f0, 6).map_or("-".into(), periods);
+                row += &format!(" {:>9}", format!("{first}/{six}"));
+            }
+            println!("{row}");
+        }
+    }
+}
+
 /// The slip against the bow position, landed: the violin's open D string (D4) on the bare
 /// instrument (no performer), 0.1 m/s and 0.84 N (`F_max / 2` at beta 0.18), 1.2 s at
 /// 48 kHz; the slip fraction (the map's `slip_stats`, over the last 0.6 s) and its ratio
