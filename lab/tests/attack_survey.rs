@@ -431,7 +431,8 @@ fn first_slip_along_guettlers_rays_survey() {
 
 /// Guettler's own attacks: the bow accelerating at a constant rate the whole time (no
 /// speed to settle at) with a constant force, on the bare cello's D3 (hyperbolic law, beta
-/// 0.1), with the string's stiffness (the nut's dispersion sections) and without; printed:
+/// 0.1; or `NOTE`, its forces scaled by `FORCE_SCALE` as in [`guettler_diagram_survey`]),
+/// with the string's stiffness (the nut's dispersion sections) and without; printed:
 /// the first slip / the first of six slips one period apart ([`first_helmholtz_run`]), in
 /// periods from the bow's start. A perfect attack has the two equal. `cargo test
 /// --release -p colophony-lab --test attack_survey constant_acceleration -- --ignored
@@ -440,21 +441,24 @@ fn first_slip_along_guettlers_rays_survey() {
 #[ignore]
 fn guettlers_constant_acceleration_with_and_without_stiffness_survey() {
     use colophony::measure::regime::slip_onsets;
-    let (note, beta) = (50u8, 0.1);
+    let note: u8 = std::env::var("NOTE").map_or(50, |s| s.parse().expect("NOTE: a MIDI note"));
+    let scale: f64 =
+        std::env::var("FORCE_SCALE").map_or(1.0, |s| s.parse().expect("FORCE_SCALE: a factor"));
+    let beta = 0.1;
     let f0 = midi_to_hz(note as f64);
     let n = (0.5 * FS) as usize;
     let accels = [0.25, 0.5, 1.0, 2.0, 4.0, 8.0];
     for stiff in [true, false] {
         println!(
-            "cello D3, {}: rows force (N), columns acceleration {accels:?} (m/s^2)",
+            "cello note {note}, {}: rows force (N), columns acceleration {accels:?} (m/s^2)",
             if stiff {
                 "as played"
             } else {
                 "without stiffness"
             }
         );
-        for force_n in [0.5, 1.0, 1.5, 2.5, 3.5, 5.0, 7.5] {
-            let mut row = format!("{force_n:>4}");
+        for force_n in [0.5, 1.0, 1.5, 2.5, 3.5, 5.0, 7.5].map(|f| f * scale) {
+            let mut row = format!("{force_n:>5.2}");
             for &a in &accels {
                 let probe = bare_cello_probe(note, force_n, beta, n, stiff, |i| a * i as f64 / FS);
                 let periods = |i: usize| format!("{:.1}", i as f64 * f0 / FS);
