@@ -361,7 +361,7 @@ fn first_slip_after_the_bow_drags_the_string() {
 /// accelerating at `a` with force `F`, the string first slips at `t1 = sqrt(2 mu_s F / (K
 /// a))` ([`first_slip_after_the_bow_drags_the_string`]). If that slip is to launch a corner
 /// as tall as Helmholtz motion's at the bow's speed then, `F = rho F_max(a t1)` with `rho`
-/// near 1 (Schelleng's `F_max = 2 Z0 v / (beta (mu_s - mu_d))` is the force whose friction
+/// of order 1 (Schelleng's `F_max = 2 Z0 v / (beta (mu_s - mu_d))` is the force whose friction
 /// drop makes the jump `v / beta`); with `K = T / (beta (1 - beta) L)` and `Z0 = T / c`
 /// the two give `t1 = 2 rho (1 - beta) mu_s / (mu_s - mu_d)` periods of the note: 3.6
 /// `rho` for paper A's coefficients at beta 0.1, whatever the string. The bare cello
