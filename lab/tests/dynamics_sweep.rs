@@ -483,3 +483,69 @@ fn short_slip_map() {
         }
     }
 }
+
+/// How quiet paper B's thermal bow can play in Helmholtz motion, whatever the dynamics
+/// do: each instrument's lowest and highest open strings and a note an octave above the
+/// lowest, bowed directly (full expression, velocity 100) at the parameters' speed times
+/// `s` (1, 0.6, 0.5, 0.45, 0.4) and bow position beta (0.1, 0.15, 0.2, 0.3, 0.4), the
+/// force times `s 0.1 / beta` (its place in Schelleng's window kept: both limits scale as
+/// `v_b / beta`). Printed per note: the level (dB) and regime of every pair, and the
+/// quietest Helmholtz-motion level against the default bow's (s 1, beta 0.1): the most
+/// range any dynamics can get from the model in that motion. `cargo test --release -p
+/// colophony-lab --test dynamics_sweep thermal_floor_by_bow_position -- --ignored
+/// --nocapture` (about 30 s).
+#[test]
+#[ignore]
+fn thermal_floor_by_bow_position() {
+    const SCALES: [f64; 5] = [1.0, 0.6, 0.5, 0.45, 0.4];
+    const BETAS: [f64; 5] = [0.1, 0.15, 0.2, 0.3, 0.4];
+    let d = BowControl::default();
+    let notes: Vec<(InstrumentKind, u8)> = InstrumentKind::ALL
+        .iter()
+        .flat_map(|&kind| {
+            let open = kind.open_notes();
+            [
+                (kind, open[0]),
+                (kind, open[0] + 12),
+                (kind, open[open.len() - 1]),
+            ]
+        })
+        .collect();
+    let lines: Vec<String> = notes
+        .par_iter()
+        .map(|&(kind, note)| {
+            let setup = Setup {
+                instrument: kind,
+                point_law: None,
+                ..Setup::default()
+            };
+            let mut line = format!("{kind:?} {note}:");
+            let mut full = None;
+            let mut quietest = f64::INFINITY;
+            for beta in BETAS {
+                line += &format!("\n  beta {beta:.2}:");
+                for s in SCALES {
+                    let bow = BowControl {
+                        velocity_m_per_s: d.velocity_m_per_s * s,
+                        force_n: d.force_n * s * d.position_beta / beta,
+                        position_beta: beta,
+                    };
+                    let (db, _, regime) = play_bow(&setup, note, bow);
+                    if s == 1.0 && beta == BETAS[0] {
+                        full = Some(db);
+                    }
+                    if regime == Some(Regime::Helmholtz) {
+                        quietest = quietest.min(db);
+                    }
+                    line += &format!(" s{s}: {db:.1} {}", regime_name(regime));
+                }
+            }
+            let range = full.map_or(f64::NAN, |f| f - quietest);
+            line += &format!("\n  most range in Helmholtz motion: {range:.1} dB");
+            line
+        })
+        .collect();
+    for line in lines {
+        println!("{line}");
+    }
+}
