@@ -268,11 +268,17 @@ fn regime_name(g: Option<Regime>) -> String {
 /// (level dB, cents, regime) of `note` played with `setup` and the bow `bow` as given
 /// (velocity 100, full expression), measured as [`play`] does.
 fn play_bow(setup: &Setup, note: u8, bow: BowControl) -> (f64, f64, Option<Regime>) {
+    let (level, pitch, regime, _) = play_bow_full(setup, note, bow);
+    (level, pitch, regime)
+}
+
+/// [`play_bow`], with whether the map's full criterion holds ([`measure_full`]).
+fn play_bow_full(setup: &Setup, note: u8, bow: BowControl) -> (f64, f64, Option<Regime>, bool) {
     let mut p = Performer::new(setup.instrument);
     p.activate(setup, FS).expect("activate");
     p.configure(setup);
     p.note_on(note, 100.0 / 127.0);
-    measure(&mut p, setup, note, bow)
+    measure_full(&mut p, setup, note, bow)
 }
 
 /// The share of every note in Helmholtz motion at the middle dynamics with the force
@@ -519,12 +525,11 @@ fn short_slip_map() {
 /// 0.035, 0.025 and `f` 1, 0.5, 0.25); `SCALES=..` and `FORCES=..` for others. Printed
 /// per note: the quietest level in Helmholtz motion by the map's full criterion (one slip
 /// a period lasting beta of it, sticking at the bow's speed) against the default bow's
-/// (s 1,
-/// beta 0.1, f 1) and where it was found, the most range any dynamics can get from the
-/// model in that motion; `DETAIL=1` adds every pair's level and regime (`+` where the
-/// full criterion holds). `cargo test
-/// --release -p colophony-lab --test dynamics_sweep softest_helmholtz_by_bow_position --
-/// --ignored --nocapture` (about 30 s for the thermal bow, 2 min for a point law).
+/// (s 1, beta 0.1, f 1) and where it was found, the most range any dynamics can get from
+/// the model in that motion; `DETAIL=1` adds every pair's level and regime (`+` where the
+/// full criterion holds). `cargo test --release -p colophony-lab --test dynamics_sweep
+/// softest_helmholtz_by_bow_position -- --ignored --nocapture` (about 30 s for the
+/// thermal bow, 3 min for a point law).
 #[test]
 #[ignore]
 fn softest_helmholtz_by_bow_position() {
@@ -585,12 +590,7 @@ fn softest_helmholtz_by_bow_position() {
                             force_n: d.force_n * f * s * d.position_beta / beta,
                             position_beta: beta,
                         };
-                        let mut p = Performer::new(kind);
-                        p.activate(&setup, FS).expect("activate");
-                        p.configure(&setup);
-                        p.note_on(note, 100.0 / 127.0);
-                        let (db, _, regime, helmholtz) =
-                            measure_full(&mut p, &setup, note, bow);
+                        let (db, _, regime, helmholtz) = play_bow_full(&setup, note, bow);
                         if s == 1.0 && beta == BETAS[0] && f == 1.0 {
                             full = Some(db);
                         }
